@@ -1,0 +1,60 @@
+"""Python-level benchmarks with side-by-side ratios against peer libraries, in one process.
+
+Run: ``make bench-python`` (or ``.venv/bin/python benches/bench_python.py [--quick]``).
+Prints one line per case: median wall time of uasnav, of the peer, and the ratio. The machine is
+shared and noisy: we report medians of several repeats and compare within the same process.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+
+def median_time(fn: Callable[[], object], repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def bench_allan(n: int, repeat: int) -> None:
+    import allantools
+
+    from uasnav.allan import oadev
+
+    rng = np.random.default_rng(0)
+    y = rng.normal(0.1, 0.01, n)
+    ours = oadev(y, rate=100.0, taus="octave")
+    _, ref, _, _ = allantools.oadev(y, rate=100.0, data_type="freq", taus="octave")
+    worst = float(np.max(np.abs(ours.adev - ref) / ref))
+    t_ours = median_time(lambda: oadev(y, rate=100.0, taus="octave"), repeat)
+    t_ref = median_time(lambda: allantools.oadev(y, rate=100.0, data_type="freq", taus="octave"), repeat)
+    print(
+        f"allan oadev octave n={n:.0e}: uasnav {t_ours * 1e3:8.1f} ms | allantools {t_ref * 1e3:8.1f} ms"
+        f" | speed-up {t_ref / t_ours:5.1f}x | max rel diff {worst:.1e}"
+    )
+
+
+CASES: dict[str, Callable[[bool], None]] = {
+    "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
+}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--quick", action="store_true", help="smaller inputs, fewer repeats")
+    ap.add_argument("cases", nargs="*", help=f"cases to run (default all): {', '.join(CASES)}")
+    args = ap.parse_args()
+    for name in args.cases or list(CASES):
+        CASES[name](args.quick)
+
+
+if __name__ == "__main__":
+    main()

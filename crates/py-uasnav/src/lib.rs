@@ -1,0 +1,19 @@
+//! `uasnav._core`: the Python binding of nav-core.
+//!
+//! This crate only extracts, checks, converts, releases the GIL and maps errors; every
+//! number is computed in nav-core. One file per nav-core concept, registered below.
+mod allan;
+mod attitude;
+mod convert;
+mod errors;
+
+use pyo3::prelude::*;
+
+/// The compiled core of uasnav (private: import `uasnav.allan`, `uasnav.attitude`, …).
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    allan::register(m)?;
+    attitude::register(m)?;
+    Ok(())
+}

@@ -1,0 +1,80 @@
+"""Type stubs of the compiled extension ``uasnav._core`` (checked by ``mypy.stubtest``).
+
+Private API: import :mod:`uasnav.allan`, :mod:`uasnav.attitude`, … instead. Units: SI;
+quaternions scalar first, body → NED.
+"""
+
+import numpy as np
+from numpy.typing import NDArray
+
+__version__: str
+__all__ = [
+    "__version__",
+    "allan_cluster_size_for_tau",
+    "allan_cluster_sizes",
+    "allan_oavar",
+    "attitude_dcm_to_quat",
+    "attitude_drift_angles",
+    "attitude_euler_to_quat",
+    "attitude_first_crossing_times",
+    "attitude_propagate",
+    "attitude_quat_to_dcm",
+    "attitude_quat_to_euler",
+    "attitude_rotation_angle",
+    "noise_fit_ieee952",
+    "noise_read_points",
+]
+
+# --- allan / noise -------------------------------------------------------------------------
+def allan_cluster_sizes(n: int, spacing_name: str) -> list[int]:
+    """Cluster sizes m of a spacing ('octave', 'decade', 'all') for n samples."""
+
+def allan_cluster_size_for_tau(tau_s: float, tau0_s: float) -> int:
+    """Cluster size for a cluster time (s) at sample period tau0_s (s)."""
+
+def allan_oavar(
+    data: NDArray[np.float64], tau0_s: float, ms: list[int]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.uint64], NDArray[np.float64]]:
+    """Overlapping Allan variance of each column of data (n, k): (taus, avar (len(ms), k),
+    n_terms, rel_error)."""
+
+def noise_fit_ieee952(
+    taus: NDArray[np.float64], avar: NDArray[np.float64], rel_error: NDArray[np.float64]
+) -> tuple[list[float], list[bool], float]:
+    """Five-term IEEE 952 fit: ([Q, N, B, K, R] SI, active flags, weighted rms rel. residual)."""
+
+def noise_read_points(
+    taus: NDArray[np.float64], avar: NDArray[np.float64], rel_error: NDArray[np.float64]
+) -> list[tuple[float, int, float] | None]:
+    """Slope-line readings for Q, N, B, K, R: (value, segment index, slope) or None."""
+
+# --- attitude ------------------------------------------------------------------------------
+def attitude_propagate(
+    q0: list[float], rates: NDArray[np.float64], dt_s: float, coning: bool = False
+) -> NDArray[np.float64]:
+    """Quaternions (n, 4) after each body-rate sample (n, 3) rad/s held for dt_s."""
+
+def attitude_drift_angles(
+    rates: NDArray[np.float64], dt_s: float, coning: bool = False
+) -> NDArray[np.float64]:
+    """Rotation angle θ (rad) after each step of integrating rates (n, 3) from identity."""
+
+def attitude_first_crossing_times(
+    theta: NDArray[np.float64], dt_s: float, thresholds: list[float]
+) -> list[float | None]:
+    """First time (s) θ reaches each threshold (rad), None if never."""
+
+def attitude_rotation_angle(q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """θ = 2·acos(|q_s|) (rad) of quaternions (n, 4)."""
+
+def attitude_euler_to_quat(euler: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Quaternions (n, 4) from 3-2-1 Euler angles (n, 3) [roll, pitch, yaw] rad."""
+
+def attitude_quat_to_euler(q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """3-2-1 Euler angles (n, 3) of quaternions (n, 4)."""
+
+def attitude_quat_to_dcm(q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """DCMs C_b^n (n, 3, 3) of quaternions (n, 4)."""
+
+def attitude_dcm_to_quat(dcm: NDArray[np.float64], tol: float = 1e-6) -> NDArray[np.float64]:
+    """Quaternions (n, 4) of DCMs C_b^n (n, 3, 3)."""

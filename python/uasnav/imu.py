@@ -1,0 +1,139 @@
+"""The in-memory IMU recording: :class:`ImuLog`.
+
+One type for every source (CSV v1, simulator, PX4, ArduPilot …). Arrays are float64 in SI
+units, body frame (x forward, y right, z down):
+
+========  ============  =====================================
+field     shape         unit
+========  ============  =====================================
+t         (n,)          s, strictly increasing
+gyro      (n, 3)        rad/s
+accel     (n, 3)        m/s² (specific force)
+temp      (n,) or None  °C (die temperature of the sensor)
+mag       (n, 3)|None   µT
+truth     dict          ground-truth channels of simulated logs
+========  ============  =====================================
+
+``truth`` keys used across uasnav: ``gyro_bias`` (n, 3) rad/s, ``accel_bias`` (n, 3) m/s²,
+``attitude`` (n, 4) quaternion body → NED, scalar first.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from uasnav.errors import InputError
+
+FloatArray = NDArray[np.float64]
+
+
+def _as_float_array(name: str, value: Any, shape_tail: tuple[int, ...], n: int | None) -> FloatArray:
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.ndim != 1 + len(shape_tail) or arr.shape[1:] != shape_tail:
+        want = "(n" + "".join(f", {d}" for d in shape_tail) + ")"
+        raise InputError(f"{name}: expected shape {want}, got {arr.shape}")
+    if n is not None and arr.shape[0] != n:
+        raise InputError(f"{name}: expected {n} rows (one per time stamp), got {arr.shape[0]}")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        idx = np.argwhere(bad)[0]
+        where = f"row {idx[0]}" + (f", column {idx[1]}" if arr.ndim > 1 else "")
+        raise InputError(f"{name}: non-finite value (NaN or inf) at {where}")
+    return arr
+
+
+def check_time(t: FloatArray, name: str = "t") -> None:
+    """Raise :class:`InputError` unless ``t`` is strictly increasing (names the first bad row)."""
+    if t.size >= 2:
+        d = np.diff(t)
+        bad = np.flatnonzero(d <= 0)
+        if bad.size:
+            i = int(bad[0]) + 1
+            kind = "duplicated" if d[bad[0]] == 0 else "decreasing"
+            raise InputError(f"{name}: {kind} time stamp at row {i} ({t[i - 1]!r} then {t[i]!r})")
+
+
+@dataclass(frozen=True)
+class ImuLog:
+    """An IMU recording in SI units (see the module docs for shapes and units).
+
+    The constructor validates shapes, finiteness and strictly increasing time, so an
+    ``ImuLog`` that exists is usable.
+    """
+
+    t: FloatArray
+    gyro: FloatArray
+    accel: FloatArray
+    temp: FloatArray | None = None
+    mag: FloatArray | None = None
+    truth: dict[str, FloatArray] = field(default_factory=dict)
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        t = _as_float_array("t", self.t, (), None)
+        if t.size < 2:
+            raise InputError(f"t: need at least 2 samples, got {t.size}")
+        check_time(t)
+        n = t.size
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "gyro", _as_float_array("gyro", self.gyro, (3,), n))
+        object.__setattr__(self, "accel", _as_float_array("accel", self.accel, (3,), n))
+        if self.temp is not None:
+            object.__setattr__(self, "temp", _as_float_array("temp", self.temp, (), n))
+        if self.mag is not None:
+            object.__setattr__(self, "mag", _as_float_array("mag", self.mag, (3,), n))
+        truth = {}
+        for k, v in self.truth.items():
+            arr = np.asarray(v, dtype=np.float64)
+            truth[k] = _as_float_array(f"truth[{k!r}]", arr, arr.shape[1:], n)
+        object.__setattr__(self, "truth", truth)
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return int(self.t.size)
+
+    @property
+    def duration(self) -> float:
+        """Time span ``t[-1] - t[0]`` (s)."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def sample_rate(self) -> float:
+        """Sample rate (Hz) from the median time step."""
+        return float(1.0 / np.median(np.diff(self.t)))
+
+    def uniform_rate(self, rtol: float = 0.01) -> float:
+        """Sample rate (Hz) if every step is within ``rtol`` of the median, else InputError."""
+        d = np.diff(self.t)
+        med = float(np.median(d))
+        worst = int(np.argmax(np.abs(d - med)))
+        if abs(d[worst] - med) > rtol * med:
+            raise InputError(
+                f"t: sampling is not uniform (step {d[worst]:.6g} s at row {worst + 1} vs median "
+                f"{med:.6g} s); resample first or pass the rate explicitly"
+            )
+        return 1.0 / med
+
+    def slice(self, start: int, stop: int) -> ImuLog:
+        """Samples ``start:stop`` as a new log (truth channels sliced alike)."""
+
+        def cut(a: FloatArray | None) -> FloatArray | None:
+            return None if a is None else a[start:stop]
+
+        return ImuLog(
+            t=self.t[start:stop],
+            gyro=self.gyro[start:stop],
+            accel=self.accel[start:stop],
+            temp=cut(self.temp),
+            mag=cut(self.mag),
+            truth={k: v[start:stop] for k, v in self.truth.items()},
+            meta=dict(self.meta),
+        )
+
+
+__all__ = ["ImuLog", "check_time"]

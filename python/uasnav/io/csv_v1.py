@@ -1,0 +1,196 @@
+"""Log format v1: CSV with a header row.
+
+======== ======== ==========================================
+column   unit     required
+======== ======== ==========================================
+t        s        yes — strictly increasing
+gx gy gz rad/s    yes — body-frame angular rate
+ax ay az m/s²     yes — body-frame specific force
+temp     °C       no — sensor (die) temperature
+mx my mz µT       no — magnetometer
+truth_*  SI       no — ground truth of simulated logs, e.g.
+                  ``truth_gyro_bias_x`` (rad/s); stored in ``ImuLog.truth`` as
+                  ``gyro_bias`` with columns x, y, z (or ``_0 … _k`` for other widths)
+======== ======== ==========================================
+
+Lines starting with ``#`` before the header are comments; ``# key: value`` comments become
+``ImuLog.meta``. Any other column is ignored. Missing required columns, non-numeric cells,
+NaN/inf and non-increasing ``t`` are errors naming the line and column. Numbers are written
+with 17 significant digits, so write → read round-trips bit for bit.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+
+from uasnav.atomicfile import atomic_open
+from uasnav.errors import DataFormatError
+from uasnav.imu import ImuLog
+
+REQUIRED = ("t", "gx", "gy", "gz", "ax", "ay", "az")
+_AXES = ("x", "y", "z")
+
+
+def read_csv_v1(path: str | os.PathLike[str]) -> ImuLog:
+    """Read a CSV v1 log.
+
+    Raises
+    ------
+    DataFormatError
+        On a missing file or required column, a non-numeric or non-finite cell, or
+        non-increasing time; the message names the file, line and column.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise DataFormatError("no such file", path=str(p)) from None
+    except UnicodeDecodeError as e:
+        raise DataFormatError(f"not a UTF-8 text file ({e.reason})", path=str(p)) from None
+    return parse_csv_v1(text, source=str(p))
+
+
+def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
+    """Parse CSV v1 text (see :func:`read_csv_v1`)."""
+    lines = text.splitlines()
+    meta: dict[str, str] = {}
+    i = 0
+    while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
+        m = re.match(r"#\s*([\w.-]+)\s*:\s*(.*)$", lines[i])
+        if m:
+            meta[m.group(1)] = m.group(2).strip()
+        i += 1
+    if i >= len(lines):
+        raise DataFormatError("empty file (no header row)", path=source)
+    header_line = i + 1
+    reader = csv.reader(io.StringIO("\n".join(lines[i:])))
+    header = [h.strip() for h in next(reader)]
+    missing = [c for c in REQUIRED if c not in header]
+    if missing:
+        raise DataFormatError(
+            f"missing required column(s) {', '.join(missing)} (header: {','.join(header)})",
+            path=source,
+            line=header_line,
+        )
+    if len(set(header)) != len(header):
+        dup = sorted({h for h in header if header.count(h) > 1})
+        raise DataFormatError(f"duplicated column(s) {', '.join(dup)}", path=source, line=header_line)
+    optional = [c for c in ("temp", "mx", "my", "mz") if c in header]
+    truth_cols = [c for c in header if c.startswith("truth_")]
+    wanted = list(REQUIRED) + optional + truth_cols
+    idx = [header.index(c) for c in wanted]
+    rows: list[list[float]] = []
+    for k, row in enumerate(reader):
+        line_no = header_line + 1 + k
+        if not row or all(not c.strip() for c in row):
+            continue
+        if len(row) != len(header):
+            raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=source, line=line_no)
+        vals = []
+        for c, j in zip(wanted, idx, strict=True):
+            cell = row[j].strip()
+            try:
+                v = float(cell)
+            except ValueError:
+                raise DataFormatError(
+                    f"not a number: {cell!r}", path=source, line=line_no, column=c
+                ) from None
+            if not np.isfinite(v):
+                raise DataFormatError(f"non-finite value {cell!r}", path=source, line=line_no, column=c)
+            vals.append(v)
+        rows.append(vals)
+    if len(rows) < 2:
+        raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
+    data = np.array(rows, dtype=np.float64)
+    col = {c: data[:, j] for j, c in enumerate(wanted)}
+    t = col["t"]
+    d = np.diff(t)
+    bad = np.flatnonzero(d <= 0)
+    if bad.size:
+        r = int(bad[0]) + 1
+        kind = "duplicated" if d[bad[0]] == 0 else "decreasing"
+        raise DataFormatError(
+            f"{kind} time stamp ({t[r - 1]!r} then {t[r]!r}); t must be strictly increasing",
+            path=source,
+            line=_data_line(lines, header_line, r),
+            column="t",
+        )
+    truth = _group_truth(truth_cols, col)
+    return ImuLog(
+        t=t,
+        gyro=np.column_stack([col["gx"], col["gy"], col["gz"]]),
+        accel=np.column_stack([col["ax"], col["ay"], col["az"]]),
+        temp=col.get("temp"),
+        mag=np.column_stack([col["mx"], col["my"], col["mz"]]) if "mx" in col else None,
+        truth=truth,
+        meta={**meta, "source": source, "format": "csv-v1"},
+    )
+
+
+def _data_line(lines: list[str], header_line: int, row: int) -> int:
+    """File line number of data row ``row`` (0-based), skipping blank lines."""
+    count = -1
+    for ln in range(header_line, len(lines)):
+        if lines[ln].strip():
+            count += 1
+            if count == row:
+                return ln + 1
+    return header_line + 1 + row
+
+
+def _group_truth(cols: list[str], col: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    groups: dict[str, list[tuple[str, str]]] = {}
+    for c in cols:
+        base, _, suffix = c[len("truth_") :].rpartition("_")
+        if not base:
+            base, suffix = suffix, ""
+        groups.setdefault(base, []).append((suffix, c))
+    out = {}
+    for base, items in groups.items():
+        if [s for s, _ in items] == [""]:
+            out[base] = col[items[0][1]]
+        else:
+            order = {a: i for i, a in enumerate(_AXES)}
+            items.sort(key=lambda sc: order.get(sc[0], 100 + int(sc[0]) if sc[0].isdigit() else 1000))
+            out[base] = np.column_stack([col[c] for _, c in items])
+    return out
+
+
+def _truth_columns(name: str, arr: np.ndarray) -> list[tuple[str, np.ndarray]]:
+    if arr.ndim == 1:
+        return [(f"truth_{name}", arr)]
+    k = arr.shape[1]
+    suffixes = _AXES if k == 3 else tuple(str(i) for i in range(k))
+    return [(f"truth_{name}_{s}", arr[:, j]) for j, s in enumerate(suffixes)]
+
+
+def write_csv_v1(log: ImuLog, path: str | os.PathLike[str]) -> None:
+    """Write ``log`` as CSV v1, atomically (temporary file + rename)."""
+    cols: list[tuple[str, np.ndarray]] = [("t", log.t)]
+    cols += [(f"g{a}", log.gyro[:, j]) for j, a in enumerate(_AXES)]
+    cols += [(f"a{a}", log.accel[:, j]) for j, a in enumerate(_AXES)]
+    if log.temp is not None:
+        cols.append(("temp", log.temp))
+    if log.mag is not None:
+        cols += [(f"m{a}", log.mag[:, j]) for j, a in enumerate(_AXES)]
+    for name, arr in log.truth.items():
+        cols += _truth_columns(name, arr)
+    with atomic_open(path, "w") as fh:
+        fh.write("# uasnav log format v1 (SI units: s, rad/s, m/s^2, degC, uT)\n")
+        for k, v in log.meta.items():
+            if k in ("source", "format"):
+                continue
+            fh.write(f"# {k}: {str(v).splitlines()[0] if str(v) else ''}\n")
+        fh.write(",".join(c for c, _ in cols) + "\n")
+        block = np.column_stack([a for _, a in cols])
+        # %.17g round-trips every float64 exactly.
+        np.savetxt(fh, block, fmt="%.17g", delimiter=",")
+
+
+__all__ = ["REQUIRED", "parse_csv_v1", "read_csv_v1", "write_csv_v1"]
