@@ -95,6 +95,34 @@ _UNITS: dict[str, tuple[float, str]] = {
     "km/h": (1.0 / 3.6, "m/s"),
     "kn": (1852.0 / _H, "m/s"),
     "Hz": (1.0, "1/s"),
+    # dimensionless ratios (scale factors, misalignment as small angles use "mrad")
+    "1": (1.0, "1"),
+    "ppm": (1e-6, "1"),
+    "%": (1e-2, "1"),
+    # temperature coefficients (per kelvin = per °C difference)
+    "1/K": (1.0, "1/K"),
+    "1/degC": (1.0, "1/K"),
+    "ppm/degC": (1e-6, "1/K"),
+    "%/degC": (1e-2, "1/K"),
+    "rad/s/K": (1.0, "rad/s/K"),
+    "deg/s/degC": (_DEG, "rad/s/K"),
+    "mdps/degC": (1e-3 * _DEG, "rad/s/K"),
+    "deg/h/degC": (_DEG / _H, "rad/s/K"),
+    "m/s^2/K": (1.0, "m/s^2/K"),
+    "mg/degC": (1e-3 * STANDARD_GRAVITY, "m/s^2/K"),
+    "ug/degC": (1e-6 * STANDARD_GRAVITY, "m/s^2/K"),
+    # g-sensitivity of gyros (rate error per specific force)
+    "rad/s/(m/s^2)": (1.0, "rad·s/m"),
+    "deg/s/g": (_DEG / STANDARD_GRAVITY, "rad·s/m"),
+    "deg/h/g": (_DEG / _H / STANDARD_GRAVITY, "rad·s/m"),
+    # magnetic flux density
+    "T": (1.0, "T"),
+    "uT": (1e-6, "T"),
+    "µT": (1e-6, "T"),
+    "G": (1e-4, "T"),
+    "gauss": (1e-4, "T"),
+    "mG": (1e-7, "T"),
+    "mgauss": (1e-7, "T"),
 }
 
 # ASCII spellings users type on a command line.

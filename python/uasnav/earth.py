@@ -1,0 +1,94 @@
+"""WGS-84 Earth model: normal gravity and Earth rotation in the local NED frame.
+
+Conventions: latitude φ geodetic (rad), height h above the ellipsoid (m), NED navigation frame
+(north, east, down). Gravity is returned down-positive, so a unit at rest measures the
+specific force ``f = −g_ned = [0, 0, −g]`` (accelerometer "up" reaction).
+
+References
+----------
+P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*,
+2nd ed., Artech House (2013): eq. 2.134 (Somigliana normal gravity on the ellipsoid) and
+eq. 2.139 (second-order free-air height correction).
+NIMA TR8350.2, *Department of Defense World Geodetic System 1984*, 3rd ed. (2000), Table 3.1–3.3.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: Earth rotation rate ω_ie (rad/s), WGS-84.
+OMEGA_IE = 7.292115e-5
+#: WGS-84 semi-major axis (m).
+WGS84_A = 6378137.0
+#: WGS-84 flattening.
+WGS84_F = 1.0 / 298.257223563
+#: WGS-84 first eccentricity squared e².
+WGS84_E2 = WGS84_F * (2.0 - WGS84_F)
+#: WGS-84 semi-minor axis (m).
+WGS84_B = WGS84_A * (1.0 - WGS84_F)
+#: WGS-84 Earth gravitational constant GM (m³/s²).
+WGS84_MU = 3.986004418e14
+#: Normal gravity at the equator (m/s²), WGS-84.
+GAMMA_EQUATOR = 9.7803253359
+#: Somigliana constant k = (b·γ_p)/(a·γ_e) − 1, WGS-84.
+SOMIGLIANA_K = 0.00193185265241
+
+
+def normal_gravity(latitude_rad: float, height_m: float = 0.0) -> float:
+    """WGS-84 normal gravity magnitude (m/s²) at geodetic latitude and ellipsoidal height.
+
+    Somigliana's closed form on the ellipsoid, then the second-order free-air correction
+    ``γ(h) = γ₀ [1 − 2/a (1 + f + m − 2 f sin²φ) h + 3 h²/a²]`` (Groves eq. 2.139), with
+    ``m = ω_ie² a² b / GM``.
+
+    Parameters
+    ----------
+    latitude_rad : float
+        Geodetic latitude φ (rad).
+    height_m : float
+        Height above the WGS-84 ellipsoid (m).
+
+    Returns
+    -------
+    float
+        |g| (m/s²); 9.780 m/s² at the equator, 9.832 m/s² at the poles (h = 0).
+    """
+    s2 = math.sin(latitude_rad) ** 2
+    g0 = GAMMA_EQUATOR * (1.0 + SOMIGLIANA_K * s2) / math.sqrt(1.0 - WGS84_E2 * s2)
+    m = OMEGA_IE**2 * WGS84_A**2 * WGS84_B / WGS84_MU
+    h = float(height_m)
+    return g0 * (
+        1.0 - 2.0 / WGS84_A * (1.0 + WGS84_F + m - 2.0 * WGS84_F * s2) * h + 3.0 * h * h / WGS84_A**2
+    )
+
+
+def earth_rate_ned(latitude_rad: float) -> NDArray[np.float64]:
+    """Earth rotation ω_ie resolved in NED (rad/s): ``ω_ie · [cos φ, 0, −sin φ]``, shape (3,)."""
+    return OMEGA_IE * np.array([math.cos(latitude_rad), 0.0, -math.sin(latitude_rad)])
+
+
+def gravity_ned(latitude_rad: float, height_m: float = 0.0) -> NDArray[np.float64]:
+    """Normal gravity vector in NED (m/s²), down positive: ``[0, 0, γ(φ, h)]``, shape (3,).
+
+    The small north component of plumb-line gravity (centrifugal deflection, < 1e-5 g with
+    normal gravity defined along the ellipsoid normal) is zero by construction.
+    """
+    return np.array([0.0, 0.0, normal_gravity(latitude_rad, height_m)])
+
+
+__all__ = [
+    "GAMMA_EQUATOR",
+    "OMEGA_IE",
+    "SOMIGLIANA_K",
+    "WGS84_A",
+    "WGS84_B",
+    "WGS84_E2",
+    "WGS84_F",
+    "WGS84_MU",
+    "earth_rate_ned",
+    "gravity_ned",
+    "normal_gravity",
+]

@@ -1,0 +1,612 @@
+"""The simulation engine: static scenario, error terms, thermal terms, output path.
+
+Signal chain per triad (sensor frame s, mounting ``M = C_b^s``, all vectorised):
+
+    y = LPF( (I + S + k_sf ΔT) x_true + G f_true + b_on + b_T(T, branch) + b_GM + b_RRW
+             + N (1 + k_N ΔT) √f_s ε )                then rounded to the LSB
+
+with ``x_true`` the true rate (Earth rate) or specific force (gravity reaction), ``S`` the
+scale-factor/misalignment matrix, ``G`` the gyro g-sensitivity, ``ΔT = T_die − T_ref``,
+``b_GM`` the bias instability as a sum of first-order Gauss–Markov processes, ``b_RRW`` a
+random walk, ``ε`` unit white noise and LPF the AHRS anti-alias low-pass (Butterworth,
+default 2nd order, 30 Hz; skipped when the cut-off is not below 0.45 f_s).
+
+Flicker approximation: Gauss–Markov processes with correlation times τ_k spaced by a ratio
+``r`` (3 per decade) over the preset's ``bias_instability_tau_s`` range, each of variance
+``σ_k² = B² ln r / π``, sum to the two-sided PSD ``B²/(2π f)`` of IEEE Std 952 flicker noise
+between the extreme corner frequencies, so the Allan deviation is flat at 0.664 B there.
+Slow processes (τ_k ≫ 1/f_s, and the rate random walk) are generated on a coarser grid
+(step ≤ τ_k/50) and interpolated linearly, which changes their spectrum only where the white
+noise dominates by orders of magnitude; this keeps 10⁷ samples to a few seconds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import signal
+
+from uasnav import earth
+from uasnav.errors import InputError
+from uasnav.imu import ImuLog
+from uasnav.sim.model import SensorModel, TriadModel, load_preset
+from uasnav.sim.profiles import TemperatureProfile, named_profile
+
+FloatArray = NDArray[np.float64]
+Progress = Callable[[float], None] | None
+
+# Independent random streams (a term switched off does not change the others).
+_STREAMS = {
+    name: i
+    for i, name in enumerate(
+        [
+            "gyro_white",
+            "gyro_gm",
+            "gyro_rrw",
+            "gyro_turn_on",
+            "gyro_static",
+            "accel_white",
+            "accel_gm",
+            "accel_rrw",
+            "accel_turn_on",
+            "accel_static",
+            "temp",
+            "array",
+        ]
+    )
+}
+GM_PER_DECADE = 3
+
+
+def _rng(seed: int, sensor: int, stream: str) -> np.random.Generator:
+    return np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(int(sensor), _STREAMS[stream])))
+
+
+def _euler_dcm(euler: ArrayLike) -> FloatArray:
+    """C_b^n (body → NED) of 3-2-1 Euler angles ``[roll, pitch, yaw]`` (rad)."""
+    r, p, y = (float(v) for v in np.asarray(euler, dtype=np.float64).ravel())
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array(
+        [
+            [cp * cy, sr * sp * cy - cr * sy, cr * sp * cy + sr * sy],
+            [cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy],
+            [-sp, sr * cp, cr * cp],
+        ]
+    )
+
+
+def _dcm_quat(c: FloatArray) -> FloatArray:
+    """Scalar-first quaternion of a rotation matrix (Shepperd's method)."""
+    tr = np.trace(c)
+    k = int(np.argmax([tr, c[0, 0], c[1, 1], c[2, 2]]))
+    if k == 0:
+        s = math.sqrt(1.0 + tr) * 2.0
+        q = [0.25 * s, (c[2, 1] - c[1, 2]) / s, (c[0, 2] - c[2, 0]) / s, (c[1, 0] - c[0, 1]) / s]
+    elif k == 1:
+        s = math.sqrt(1.0 + c[0, 0] - c[1, 1] - c[2, 2]) * 2.0
+        q = [(c[2, 1] - c[1, 2]) / s, 0.25 * s, (c[0, 1] + c[1, 0]) / s, (c[0, 2] + c[2, 0]) / s]
+    elif k == 2:
+        s = math.sqrt(1.0 + c[1, 1] - c[0, 0] - c[2, 2]) * 2.0
+        q = [(c[0, 2] - c[2, 0]) / s, (c[0, 1] + c[1, 0]) / s, 0.25 * s, (c[1, 2] + c[2, 1]) / s]
+    else:
+        s = math.sqrt(1.0 + c[2, 2] - c[0, 0] - c[1, 1]) * 2.0
+        q = [(c[1, 0] - c[0, 1]) / s, (c[0, 2] + c[2, 0]) / s, (c[1, 2] + c[2, 1]) / s, 0.25 * s]
+    qa = np.array(q)
+    return qa if qa[0] >= 0 else -qa
+
+
+def _interp_rows(idx: FloatArray, grid: FloatArray, values: FloatArray, out: FloatArray) -> None:
+    """out[j] += interp(idx, grid, values[j]) for each row of a (k, m) array (in place)."""
+    for j in range(values.shape[0]):
+        out[j] += np.interp(idx, grid, values[j])
+
+
+class SlowSum:
+    """Sum of slowly varying 3-row processes (layout (3, n)), each sampled every ``m`` samples.
+
+    Processes are added on their own grids; :meth:`render` accumulates them from the coarsest
+    grid to the finest by linear interpolation, so each interpolation costs the size of the
+    finer grid and the total cost is a small multiple of one full-rate interpolation.
+    """
+
+    def __init__(self, n: int, rows: int = 3) -> None:
+        self.n = n
+        self.rows = rows
+        self.parts: dict[int, FloatArray] = {}
+
+    def grid_size(self, m: int) -> int:
+        """Number of grid points of step ``m`` covering samples 0 … n−1 (n when m = 1)."""
+        return self.n if m == 1 else (self.n - 1) // m + 2
+
+    def add(self, m: int, x: FloatArray) -> None:
+        """Add a process sampled at samples 0, m, 2m … (shape (rows, grid_size(m))); the
+        array is taken over (not copied)."""
+        if m in self.parts:
+            self.parts[m] += x
+        else:
+            self.parts[m] = x
+
+    def render(self) -> FloatArray:
+        """The sum at every output sample, shape (rows, n)."""
+        acc: FloatArray | None = None
+        acc_m = 0
+        levels = sorted(self.parts, reverse=True)
+        if 1 not in self.parts:
+            levels.append(1)
+        for m in levels:
+            size = self.grid_size(m)
+            x = self.parts.get(m)
+            cur = np.zeros((self.rows, size)) if x is None else x
+            if acc is not None:
+                xs = np.arange(size, dtype=np.float64)
+                if m > 1:
+                    xs *= m
+                _interp_rows(xs, np.arange(acc.shape[1], dtype=np.float64) * acc_m, acc, cur)
+            acc, acc_m = cur, m
+        assert acc is not None
+        return acc
+
+
+def _pow2_step(samples: float) -> int:
+    """Largest power of two ≤ ``samples`` (at least 1): grid steps shared between processes."""
+    return 1 if samples < 2 else 1 << math.floor(math.log2(samples))
+
+
+def gauss_markov_sum(
+    rng: np.random.Generator,
+    n: int,
+    dt: float,
+    b: float,
+    tau_range: tuple[float, float],
+    acc: SlowSum | None = None,
+) -> FloatArray | None:
+    """Flicker-floor bias instability of level ``b`` (IEEE 952 B) as a sum of GM processes.
+
+    Each process starts from its stationary distribution and is generated every
+    ``≤ τ_k/50`` s. Added to ``acc`` if given (returns None), else returned as (3, n) (SI).
+    """
+    target = SlowSum(n) if acc is None else acc
+    if b != 0.0:
+        lo, hi = tau_range
+        k = max(2, math.ceil(math.log10(hi / lo) * GM_PER_DECADE) + 1)
+        taus = np.geomspace(lo, hi, k)
+        var = b * b * math.log(taus[1] / taus[0]) / math.pi
+        for tc in taus:
+            m = _pow2_step(tc / 50.0 / dt)
+            nc = target.grid_size(m)
+            phi = math.exp(-m * dt / tc)
+            w = rng.standard_normal((3, nc))
+            w *= math.sqrt(var * (1.0 - phi * phi))
+            x0 = rng.standard_normal(3) * math.sqrt(var)
+            x, _ = signal.lfilter([1.0], [1.0, -phi], w, axis=-1, zi=(phi * x0)[:, None])
+            target.add(m, x)
+    return target.render() if acc is None else None
+
+
+def random_walk(
+    rng: np.random.Generator, n: int, dt: float, k: float, duration: float, acc: SlowSum | None = None
+) -> FloatArray | None:
+    """Rate random walk of density ``k`` (SI per √s), zero at t = 0, generated every
+    ≤ min(1 s, duration/1000). Added to ``acc`` if given (returns None), else (3, n)."""
+    target = SlowSum(n) if acc is None else acc
+    if k != 0.0:
+        m = _pow2_step(min(1.0, duration / 1000.0) / dt)
+        nc = target.grid_size(m)
+        steps = rng.standard_normal((3, nc)) * (k * math.sqrt(m * dt))
+        steps[:, 0] = 0.0
+        target.add(m, np.cumsum(steps, axis=1))
+    return target.render() if acc is None else None
+
+
+def _error_matrix(rng: np.random.Generator, sf: float, mis: float) -> FloatArray:
+    """Scale-factor (diagonal) and misalignment (off-diagonal) error matrix S."""
+    s = np.zeros((3, 3))
+    d = rng.standard_normal(3)
+    o = rng.standard_normal(6)
+    s[np.diag_indices(3)] = sf * d
+    s[~np.eye(3, dtype=bool)] = mis * o
+    return s
+
+
+def _antialias(y: FloatArray, rate: float, cutoff: float | None, order: int) -> FloatArray:
+    """Butterworth low-pass along the last axis, started in steady state on the first sample."""
+    if cutoff is None or cutoff >= 0.45 * rate:
+        return y
+    b, a = signal.butter(order, cutoff, fs=rate)
+    zi = signal.lfilter_zi(b, a)[None, :] * y[:, :1]
+    out, _ = signal.lfilter(b, a, y, axis=-1, zi=zi)
+    return out
+
+
+def _quantize(y: FloatArray, lsb: float) -> FloatArray:
+    if lsb > 0.0:
+        np.divide(y, lsb, out=y)
+        np.round(y, out=y)
+        np.multiply(y, lsb, out=y)
+    return y
+
+
+def _resolve_profile(model: SensorModel, profile: str | TemperatureProfile) -> TemperatureProfile:
+    if isinstance(profile, TemperatureProfile):
+        return profile
+    tm = model.temperature
+    return named_profile(
+        str(profile), self_heating_c=tm.self_heating_c, ambient_c=tm.ambient_c, warmup_tau_s=tm.warmup_tau_s
+    )
+
+
+def die_temperature(
+    model: SensorModel, profile: TemperatureProfile, t: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """``(chamber, die)`` temperatures (°C) at times ``t`` (s, uniform): first-order lag
+    ``τ dT_die/dt = T_chamber − T_die`` plus self-heating (exponential after power-on for a
+    warm-up profile), starting in equilibrium with the chamber."""
+    tm = model.temperature
+    chamber = profile.chamber(t)
+    if tm.lag_s > 0 and t.size > 1:
+        dt = float(t[1] - t[0])
+        a = math.exp(-dt / tm.lag_s)
+        die, _ = signal.lfilter([1.0 - a], [1.0, -a], chamber, zi=[a * chamber[0]])
+    else:
+        die = chamber.copy()
+    if profile.warmup:
+        die = die + tm.self_heating_c * (1.0 - np.exp(-(t - t[0]) / max(tm.warmup_tau_s, 1e-9)))
+    else:
+        die = die + tm.self_heating_c
+    return chamber, die
+
+
+def _triad(
+    tri: TriadModel,
+    *,
+    seed: int,
+    sensor: int,
+    n: int,
+    rate: float,
+    duration: float,
+    x_true: FloatArray,
+    f_true: FloatArray,
+    die_grid: FloatArray,
+    gstep: int,
+    thermal_factors: FloatArray | None,
+    model: SensorModel,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Simulate one triad. Returns (output, total bias, thermal bias), each (n, 3)."""
+    k = tri.kind
+    dt = 1.0 / rate
+    st = _rng(seed, sensor, f"{k}_static")
+    s_mat = _error_matrix(st, tri.scale_factor, tri.misalignment)
+    g_mat = tri.g_sensitivity * st.standard_normal((3, 3)) if k == "gyro" else np.zeros((3, 3))
+    const = _rng(seed, sensor, f"{k}_turn_on").standard_normal(3) * tri.turn_on_bias
+    const += s_mat @ x_true + g_mat @ f_true
+    slow = SlowSum(n)
+    th = tri.thermal
+    noise_scale: FloatArray | None = None
+    thermal_grid = np.zeros((3, die_grid.size))
+    if th is not None:
+        if thermal_factors is not None:
+            th = th.scaled(thermal_factors)
+        thermal_grid = th.bias(die_grid).T.copy()
+        d_t = die_grid - th.t_ref_c
+        extra = thermal_grid.copy()
+        if th.scale_factor_tc != 0.0:
+            extra += th.scale_factor_tc * d_t[None, :] * x_true[:, None]
+        slow.add(gstep, extra)
+        if th.noise_tc != 0.0:
+            noise_scale = np.interp(
+                np.arange(n, dtype=np.float64),
+                np.arange(die_grid.size) * float(gstep),
+                np.maximum(1.0 + th.noise_tc * d_t, 0.1),
+            )
+    gauss_markov_sum(
+        _rng(seed, sensor, f"{k}_gm"), n, dt, tri.bias_instability, tri.bias_instability_tau_s, slow
+    )
+    random_walk(_rng(seed, sensor, f"{k}_rrw"), n, dt, tri.rate_random_walk, duration, slow)
+    bias = slow.render()
+    bias += const[:, None]
+    y = _rng(seed, sensor, f"{k}_white").standard_normal((3, n))
+    y *= tri.white * math.sqrt(rate)
+    if noise_scale is not None:
+        y *= noise_scale[None, :]
+    y += bias
+    y += x_true[:, None]
+    y = _quantize(_antialias(y, rate, model.antialias_hz, model.antialias_order), tri.quantization)
+    thermal = np.zeros((n, 3))
+    if th is not None:
+        idx = np.arange(n, dtype=np.float64)
+        grid = np.arange(die_grid.size, dtype=np.float64) * gstep
+        for j in range(3):
+            thermal[:, j] = np.interp(idx, grid, thermal_grid[j])
+    return np.ascontiguousarray(y.T), np.ascontiguousarray(bias.T), thermal
+
+
+def simulate_one(
+    model: SensorModel,
+    *,
+    profile: str | TemperatureProfile = "static",
+    duration: float | None = None,
+    rate: float = 100.0,
+    seed: int = 0,
+    latitude_deg: float = 45.0,
+    height_m: float = 0.0,
+    euler_rad: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    progress: Progress = None,
+    mounting: ArrayLike | None = None,
+    sensor: int = 0,
+    thermal_factors: FloatArray | None = None,
+) -> ImuLog:
+    """Simulate one sensor (see :func:`uasnav.sim.simulate`); ``mounting`` is C_b^s."""
+    if not (math.isfinite(rate) and rate > 0):
+        raise InputError(f"rate: must be a positive number of Hz, got {rate!r}")
+    if not -90.0 <= latitude_deg <= 90.0:
+        raise InputError(f"latitude_deg: must be within [-90, 90], got {latitude_deg!r}")
+    prof = _resolve_profile(model, profile)
+    dur = prof.duration if duration is None else float(duration)
+    if not (math.isfinite(dur) and dur > 0):
+        raise InputError(f"duration: must be a positive number of seconds, got {duration!r}")
+    n = round(dur * rate)
+    if n < 2:
+        raise InputError(f"duration × rate gives {n} samples; need at least 2")
+
+    def tick(f: float) -> None:
+        if progress is not None:
+            progress(f)
+
+    tick(0.0)
+    t = np.arange(n, dtype=np.float64) / rate
+    idx = np.arange(n, dtype=np.float64)
+    m_bs = np.eye(3) if mounting is None else np.asarray(mounting, dtype=np.float64)
+    if m_bs.shape != (3, 3):
+        raise InputError(f"mounting: expected a 3×3 matrix, got shape {m_bs.shape}")
+    lat = math.radians(latitude_deg)
+    c_bn = _euler_dcm(euler_rad)
+    w_b = c_bn.T @ earth.earth_rate_ned(lat)
+    f_b = -(c_bn.T @ earth.gravity_ned(lat, height_m))
+    w_s, f_s = m_bs @ w_b, m_bs @ f_b
+
+    # thermal grid: slow dynamics, evaluated every ≥ 0.1 s and interpolated
+    gstep = max(1, int(0.1 * rate))
+    ng = n if gstep == 1 else (n - 1) // gstep + 2
+    grid_idx = np.arange(ng, dtype=np.float64) * gstep
+    chamber_g, die_g = die_temperature(model, prof, grid_idx / rate)
+    tick(0.05)
+    common = dict(seed=seed, sensor=sensor, n=n, rate=rate, duration=dur, die_grid=die_g, gstep=gstep)
+    common.update(thermal_factors=thermal_factors, model=model)
+    gyro, gbias, gtherm = _triad(model.gyro, x_true=w_s, f_true=f_s, **common)  # type: ignore[arg-type]
+    tick(0.5)
+    accel, abias, _ = _triad(model.accel, x_true=f_s, f_true=f_s, **common)  # type: ignore[arg-type]
+    tick(0.9)
+    die = np.interp(idx, grid_idx, die_g)
+    tm = model.temperature
+    temp = die.copy()
+    if tm.noise_c > 0:
+        temp += _rng(seed, sensor, "temp").standard_normal(n) * tm.noise_c
+    if tm.resolution_c > 0:
+        temp = np.round(temp / tm.resolution_c) * tm.resolution_c
+    q = _dcm_quat(c_bn)
+    truth = {
+        "rate_true": np.broadcast_to(w_s, (n, 3)),
+        "specific_force_true": np.broadcast_to(f_s, (n, 3)),
+        "gyro_bias": gbias,
+        "gyro_bias_thermal": gtherm,
+        "accel_bias": abias,
+        "attitude": np.broadcast_to(q, (n, 4)),
+        "temp_die": die,
+        "temp_chamber": np.interp(idx, grid_idx, chamber_g),
+    }
+    meta: dict[str, Any] = {
+        "source": "uasnav.sim",
+        "preset": model.name,
+        "seed": int(seed),
+        "sensor_index": int(sensor),
+        "profile": prof.name,
+        "rate_hz": float(rate),
+        "duration_s": float(dur),
+        "latitude_deg": float(latitude_deg),
+        "height_m": float(height_m),
+        "euler_rad": [float(v) for v in euler_rad],
+        "mounting": m_bs.tolist(),
+        "antialias_hz": model.antialias_hz
+        if model.antialias_hz and model.antialias_hz < 0.45 * rate
+        else None,
+        "temp_resolution_c": tm.resolution_c,
+    }
+    if thermal_factors is not None:
+        meta["thermal_factors"] = [float(v) for v in thermal_factors]
+    log = ImuLog(t=t, gyro=gyro, accel=accel, temp=temp, truth=truth, meta=meta)
+    tick(1.0)
+    return log
+
+
+def _as_model(preset: str | SensorModel) -> SensorModel:
+    return preset if isinstance(preset, SensorModel) else load_preset(preset)
+
+
+def simulate(
+    preset: str | SensorModel,
+    *,
+    profile: str | TemperatureProfile = "static",
+    duration: float | None = None,
+    rate: float = 100.0,
+    seed: int = 0,
+    latitude_deg: float = 45.0,
+    height_m: float = 0.0,
+    euler_rad: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    progress: Progress = None,
+) -> ImuLog:
+    """Simulate a static IMU (one sensor) with every error term and its ground truth.
+
+    Parameters
+    ----------
+    preset : str or SensorModel
+        ``"crs05-02"``, ``"ms8010"``, ``"ax1"``, ``"lsm6dsm"``, a preset JSON path, or a model
+        (e.g. ``load_preset("ax1").without("thermal")``).
+    profile : {"static", "soak", "ramp", "warmup"} or TemperatureProfile
+        Chamber temperature profile (see :mod:`uasnav.sim.profiles`).
+    duration : float, optional
+        Length (s); default the profile's natural length.
+    rate : float
+        Output sample rate (Hz), typically 100–1000.
+    seed : int
+        Seed; the output is a deterministic function of all arguments.
+    latitude_deg, height_m : float
+        Location (WGS-84) setting Earth rate and normal gravity.
+    euler_rad : (roll, pitch, yaw)
+        Attitude of the body frame w.r.t. NED (rad, 3-2-1).
+    progress : callable(float), optional
+        Called with the completed fraction 0 … 1.
+
+    Returns
+    -------
+    ImuLog
+        Outputs (rad/s, m/s², measured die temperature °C) and ``truth`` channels
+        (``rate_true``, ``specific_force_true``, ``gyro_bias``, ``gyro_bias_thermal``,
+        ``accel_bias``, ``attitude``, ``temp_die``, ``temp_chamber``). ``gyro_bias`` is
+        everything in the output that is neither the true rate nor white noise nor
+        quantisation: turn-on + thermal + instability + random walk, plus the (constant,
+        when static) scale-factor/misalignment and g-sensitivity errors of the true input.
+    """
+    return simulate_one(
+        _as_model(preset),
+        profile=profile,
+        duration=duration,
+        rate=rate,
+        seed=seed,
+        latitude_deg=latitude_deg,
+        height_m=height_m,
+        euler_rad=euler_rad,
+        progress=progress,
+    )
+
+
+def _face_matrices() -> list[FloatArray]:
+    """C_b^s of the six cube faces (+x, −x, +y, −y, +z, −z): sensor z along the outward normal."""
+    faces = []
+    for normal, x_axis in (
+        ((1, 0, 0), (0, 0, -1)),
+        ((-1, 0, 0), (0, 0, 1)),
+        ((0, 1, 0), (1, 0, 0)),
+        ((0, -1, 0), (1, 0, 0)),
+        ((0, 0, 1), (1, 0, 0)),
+        ((0, 0, -1), (1, 0, 0)),
+    ):
+        z = np.array(normal, dtype=np.float64)
+        x = np.array(x_axis, dtype=np.float64)
+        y = np.cross(z, x)
+        faces.append(np.vstack([x, y, z]))
+    return faces
+
+
+ARRAY_SHAPES = ("cube", "planar")
+
+
+def array_mountings(shape: str = "cube", per_face: int = 1) -> list[FloatArray]:
+    """Mounting matrices C_b^s (IMU body → sensor frame) of an array.
+
+    ``"cube"``: ``per_face`` sensors on each of the six faces (+x, −x, +y, −y, +z, −z), sensor
+    z axis along the outward face normal. ``"planar"``: ``per_face`` sensors all aligned with
+    the body (the thesis' six SensorTiles on one cradle board, §4.3.4).
+    """
+    if per_face < 1:
+        raise InputError(f"per_face: must be >= 1, got {per_face}")
+    if shape == "cube":
+        return [m for m in _face_matrices() for _ in range(per_face)]
+    if shape == "planar":
+        return [np.eye(3) for _ in range(per_face)]
+    raise InputError(f"unknown array shape {shape!r}; expected one of {', '.join(ARRAY_SHAPES)}")
+
+
+def simulate_array(
+    preset: str | SensorModel,
+    *,
+    shape: str = "cube",
+    per_face: int = 1,
+    thermal_spread: float = 0.5,
+    progress: Progress = None,
+    **kwargs: Any,
+) -> list[ImuLog]:
+    """Simulate several sensors of one type in a rigid array, with independent errors.
+
+    Each sensor has its own random streams, its own mounting (``log.meta["mounting"]`` =
+    C_b^s, outputs and ``rate_true``/``specific_force_true``/biases in the sensor frame;
+    ``attitude`` stays body → NED), and its own thermal curve: the preset's curve per axis
+    scaled by a factor drawn uniformly in ``[1 − thermal_spread, 1 + thermal_spread]`` with
+    a random sign (``meta["thermal_factors"]``). Other keyword arguments as :func:`simulate`.
+    """
+    model = _as_model(preset)
+    mounts = array_mountings(shape, per_face)
+    seed = int(kwargs.get("seed", 0))
+    rng = _rng(seed, 10_000, "array")
+    logs = []
+    for i, m in enumerate(mounts):
+        factors = rng.uniform(1.0 - thermal_spread, 1.0 + thermal_spread, 3) * rng.choice([-1.0, 1.0], 3)
+
+        def sub(f: float, i: int = i) -> None:
+            if progress is not None:
+                progress((i + f) / len(mounts))
+
+        logs.append(
+            simulate_one(model, mounting=m, sensor=i, thermal_factors=factors, progress=sub, **kwargs)
+        )
+    for log in logs:
+        log.meta["array_shape"] = shape
+        log.meta["array_size"] = len(mounts)
+    return logs
+
+
+def thermal_model(preset: str | SensorModel, sensor: str = "gyro", factors: ArrayLike | None = None):  # type: ignore[no-untyped-def]
+    """The :class:`~uasnav.sim.model.ThermalModel` of a preset's gyro (or ``"accel"``)."""
+    model = _as_model(preset)
+    tri = model.gyro if sensor == "gyro" else model.accel
+    th = tri.thermal
+    if th is not None and factors is not None:
+        th = th.scaled(np.asarray(factors, dtype=np.float64))
+    return th
+
+
+def thermal_bias(
+    preset: str | SensorModel, temp_c: ArrayLike, branch: str = "heating", *, factors: ArrayLike | None = None
+) -> FloatArray:
+    """True thermal gyro bias (n, 3) (rad/s) at die temperatures ``temp_c`` (°C).
+
+    ``branch`` selects the hysteresis branch (``"heating"``: curve + h/2, ``"cooling"``:
+    curve − h/2), matching ``truth["gyro_bias_thermal"]`` once the branch is established.
+    ``factors`` are an array sensor's ``meta["thermal_factors"]``.
+    """
+    th = thermal_model(preset, "gyro", factors)
+    t = np.atleast_1d(np.asarray(temp_c, dtype=np.float64))
+    if th is None:
+        return np.zeros((t.size, 3))
+    return th.branch_bias(t, branch)
+
+
+def thermal_bias_derivative(
+    preset: str | SensorModel, temp_c: ArrayLike, branch: str = "heating", *, factors: ArrayLike | None = None
+) -> FloatArray:
+    """∂b/∂T (n, 3) (rad/s/°C) of :func:`thermal_bias` (equal on both branches)."""
+    th = thermal_model(preset, "gyro", factors)
+    t = np.atleast_1d(np.asarray(temp_c, dtype=np.float64))
+    if branch not in ("heating", "cooling"):
+        raise InputError(f"branch: expected 'heating' or 'cooling', got {branch!r}")
+    if th is None:
+        return np.zeros((t.size, 3))
+    return th.derivative(t)
+
+
+__all__ = [
+    "ARRAY_SHAPES",
+    "array_mountings",
+    "die_temperature",
+    "gauss_markov_sum",
+    "random_walk",
+    "simulate",
+    "simulate_array",
+    "simulate_one",
+    "thermal_bias",
+    "thermal_bias_derivative",
+    "thermal_model",
+]

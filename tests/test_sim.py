@@ -1,0 +1,224 @@
+"""Simulator validation against its configured error model and closed forms."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from uasnav import earth
+from uasnav.allan import oadev
+from uasnav.errors import DataFormatError, InputError
+from uasnav.noise import identify
+from uasnav.sim import (
+    PRESET_NAMES,
+    load_preset,
+    simulate,
+    simulate_array,
+    thermal_bias,
+    thermal_bias_derivative,
+)
+from uasnav.units import convert
+
+# A gyro whose three noise terms are all visible in a 2e5 s record (lsm6dsm white noise).
+N_TEST = float(convert(3.8, "mdps/√Hz", "rad/√s"))
+B_TEST = float(convert(0.003, "deg/s", "rad/s"))
+K_TEST = 2e-5
+
+
+def _noise_only(white: float, b: float, k: float):
+    m = load_preset("lsm6dsm").without(
+        "thermal",
+        "turn_on_bias",
+        "quantization",
+        "scale_factor",
+        "misalignment",
+        "g_sensitivity",
+        "antialias",
+    )
+    return replace(m, gyro=replace(m.gyro, white=white, bias_instability=b, rate_random_walk=k))
+
+
+def _identify(model, seed: int):
+    log = simulate(model, duration=2e5, rate=10.0, seed=seed)
+    curve = oadev(log.gyro - log.truth["rate_true"], 10.0, "octave", unit="rad/s")
+    return identify(curve)
+
+
+def test_presets_load_with_sources_and_thesis_values() -> None:
+    for name in PRESET_NAMES:
+        m = load_preset(name)
+        assert m.name == name and m.sources
+    crs = load_preset("crs05-02")
+    assert convert(crs.gyro.white, "rad/√s", "deg/√h") == pytest.approx(3.18)
+    assert convert(crs.gyro.bias_instability, "rad/s", "deg/s") == pytest.approx(1.5e-4)
+    ms = load_preset("ms8010")
+    assert convert(ms.accel.white, "m/s/√s", "m/s/√h") == pytest.approx(0.05)
+    assert convert(ms.accel.bias_instability, "m/s^2", "m/s/h") == pytest.approx(2.0)
+    lsm = load_preset("lsm6dsm")
+    assert convert(lsm.gyro.white, "rad/√s", "mdps/√Hz") == pytest.approx(3.8)
+    assert convert(lsm.accel.white, "m/s/√s", "µg/√Hz") == pytest.approx(40.0)
+    ax1 = load_preset("ax1")
+    assert ax1.gyro.white == crs.gyro.white and ax1.accel.white == ms.accel.white
+    assert ax1.antialias_hz == 30.0
+    with pytest.raises(InputError, match="unknown preset"):
+        load_preset("nope")
+    with pytest.raises(DataFormatError, match="no such preset file"):
+        load_preset("/nonexistent/p.json")
+
+
+def test_allan_recovers_arw_and_bias_instability_within_10_percent() -> None:
+    rep = _identify(_noise_only(N_TEST, B_TEST, 0.0), seed=11)
+    np.testing.assert_allclose(rep.fit.random_walk, N_TEST, rtol=0.10)
+    b_pooled = math.sqrt(float(np.mean(rep.fit.bias_instability**2)))
+    assert b_pooled == pytest.approx(B_TEST, rel=0.10)
+    assert np.all(rep.fit.rate_random_walk < 0.05 * K_TEST)  # none configured
+
+
+def test_allan_recovers_arw_and_rate_random_walk_within_10_percent() -> None:
+    rep = _identify(_noise_only(N_TEST, 0.0, K_TEST), seed=12)
+    np.testing.assert_allclose(rep.fit.random_walk, N_TEST, rtol=0.10)
+    k_pooled = math.sqrt(float(np.mean(rep.fit.rate_random_walk**2)))
+    assert k_pooled == pytest.approx(K_TEST, rel=0.10)
+
+
+def test_static_mean_is_earth_rate_plus_true_bias() -> None:
+    lat = 45.0
+    log = simulate(
+        "ax1", duration=600.0, rate=100.0, seed=3, latitude_deg=lat, euler_rad=(0.0, 0.0, math.pi / 2)
+    )
+    # yaw 90°: body x east, y south, z down
+    w = earth.OMEGA_IE * np.array([0.0, -math.cos(math.radians(lat)), -math.sin(math.radians(lat))])
+    np.testing.assert_allclose(log.truth["rate_true"][0], w, atol=1e-18)
+    g = earth.normal_gravity(math.radians(lat), 0.0)
+    np.testing.assert_allclose(log.truth["specific_force_true"][0], [0.0, 0.0, -g], atol=1e-15)
+    m = load_preset("ax1")
+    sigma_mean = m.gyro.white * 1.3 / math.sqrt(log.duration)  # ×1.3: noise rises with T (noise_tc)
+    resid = (log.gyro - log.truth["rate_true"] - log.truth["gyro_bias"]).mean(axis=0)
+    assert np.all(np.abs(resid) < 4 * sigma_mean)
+    expected = w + log.truth["gyro_bias"].mean(axis=0)
+    np.testing.assert_allclose(log.gyro.mean(axis=0), expected, atol=4 * sigma_mean)
+    # the bias is a real, non-trivial part of the output (turn-on 0.05 deg/s 1-σ)
+    assert np.max(np.abs(log.truth["gyro_bias"].mean(axis=0))) > 10 * sigma_mean
+    sig_a = m.accel.white * 1.3 / math.sqrt(log.duration)
+    resid_a = (log.accel - log.truth["specific_force_true"] - log.truth["accel_bias"]).mean(axis=0)
+    assert np.all(np.abs(resid_a) < 4 * sig_a)
+
+
+def test_deterministic_and_seed_dependent() -> None:
+    a = simulate("lsm6dsm", duration=5.0, seed=7)
+    b = simulate("lsm6dsm", duration=5.0, seed=7)
+    c = simulate("lsm6dsm", duration=5.0, seed=8)
+    assert np.array_equal(a.gyro, b.gyro) and np.array_equal(a.accel, b.accel)
+    assert np.array_equal(a.truth["gyro_bias"], b.truth["gyro_bias"])
+    assert not np.array_equal(a.gyro, c.gyro)
+    assert a.meta["seed"] == 7 and a.meta["preset"] == "lsm6dsm" and a.meta["profile"] == "static"
+
+
+def test_quantisation_and_antialias() -> None:
+    log = simulate("lsm6dsm", duration=20.0, rate=400.0, seed=1)
+    lsb = float(convert(8.75, "mdps", "rad/s"))
+    k = log.gyro / lsb
+    np.testing.assert_allclose(k, np.round(k), atol=1e-6)
+    # 2nd-order 30 Hz low-pass at 400 Hz: white noise variance shrinks to ≈ fc·π/(2·fs/2)·…;
+    # compare with the unfiltered run of the same seed
+    raw = simulate(load_preset("lsm6dsm").without("antialias"), duration=20.0, rate=400.0, seed=1)
+    ratio = np.std(log.gyro - log.truth["gyro_bias"], axis=0) / np.std(
+        raw.gyro - raw.truth["gyro_bias"], axis=0
+    )
+    # Butterworth n=2 equivalent noise bandwidth = fc·π/(2n·sin(π/2n)) = 1.11·fc = 33.3 Hz of 200 Hz
+    np.testing.assert_allclose(ratio, math.sqrt(33.32 / 200.0), rtol=0.05)
+    assert log.meta["antialias_hz"] == 30.0
+    assert simulate("lsm6dsm", duration=2.0, rate=50.0).meta["antialias_hz"] is None
+
+
+def test_temperature_channel_is_quantised_die_temperature() -> None:
+    m = replace(load_preset("ax1"), temperature=replace(load_preset("ax1").temperature, resolution_c=1.0))
+    log = simulate(m, profile="ramp", rate=10.0, seed=2)
+    assert log.temp is not None
+    np.testing.assert_array_equal(log.temp, np.round(log.truth["temp_die"]))
+    assert np.max(np.abs(log.temp - log.truth["temp_die"])) <= 0.5
+    # die lags the chamber (first order, τ = 90 s) and is self-heated by 6 °C
+    die, ch = log.truth["temp_die"], log.truth["temp_chamber"]
+    assert die.max() == pytest.approx(34.08, abs=0.05)
+    assert die.min() == pytest.approx(27.28, abs=0.05)
+    i_top = int(np.argmax(ch))
+    assert die[i_top] < ch[i_top] + 6.0 - 1.0
+
+
+def test_soak_profile_reaches_thesis_temperatures() -> None:
+    log = simulate("ax1", profile="soak", rate=1.0, seed=0)
+    die = log.truth["temp_die"]
+    assert die.min() == pytest.approx(-20.53, abs=0.02)
+    assert die.max() == pytest.approx(37.30, abs=0.02)
+    assert np.all(np.diff(die) >= -1e-9)  # heating only
+
+
+def test_hysteresis_branches_differ_by_configured_offset() -> None:
+    m = load_preset("ax1")
+    h = m.gyro.thermal.hysteresis  # type: ignore[union-attr]
+    temps = np.linspace(28.0, 33.0, 11)
+    diff = thermal_bias(m, temps, "heating") - thermal_bias(m, temps, "cooling")
+    np.testing.assert_allclose(diff, h, rtol=1e-12)
+    d_h = thermal_bias_derivative(m, temps, "heating")
+    eps = 1e-4
+    num = (thermal_bias(m, temps + eps) - thermal_bias(m, temps - eps)) / (2 * eps)
+    np.testing.assert_allclose(d_h, num, rtol=1e-6, atol=1e-12)
+
+    log = simulate(m, profile="ramp", rate=50.0, seed=4)
+    die = log.truth["temp_die"]
+    top = int(np.argmax(die))
+    th = log.truth["gyro_bias_thermal"]
+    # truth: at equal temperature the cooling branch lies h below the heating branch
+    w_c = m.gyro.thermal.hysteresis_width_c  # type: ignore[union-attr]
+    for temp in (29.0, 30.0, 31.0, 32.5):
+        i_up = int(np.argmin(np.abs(die[:top] - temp)))
+        i_dn = top + int(np.argmin(np.abs(die[top:] - temp)))
+        # branch state relaxes over the temperature travel since the reversal at the top
+        s_dn = -1.0 + 2.0 * math.exp(-(die[top] - die[i_dn]) / w_c)
+        np.testing.assert_allclose(th[i_up] - th[i_dn], 0.5 * h * (1.0 - s_dn), rtol=2e-3)
+        if temp <= 31.0:
+            np.testing.assert_allclose(th[i_up] - th[i_dn], h, rtol=0.01)
+        np.testing.assert_allclose(th[i_up], thermal_bias(m, die[i_up : i_up + 1], "heating")[0], rtol=0.01)
+    # output: remove the known branch-free curve, the branch means differ by h
+    curve = m.gyro.thermal.curve(die)  # type: ignore[union-attr]
+    r = log.gyro - log.truth["rate_true"] - curve
+    band = (die > 29.0) & (die < 33.0)
+    up = band & (np.arange(log.n) < top)
+    dn = band & (np.arange(log.n) > top)
+    diff_out = r[up].mean(axis=0) - r[dn].mean(axis=0)
+    se = m.gyro.white * math.sqrt(50.0) * math.sqrt(1 / up.sum() + 1 / dn.sum())
+    assert np.all(np.abs(diff_out - h) < 4 * se)
+    # pooled over the three axes (same offset on each): clearly non-zero and equal to h
+    se_pooled = se / math.sqrt(3.0)
+    assert abs(diff_out.mean() - h) < 4 * se_pooled
+    assert diff_out.mean() > 6 * se_pooled
+
+
+def test_cube_array_has_independent_errors_and_mountings() -> None:
+    logs = simulate_array("lsm6dsm", shape="cube", duration=5.0, rate=100.0, seed=5)
+    assert len(logs) == 6
+    for log in logs:
+        c = np.array(log.meta["mounting"])
+        np.testing.assert_allclose(c @ c.T, np.eye(3), atol=1e-15)
+        assert np.linalg.det(c) == pytest.approx(1.0)
+        g = log.truth["specific_force_true"][0]
+        np.testing.assert_allclose(c.T @ g, logs[4].truth["specific_force_true"][0], atol=1e-12)
+    assert logs[4].meta["mounting"] == np.eye(3).tolist()
+    on = [log.truth["gyro_bias"][0] for log in logs]
+    assert len({tuple(np.round(b, 12)) for b in on}) == 6
+    with pytest.raises(InputError, match="shape"):
+        simulate_array("lsm6dsm", shape="sphere", duration=1.0)
+
+
+def test_bad_arguments_name_the_argument() -> None:
+    with pytest.raises(InputError, match="rate"):
+        simulate("ax1", duration=1.0, rate=-1.0)
+    with pytest.raises(InputError, match="duration"):
+        simulate("ax1", duration=float("nan"))
+    with pytest.raises(InputError, match="profile"):
+        simulate("ax1", profile="boil", duration=1.0)
+    with pytest.raises(InputError, match="branch"):
+        thermal_bias("ax1", [20.0], "sideways")
