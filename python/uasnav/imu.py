@@ -135,5 +135,75 @@ class ImuLog:
             meta=dict(self.meta),
         )
 
+    def between(self, t_start: float, t_end: float) -> ImuLog:
+        """Samples with ``t_start <= t <= t_end`` (s) as a new log (at least 2 samples)."""
+        i0 = int(np.searchsorted(self.t, t_start, side="left"))
+        i1 = int(np.searchsorted(self.t, t_end, side="right"))
+        if i1 - i0 < 2:
+            raise InputError(
+                f"between({t_start!r}, {t_end!r}): fewer than 2 samples in the interval "
+                f"(log spans {self.t[0]!r} … {self.t[-1]!r} s)"
+            )
+        return self.slice(i0, i1)
+
+    def segments(self, intervals: list[tuple[float, float]], min_samples: int = 2) -> list[ImuLog]:
+        """One log per ``(t_start, t_end)`` interval (e.g. static intervals); intervals with
+        fewer than ``min_samples`` samples are skipped."""
+        out = []
+        for a, b in intervals:
+            i0 = int(np.searchsorted(self.t, a, side="left"))
+            i1 = int(np.searchsorted(self.t, b, side="right"))
+            if i1 - i0 >= max(2, min_samples):
+                out.append(self.slice(i0, i1))
+        return out
+
+    def resample(self, rate: float, t_start: float | None = None) -> ImuLog:
+        """Linear interpolation of every channel (truth included) onto a uniform grid.
+
+        Parameters
+        ----------
+        rate : float
+            New sample rate (Hz).
+        t_start : float, optional
+            First time stamp (default the log's first).
+
+        Notes
+        -----
+        No anti-alias filter is applied: when down-sampling noisy data, low-pass first.
+        Quaternion truth channels (4 columns named ``attitude``) are re-normalised.
+        """
+        if not (np.isfinite(rate) and rate > 0):
+            raise InputError(f"rate: must be a positive number of Hz, got {rate!r}")
+        t0 = float(self.t[0]) if t_start is None else float(t_start)
+        n = int(np.floor((self.t[-1] - t0) * rate + 1e-9)) + 1
+        if n < 2 or t0 < self.t[0]:
+            raise InputError(f"resample: no room for 2 samples at {rate} Hz from t = {t0}")
+        t = t0 + np.arange(n) / rate
+
+        def interp(a: FloatArray | None) -> FloatArray | None:
+            if a is None:
+                return None
+            if a.ndim == 1:
+                return np.interp(t, self.t, a)
+            flat = a.reshape(a.shape[0], -1)
+            out = np.column_stack([np.interp(t, self.t, flat[:, j]) for j in range(flat.shape[1])])
+            return out.reshape((n, *a.shape[1:]))
+
+        truth = {k: interp(v) for k, v in self.truth.items()}
+        if "attitude" in truth and truth["attitude"] is not None and truth["attitude"].shape[1:] == (4,):
+            q = truth["attitude"]
+            truth["attitude"] = q / np.linalg.norm(q, axis=1, keepdims=True)
+        meta = dict(self.meta)
+        meta["rate_hz"] = float(rate)
+        return ImuLog(
+            t=t,
+            gyro=interp(self.gyro),
+            accel=interp(self.accel),
+            temp=interp(self.temp),
+            mag=interp(self.mag),
+            truth={k: v for k, v in truth.items() if v is not None},
+            meta=meta,
+        )
+
 
 __all__ = ["ImuLog", "check_time"]
