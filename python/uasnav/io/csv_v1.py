@@ -148,8 +148,9 @@ def _group_truth(cols: list[str], col: dict[str, np.ndarray]) -> dict[str, np.nd
     groups: dict[str, list[tuple[str, str]]] = {}
     for c in cols:
         base, _, suffix = c[len("truth_") :].rpartition("_")
-        if not base:
-            base, suffix = suffix, ""
+        if not base or not (suffix in _AXES or suffix.isdigit()):
+            # a 1-D channel, possibly with "_" in its name (truth_temp_die)
+            base, suffix = c[len("truth_") :], ""
         groups.setdefault(base, []).append((suffix, c))
     out = {}
     for base, items in groups.items():
