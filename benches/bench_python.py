@@ -42,8 +42,31 @@ def bench_allan(n: int, repeat: int) -> None:
     )
 
 
+def bench_sim(n: int, repeat: int) -> None:
+    """Full simulator run (ax1: both triads, thermal terms, truth channels) and its flicker
+    generator against allantools' Kasdin–Walter power-law noise generator (one axis)."""
+    import allantools.noise
+
+    from uasnav.sim import gauss_markov_sum, simulate
+
+    rate = 100.0
+    t_sim = median_time(lambda: simulate("ax1", duration=n / rate, rate=rate, seed=1), repeat)
+    rng = np.random.default_rng(0)
+    t_gm = median_time(lambda: gauss_markov_sum(rng, n, 1 / rate, 1e-5, (0.5, 2e4)), repeat)
+    t_pink = median_time(lambda: allantools.noise.pink(n), repeat)
+    print(
+        f"simulate ax1 static n={n:.0e} (x3 axes, gyro+accel, truth): {t_sim:6.2f} s"
+        f" | {n / t_sim / 1e6:5.2f} M samples/s"
+    )
+    print(
+        f"flicker n={n:.0e}: uasnav GM sum (3 axes) {t_gm * 1e3:8.1f} ms | allantools.noise.pink (1 axis)"
+        f" {t_pink * 1e3:8.1f} ms | ratio per axis {t_pink / (t_gm / 3):5.1f}x"
+    )
+
+
 CASES: dict[str, Callable[[bool], None]] = {
     "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
+    "sim": lambda quick: bench_sim(10**6 if quick else 10**7, 3),
 }
 
 

@@ -16,7 +16,7 @@ Flicker approximation: Gauss–Markov processes with correlation times τ_k spac
 ``σ_k² = B² ln r / π``, sum to the two-sided PSD ``B²/(2π f)`` of IEEE Std 952 flicker noise
 between the extreme corner frequencies, so the Allan deviation is flat at 0.664 B there.
 Slow processes (τ_k ≫ 1/f_s, and the rate random walk) are generated on a coarser grid
-(step ≤ τ_k/50) and interpolated linearly, which changes their spectrum only where the white
+(step ≤ τ_k/20) and interpolated linearly, which changes their spectrum only where the white
 noise dominates by orders of magnitude; this keeps 10⁷ samples to a few seconds.
 """
 
@@ -167,7 +167,7 @@ def gauss_markov_sum(
     """Flicker-floor bias instability of level ``b`` (IEEE 952 B) as a sum of GM processes.
 
     Each process starts from its stationary distribution and is generated every
-    ``≤ τ_k/50`` s. Added to ``acc`` if given (returns None), else returned as (3, n) (SI).
+    ``≤ τ_k/20`` s. Added to ``acc`` if given (returns None), else returned as (3, n) (SI).
     """
     target = SlowSum(n) if acc is None else acc
     if b != 0.0:
@@ -176,7 +176,7 @@ def gauss_markov_sum(
         taus = np.geomspace(lo, hi, k)
         var = b * b * math.log(taus[1] / taus[0]) / math.pi
         for tc in taus:
-            m = _pow2_step(tc / 50.0 / dt)
+            m = _pow2_step(tc / 20.0 / dt)
             nc = target.grid_size(m)
             phi = math.exp(-m * dt / tc)
             w = rng.standard_normal((3, nc))

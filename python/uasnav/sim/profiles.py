@@ -13,7 +13,8 @@ ramp      die 27.28 → 34.08 °C at 2 °C/min, held 10 min, back down at 2 °C/
           (heating then cooling branch: hysteresis), thesis Figure 30
 warmup    constant chamber (ambient); the die warms by the self-heating with time constant
           ``warmup_tau_s`` after power-on (natural length 5 time constants)
-static    constant chamber (ambient), die at ambient + self-heating; natural length 1 h
+static    constant temperature, die at the ambient temperature (chamber = ambient − self-heating,
+          so the preset's 25 °C specification applies); natural length 1 h
 ========  ====================================================================================
 """
 
@@ -99,7 +100,10 @@ def named_profile(
 ) -> TemperatureProfile:
     """One of :data:`PROFILE_NAMES` for a sensor with the given thermal constants."""
     if name == "static":
-        return TemperatureProfile(np.array([0.0, 3600.0]), np.full(2, ambient_c), name="static")
+        # die at the ambient (= reference) temperature: chamber below it by the self-heating
+        return TemperatureProfile(
+            np.array([0.0, 3600.0]), np.full(2, ambient_c - self_heating_c), name="static"
+        )
     if name == "warmup":
         return TemperatureProfile(
             np.array([0.0, 5.0 * warmup_tau_s]), np.full(2, ambient_c), name="warmup", warmup=True
