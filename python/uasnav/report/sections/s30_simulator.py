@@ -62,18 +62,26 @@ def _thermal_figures(w: SectionWriter) -> None:
     fig, _ = new_figure(9.0, 3.2)
     fig.clear()
     axs = fig.subplots(1, 3, sharex=True)
-    width = int(5 * rate)
+    edges = np.arange(27.0, 34.5, 0.25)
+    offset = (ramp.truth["gyro_bias"] - ramp.truth["gyro_bias_thermal"]).mean(axis=0) * RAD2DEG
+    earth = ramp.truth["rate_true"][0] * RAD2DEG
+    grid = np.linspace(27.3, 34.0, 100)
     for part, lab in ((slice(0, top), "heating"), (slice(top, ramp.n), "cooling")):
-        assert ramp.temp is not None
-        tb, gb = _bin_means(ramp.temp[part], ramp.gyro[part] * RAD2DEG, width)
+        dp = die[part]
+        k = np.digitize(dp, edges)
+        occupied = np.unique(k)
+        tb = np.array([dp[k == i].mean() for i in occupied])
+        gb = np.array([ramp.gyro[part][k == i].mean(axis=0) for i in occupied]) * RAD2DEG
+        true = thermal_bias(model, grid, lab) * RAD2DEG + offset + earth
         for j, ax in enumerate(axs):
-            ax.plot(tb, gb[:, j], ".-", ms=3, lw=0.5, label=lab)
+            (ln,) = ax.plot(tb, gb[:, j], "o", ms=3, label=f"{lab}: output, 0.25 °C bins")
+            ax.plot(grid, true[:, j], "-", lw=1, color=ln.get_color(), label=f"{lab}: true")
     for j, ax in enumerate(axs):
         ax.set_title(f"ω_{'xyz'[j]}")
         ax.set_xlabel("die temperature (°C)")
         ax.grid(alpha=0.3)
-    axs[0].set_ylabel("gyro output (deg/s), 5 s means")
-    axs[0].legend(fontsize=7)
+    axs[0].set_ylabel("gyro output (deg/s)")
+    axs[0].legend(fontsize=6)
     w.figure(
         fig,
         "ramp",
