@@ -222,3 +222,65 @@ def test_bad_arguments_name_the_argument() -> None:
         simulate("ax1", profile="boil", duration=1.0)
     with pytest.raises(InputError, match="branch"):
         thermal_bias("ax1", [20.0], "sideways")
+
+
+def test_warmup_and_user_profiles() -> None:
+    from uasnav.sim import TemperatureProfile
+
+    m = load_preset("lsm6dsm")
+    tm = m.temperature
+    log = simulate(m, profile="warmup", rate=10.0, seed=1)
+    die = log.truth["temp_die"]
+    assert log.duration == pytest.approx(5 * tm.warmup_tau_s, abs=0.2)
+    # chamber constant at ambient; die = ambient + ΔT (1 − e^(−t/τ)) exactly (no lag needed)
+    i = round(tm.warmup_tau_s * 10.0)
+    assert die[i] - tm.ambient_c == pytest.approx(tm.self_heating_c * (1 - math.exp(-1)), rel=1e-3)
+    prof = TemperatureProfile.from_arrays([0.0, 100.0, 200.0], [10.0, 30.0, 30.0])
+    log = simulate(m, profile=prof, rate=10.0, seed=1)
+    assert log.meta["profile"] == "user" and log.duration == pytest.approx(200.0, abs=0.2)
+    np.testing.assert_allclose(log.truth["temp_chamber"][[0, 1000, 1999]], [10.0, 30.0, 30.0], atol=1e-9)
+    with pytest.raises(InputError, match="profile t"):
+        TemperatureProfile.from_arrays([0.0, 0.0], [1.0, 2.0])
+
+
+def test_array_thermal_truth_matches_thermal_bias_with_factors() -> None:
+    logs = simulate_array("lsm6dsm", shape="planar", per_face=3, profile="ramp", rate=5.0, seed=2)
+    assert len(logs) == 3 and all(log.meta["mounting"] == np.eye(3).tolist() for log in logs)
+    for log in logs:
+        die = log.truth["temp_die"]
+        top = int(np.argmax(die))
+        f = log.meta["thermal_factors"]
+        assert all(0.5 <= abs(v) <= 1.5 for v in f)
+        np.testing.assert_allclose(
+            log.truth["gyro_bias_thermal"][:top:50],
+            thermal_bias("lsm6dsm", die[:top:50], "heating", factors=f),
+            rtol=1e-3,
+            atol=1e-9,
+        )
+    assert logs[0].meta["thermal_factors"] != logs[1].meta["thermal_factors"]
+
+
+def test_rate_table_truth_is_consistent_with_attitude_propagation() -> None:
+    from uasnav.attitude import propagate, quat_to_dcm
+
+    lat = math.radians(45.0)
+    om = 10.0  # deg/s, 36 s per turn
+    log = simulate(
+        "lsm6dsm", duration=72.0, rate=100.0, seed=6, table_rate_dps=om, euler_rad=(0.1, -0.05, 0.3)
+    )
+    q = log.truth["attitude"]
+    c = quat_to_dcm(q)
+    # ω_nb^b = ω_ib^b − C_n^b ω_ie^n integrates to the truth attitude (independent propagator)
+    w_nb = log.truth["rate_true"] - np.einsum("nji,j->ni", c, earth.earth_rate_ned(lat))
+    qp = propagate(q[0], w_nb[:-1], 0.01)
+    err = np.abs(np.einsum("ni,ni->n", qp[-1:], q[-1:]))
+    assert err[0] == pytest.approx(1.0, abs=1e-10)
+    # body rate magnitude |ω_ie + Ω e_z|; yaw advances by Ω t
+    v = earth.earth_rate_ned(lat) + np.array([0, 0, math.radians(om)])
+    np.testing.assert_allclose(np.linalg.norm(log.truth["rate_true"], axis=1), np.linalg.norm(v), rtol=1e-12)
+    # output = truth + bias + noise, including the scale-factor error of the 10 deg/s input
+    resid = (log.gyro - log.truth["rate_true"] - log.truth["gyro_bias"]).mean(axis=0)
+    sigma = load_preset("lsm6dsm").gyro.white * 1.3 / math.sqrt(log.duration)
+    assert np.all(np.abs(resid) < 4 * sigma)
+    f_from_att = np.einsum("nji,j->ni", c, [0.0, 0.0, -earth.normal_gravity(lat)])
+    np.testing.assert_allclose(log.truth["specific_force_true"], f_from_att, atol=1e-12)

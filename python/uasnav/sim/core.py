@@ -99,6 +99,21 @@ def _dcm_quat(c: FloatArray) -> FloatArray:
     return qa if qa[0] >= 0 else -qa
 
 
+def _quat_mul(p: FloatArray, q: FloatArray) -> FloatArray:
+    """Hamilton product p ⊗ q of scalar-first quaternions (n, 4) ⊗ (4,) → (n, 4)."""
+    pw, px, py, pz = p[:, 0], p[:, 1], p[:, 2], p[:, 3]
+    qw, qx, qy, qz = q
+    return np.stack(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ],
+        axis=1,
+    )
+
+
 def _interp_rows(idx: FloatArray, grid: FloatArray, values: FloatArray, out: FloatArray) -> None:
     """out[j] += interp(idx, grid, values[j]) for each row of a (k, m) array (in place)."""
     for j in range(values.shape[0]):
@@ -282,7 +297,10 @@ def _triad(
     s_mat = _error_matrix(st, tri.scale_factor, tri.misalignment)
     g_mat = tri.g_sensitivity * st.standard_normal((3, 3)) if k == "gyro" else np.zeros((3, 3))
     const = _rng(seed, sensor, f"{k}_turn_on").standard_normal(3) * tri.turn_on_bias
-    const += s_mat @ x_true + g_mat @ f_true
+    const += g_mat @ f_true
+    moving = x_true.ndim == 2  # (3, n) true input on a rate table, else constant (3,)
+    if not moving:
+        const += s_mat @ x_true
     slow = SlowSum(n)
     th = tri.thermal
     noise_scale: FloatArray | None = None
@@ -293,7 +311,7 @@ def _triad(
         thermal_grid = th.bias(die_grid).T.copy()
         d_t = die_grid - th.t_ref_c
         extra = thermal_grid.copy()
-        if th.scale_factor_tc != 0.0:
+        if th.scale_factor_tc != 0.0 and not moving:
             extra += th.scale_factor_tc * d_t[None, :] * x_true[:, None]
         slow.add(gstep, extra)
         if th.noise_tc != 0.0:
@@ -308,12 +326,17 @@ def _triad(
     random_walk(_rng(seed, sensor, f"{k}_rrw"), n, dt, tri.rate_random_walk, duration, slow)
     bias = slow.render()
     bias += const[:, None]
+    if moving:
+        bias += s_mat @ x_true
+        if th is not None and th.scale_factor_tc != 0.0:
+            d_full = np.interp(np.arange(n, dtype=np.float64), np.arange(die_grid.size) * float(gstep), d_t)
+            bias += th.scale_factor_tc * d_full[None, :] * x_true
     y = _rng(seed, sensor, f"{k}_white").standard_normal((3, n))
     y *= tri.white * math.sqrt(rate)
     if noise_scale is not None:
         y *= noise_scale[None, :]
     y += bias
-    y += x_true[:, None]
+    y += x_true if moving else x_true[:, None]
     y = _quantize(_antialias(y, rate, model.antialias_hz, model.antialias_order), tri.quantization)
     thermal = np.zeros((n, 3))
     if th is not None:
@@ -338,6 +361,7 @@ def simulate_one(
     mounting: ArrayLike | None = None,
     sensor: int = 0,
     thermal_factors: FloatArray | None = None,
+    table_rate_dps: float = 0.0,
 ) -> ImuLog:
     """Simulate one sensor (see :func:`uasnav.sim.simulate`); ``mounting`` is C_b^s."""
     if not (math.isfinite(rate) and rate > 0):
@@ -367,6 +391,23 @@ def simulate_one(
     w_b = c_bn.T @ earth.earth_rate_ned(lat)
     f_b = -(c_bn.T @ earth.gravity_ned(lat, height_m))
     w_s, f_s = m_bs @ w_b, m_bs @ f_b
+    q0 = _dcm_quat(c_bn)
+    if table_rate_dps != 0.0:
+        # single-axis rate table turning about the local vertical (NED down) at Ω:
+        # C_b^n(t) = R_z(Ω t) C_b^n(0); ω_ib^b = C_n^b(t) (ω_ie^n + Ω e_z); f^b is unchanged
+        om = math.radians(table_rate_dps)
+        th_t = om * t
+        c, s_ = np.cos(th_t), np.sin(th_t)
+        v = earth.earth_rate_ned(lat) + np.array([0.0, 0.0, om])
+        # R_z(θ)^T v, then C_b^n(0)^T, then the mounting
+        v_rot = np.stack([c * v[0] + s_ * v[1], -s_ * v[0] + c * v[1], np.full(n, v[2])])
+        w_s_t = (m_bs @ c_bn.T) @ v_rot  # (3, n)
+        half = 0.5 * th_t
+        qz = np.stack([np.cos(half), np.zeros(n), np.zeros(n), np.sin(half)], axis=1)
+        att = _quat_mul(qz, q0)
+    else:
+        w_s_t = w_s
+        att = np.broadcast_to(q0, (n, 4))
 
     # thermal grid: slow dynamics, evaluated every ≥ 0.1 s and interpolated
     gstep = max(1, int(0.1 * rate))
@@ -376,7 +417,7 @@ def simulate_one(
     tick(0.05)
     common = dict(seed=seed, sensor=sensor, n=n, rate=rate, duration=dur, die_grid=die_g, gstep=gstep)
     common.update(thermal_factors=thermal_factors, model=model)
-    gyro, gbias, gtherm = _triad(model.gyro, x_true=w_s, f_true=f_s, **common)  # type: ignore[arg-type]
+    gyro, gbias, gtherm = _triad(model.gyro, x_true=w_s_t, f_true=f_s, **common)  # type: ignore[arg-type]
     tick(0.5)
     accel, abias, _ = _triad(model.accel, x_true=f_s, f_true=f_s, **common)  # type: ignore[arg-type]
     tick(0.9)
@@ -387,14 +428,13 @@ def simulate_one(
         temp += _rng(seed, sensor, "temp").standard_normal(n) * tm.noise_c
     if tm.resolution_c > 0:
         temp = np.round(temp / tm.resolution_c) * tm.resolution_c
-    q = _dcm_quat(c_bn)
     truth = {
-        "rate_true": np.broadcast_to(w_s, (n, 3)),
+        "rate_true": np.ascontiguousarray(w_s_t.T) if w_s_t.ndim == 2 else np.broadcast_to(w_s, (n, 3)),
         "specific_force_true": np.broadcast_to(f_s, (n, 3)),
         "gyro_bias": gbias,
         "gyro_bias_thermal": gtherm,
         "accel_bias": abias,
-        "attitude": np.broadcast_to(q, (n, 4)),
+        "attitude": att,
         "temp_die": die,
         "temp_chamber": np.interp(idx, grid_idx, chamber_g),
     }
@@ -414,6 +454,7 @@ def simulate_one(
         if model.antialias_hz and model.antialias_hz < 0.45 * rate
         else None,
         "temp_resolution_c": tm.resolution_c,
+        "table_rate_dps": float(table_rate_dps),
     }
     if thermal_factors is not None:
         meta["thermal_factors"] = [float(v) for v in thermal_factors]
@@ -437,6 +478,7 @@ def simulate(
     height_m: float = 0.0,
     euler_rad: tuple[float, float, float] = (0.0, 0.0, 0.0),
     progress: Progress = None,
+    table_rate_dps: float = 0.0,
 ) -> ImuLog:
     """Simulate a static IMU (one sensor) with every error term and its ground truth.
 
@@ -459,6 +501,10 @@ def simulate(
         Attitude of the body frame w.r.t. NED (rad, 3-2-1).
     progress : callable(float), optional
         Called with the completed fraction 0 … 1.
+    table_rate_dps : float
+        Optional slow motion: the unit sits (at ``euler_rad``) on a single-axis rate table
+        turning about the local vertical at this rate (deg/s, positive clockwise seen from
+        above); the true rate, attitude and sensor outputs follow (specific force unchanged).
 
     Returns
     -------
@@ -480,6 +526,7 @@ def simulate(
         height_m=height_m,
         euler_rad=euler_rad,
         progress=progress,
+        table_rate_dps=table_rate_dps,
     )
 
 

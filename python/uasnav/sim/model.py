@@ -158,7 +158,7 @@ class ThermalModel:
         return out
 
     def scaled(self, factors: FloatArray) -> ThermalModel:
-        """A copy with each axis' bias curve and hysteresis multiplied by ``factors`` (3,)."""
+        """A copy with each axis' bias curve multiplied by ``factors`` (3,); hysteresis unchanged."""
         f = np.asarray(factors, dtype=np.float64)
         steps = [s * np.array([f[i], 1.0, 1.0]) for i, s in enumerate(self.steps)]
         bumps = [b * np.array([f[i], 1.0, 1.0]) for i, b in enumerate(self.bumps)]
