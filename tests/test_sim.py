@@ -284,3 +284,12 @@ def test_rate_table_truth_is_consistent_with_attitude_propagation() -> None:
     assert np.all(np.abs(resid) < 4 * sigma)
     f_from_att = np.einsum("nji,j->ni", c, [0.0, 0.0, -earth.normal_gravity(lat)])
     np.testing.assert_allclose(log.truth["specific_force_true"], f_from_att, atol=1e-12)
+
+
+def test_progress_is_reported_from_0_to_1() -> None:
+    seen: list[float] = []
+    simulate("ax1", duration=2.0, progress=seen.append)
+    assert seen[0] == 0.0 and seen[-1] == 1.0 and seen == sorted(seen)
+    seen.clear()
+    simulate_array("lsm6dsm", duration=1.0, progress=seen.append)
+    assert seen[-1] == 1.0 and seen == sorted(seen) and len(seen) > 6

@@ -45,6 +45,14 @@ def _outputs(out: Path, count: int) -> list[Path]:
     "Multi-sensor runs write one file per sensor: OUT_s0.ext … OUT_s5.ext.",
 )
 @click.option(
+    "--table-rate",
+    "table_rate_dps",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Slow motion: rate table turning about the vertical at this rate (deg/s).",
+)
+@click.option(
     "--out", "out", type=click.Path(dir_okay=False), required=True, help="Output log (.csv or .npz)."
 )
 @click.option("--json", "as_json", is_flag=True, help="Print a JSON summary.")
@@ -57,6 +65,7 @@ def command(
     latitude_deg: float,
     height_m: float,
     sensors: str,
+    table_rate_dps: float,
     out: str,
     as_json: bool,
 ) -> None:
@@ -84,7 +93,13 @@ def command(
     n_est = (duration or 3600.0) * rate
     cb = progress if n_est >= 1e6 else None
     kwargs = dict(
-        profile=profile, duration=duration, rate=rate, seed=seed, latitude_deg=latitude_deg, height_m=height_m
+        profile=profile,
+        duration=duration,
+        rate=rate,
+        seed=seed,
+        latitude_deg=latitude_deg,
+        height_m=height_m,
+        table_rate_dps=table_rate_dps,
     )
     arr = _SENSORS[sensors]
     if arr is None:
