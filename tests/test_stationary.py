@@ -69,3 +69,21 @@ def test_log_between_segments_resample() -> None:
         log.between(20.0, 30.0)
     with pytest.raises(InputError, match="rate"):
         log.resample(0.0)
+
+
+def test_real_xio_log_quiet_and_moving_windows(shared_data) -> None:
+    from uasnav.io import read_log
+
+    log = read_log(shared_data / "imu" / "xio_fusion_sensor_data.csv").resample(100.0)
+    res = detect_static(log)
+    w = np.rad2deg(np.linalg.norm(log.gyro, axis=1))
+    quiet, moving = [], []
+    for a in range(0, log.n - 500, 500):
+        s = slice(a, a + 500)
+        if np.percentile(w[s], 90) < 0.3:  # 5 s windows clearly at rest (x-IMU noise ≈ 0.1 deg/s)
+            quiet.append(res.mask[s].mean())
+        elif np.median(w[s]) > 2.0:  # clearly moving
+            moving.append(res.mask[s].mean())
+    assert len(quiet) >= 8 and len(moving) >= 10
+    assert min(quiet) > 0.9
+    assert max(moving) < 0.05

@@ -195,10 +195,12 @@ class ImuLog:
             truth["attitude"] = q / np.linalg.norm(q, axis=1, keepdims=True)
         meta = dict(self.meta)
         meta["rate_hz"] = float(rate)
+        gyro, accel = interp(self.gyro), interp(self.accel)
+        assert gyro is not None and accel is not None
         return ImuLog(
             t=t,
-            gyro=interp(self.gyro),
-            accel=interp(self.accel),
+            gyro=gyro,
+            accel=accel,
             temp=interp(self.temp),
             mag=interp(self.mag),
             truth={k: v for k, v in truth.items() if v is not None},

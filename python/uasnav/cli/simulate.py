@@ -105,7 +105,7 @@ def command(
     if arr is None:
         logs = [simulate(model, progress=cb, **kwargs)]  # type: ignore[arg-type]
     else:
-        logs = simulate_array(model, shape=arr[0], per_face=arr[1], progress=cb, **kwargs)
+        logs = simulate_array(model, shape=arr[0], per_face=arr[1], progress=cb, **kwargs)  # type: ignore[arg-type]
     paths = _outputs(out_path, len(logs))
     for log, p in zip(logs, paths, strict=True):
         write_log(log, p)
