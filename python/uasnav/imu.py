@@ -15,7 +15,14 @@ truth     dict          ground-truth channels of simulated logs
 ========  ============  =====================================
 
 ``truth`` keys used across uasnav: ``gyro_bias`` (n, 3) rad/s, ``accel_bias`` (n, 3) m/s²,
-``attitude`` (n, 4) quaternion body → NED, scalar first.
+``attitude`` (n, 4) quaternion body → NED, scalar first; the simulator (:mod:`uasnav.sim`)
+adds ``rate_true`` (n, 3) rad/s, ``specific_force_true`` (n, 3) m/s², ``gyro_bias_thermal``
+(n, 3) rad/s, ``temp_die`` and ``temp_chamber`` (n,) °C.
+
+``meta`` holds sensor metadata (``preset``/``source``, ``format``, ``rate_hz``, ``frame``,
+``mounting`` …). Helpers: :meth:`ImuLog.slice`, :meth:`ImuLog.between`,
+:meth:`ImuLog.segments` (e.g. the static intervals of :func:`uasnav.stationary.detect_static`)
+and :meth:`ImuLog.resample`.
 """
 
 from __future__ import annotations

@@ -114,6 +114,14 @@ def _quat_mul(p: FloatArray, q: FloatArray) -> FloatArray:
     )
 
 
+def _rows_to_columns(x: FloatArray) -> FloatArray:
+    """(k, n) → C-contiguous (n, k); column-wise copies beat a generic strided transpose."""
+    out = np.empty((x.shape[1], x.shape[0]))
+    for j in range(x.shape[0]):
+        out[:, j] = x[j]
+    return out
+
+
 def _interp_rows(idx: FloatArray, grid: FloatArray, values: FloatArray, out: FloatArray) -> None:
     """out[j] += interp(idx, grid, values[j]) for each row of a (k, m) array (in place)."""
     for j in range(values.shape[0]):
@@ -290,7 +298,8 @@ def _triad(
     thermal_factors: FloatArray | None,
     model: SensorModel,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Simulate one triad. Returns (output, total bias, thermal bias), each (n, 3)."""
+    """Simulate one triad. Returns (output, total bias, thermal bias), each (n, 3); the
+    thermal part is only interpolated to full rate for the gyro (a truth channel)."""
     k = tri.kind
     dt = 1.0 / rate
     st = _rng(seed, sensor, f"{k}_static")
@@ -331,20 +340,23 @@ def _triad(
         if th is not None and th.scale_factor_tc != 0.0:
             d_full = np.interp(np.arange(n, dtype=np.float64), np.arange(die_grid.size) * float(gstep), d_t)
             bias += th.scale_factor_tc * d_full[None, :] * x_true
-    y = _rng(seed, sensor, f"{k}_white").standard_normal((3, n))
-    y *= tri.white * math.sqrt(rate)
-    if noise_scale is not None:
-        y *= noise_scale[None, :]
-    y += bias
+    if tri.white > 0.0:
+        y = _rng(seed, sensor, f"{k}_white").standard_normal((3, n))
+        y *= tri.white * math.sqrt(rate)
+        if noise_scale is not None:
+            y *= noise_scale[None, :]
+        y += bias
+    else:  # an ideal triad (e.g. the accelerometers of the gyro-only crs05-02 preset)
+        y = bias.copy()
     y += x_true if moving else x_true[:, None]
     y = _quantize(_antialias(y, rate, model.antialias_hz, model.antialias_order), tri.quantization)
-    thermal = np.zeros((n, 3))
-    if th is not None:
+    thermal = np.zeros((n, 3)) if k == "gyro" else np.zeros((0, 3))
+    if th is not None and k == "gyro":
         idx = np.arange(n, dtype=np.float64)
         grid = np.arange(die_grid.size, dtype=np.float64) * gstep
         for j in range(3):
             thermal[:, j] = np.interp(idx, grid, thermal_grid[j])
-    return np.ascontiguousarray(y.T), np.ascontiguousarray(bias.T), thermal
+    return _rows_to_columns(y), _rows_to_columns(bias), thermal
 
 
 def simulate_one(
