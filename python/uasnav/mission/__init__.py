@@ -1,0 +1,1 @@
+"""Mission selector (thesis §5.2)."""
