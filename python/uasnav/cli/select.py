@@ -28,7 +28,9 @@ def _parse_pairs(text: str, what: str, allowed: tuple[str, ...]) -> dict[str, st
         key, sep, val = item.partition("=")
         key = key.strip()
         if not sep or key not in allowed:
-            raise click.BadParameter(f"{what}: expected NAME=VALUE with NAME in {', '.join(allowed)}, got {item!r}")
+            raise click.BadParameter(
+                f"{what}: expected NAME=VALUE with NAME in {', '.join(allowed)}, got {item!r}"
+            )
         out[key] = val.strip()
     return out
 
@@ -50,7 +52,9 @@ def _parse_pairs(text: str, what: str, allowed: tuple[str, ...]) -> dict[str, st
     show_default=True,
     help="Most important parameter: its weight is 1.25 (eq. 61 with cost first).",
 )
-@click.option("--weights", default=None, help="Explicit weights, e.g. range=1,weight=0.75,cost=1.25,resolution=1.")
+@click.option(
+    "--weights", default=None, help="Explicit weights, e.g. range=1,weight=0.75,cost=1.25,resolution=1."
+)
 @click.option(
     "--targets",
     default=None,
@@ -61,7 +65,9 @@ def _parse_pairs(text: str, what: str, allowed: tuple[str, ...]) -> dict[str, st
 @click.option("--db", "db", default=None, help="UAS/camera database: path or http(s) URL.")
 @click.option("--regulations", "regs", default=None, help="Regulations database: path or URL.")
 @click.option("--matrices", default=None, help="Compliance matrices: path or URL.")
-@click.option("--top", type=click.IntRange(1, 1000), default=10, show_default=True, help="Configurations listed.")
+@click.option(
+    "--top", type=click.IntRange(1, 1000), default=10, show_default=True, help="Configurations listed."
+)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def command(
     mission: str,
@@ -93,7 +99,15 @@ def command(
     lower is better).
     """
     from uasnav.errors import InputError
-    from uasnav.mission import Requirements, Targets, Weights, load_database, load_matrices, load_regulations, select
+    from uasnav.mission import (
+        Requirements,
+        Targets,
+        Weights,
+        load_database,
+        load_matrices,
+        load_regulations,
+        select,
+    )
 
     size = _parse_size(image_size)
     if weights:
@@ -146,7 +160,9 @@ def command(
     if as_json:
         echo_json(sel.to_dict())
         return
-    click.echo(f"Mission: {sel.mission_name}  ({jurisdiction}/{category}, max height {sel.regulatory_height_m:g} m)")
+    click.echo(
+        f"Mission: {sel.mission_name}  ({jurisdiction}/{category}, max height {sel.regulatory_height_m:g} m)"
+    )
     for n in sel.notes:
         click.echo(f"  note: {n}")
     click.echo("\nEquipment (* necessary):")

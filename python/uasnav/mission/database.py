@@ -47,7 +47,7 @@ class UasTable:
         return len(self.ids)
 
     def label(self, i: int) -> str:
-        """"Producer Name" of entry ``i``."""
+        """ "Producer Name" of entry ``i``."""
         return f"{self.producers[i]} {self.names[i]}"
 
 
@@ -74,7 +74,7 @@ class CameraTable:
         return len(self.ids)
 
     def label(self, i: int) -> str:
-        """"Producer Name" of entry ``i``."""
+        """ "Producer Name" of entry ``i``."""
         return f"{self.producers[i]} {self.names[i]}"
 
     @property

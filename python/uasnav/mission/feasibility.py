@@ -141,9 +141,13 @@ def uas_tests(u: UasTable, req: Requirements, max_mtom_g: float) -> list[TestRes
     t_req = mission_time_s(req.range_m, req.cruise_fraction * u.max_speed_ms, req.wind_ms)
     t_avail = u.endurance_min * 60.0 * (1.0 - req.reserve)
     out.append(TestResult("endurance", t_req <= t_avail, t_avail, t_req, "s", ">="))
-    out.append(TestResult("link-range", u.max_range_m >= req.range_m, u.max_range_m, full * req.range_m, "m", ">="))
     out.append(
-        TestResult("altitude", u.max_altitude_m >= req.altitude_m, u.max_altitude_m, full * req.altitude_m, "m", ">=")
+        TestResult("link-range", u.max_range_m >= req.range_m, u.max_range_m, full * req.range_m, "m", ">=")
+    )
+    out.append(
+        TestResult(
+            "altitude", u.max_altitude_m >= req.altitude_m, u.max_altitude_m, full * req.altitude_m, "m", ">="
+        )
     )
     if req.speed_ms is not None:
         rel = u.max_speed_ms - req.wind_ms
@@ -195,5 +199,7 @@ def describe(test: TestResult, i, label: str) -> str:
     if test.name == "endurance":
         if not math.isfinite(lim):
             return f"{label}: endurance: cruise airspeed does not exceed the wind"
-        return f"{label}: endurance: needs {lim:.0f} s, has {v:.0f} s after reserve (short by {lim - v:.0f} s)"
+        return (
+            f"{label}: endurance: needs {lim:.0f} s, has {v:.0f} s after reserve (short by {lim - v:.0f} s)"
+        )
     return f"{label}: {test.name}: {v:.4g} {test.unit} not {test.relation} {lim:.4g} {test.unit} (by {abs(lim - v):.3g} {test.unit})"

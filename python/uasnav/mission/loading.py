@@ -92,7 +92,9 @@ def parse_bytes(data: bytes, where: str, *, max_bytes: int = MAX_BYTES, max_dept
     pos = data.find(b"<!DOCTYPE")
     if pos >= 0:
         line = data.count(b"\n", 0, pos) + 1
-        raise DataFormatError("DTD (<!DOCTYPE …>) is not allowed (entity expansion / XXE guard)", path=where, line=line)
+        raise DataFormatError(
+            "DTD (<!DOCTYPE …>) is not allowed (entity expansion / XXE guard)", path=where, line=line
+        )
     try:
         tree = etree.ElementTree(etree.fromstring(data, _parser()))
     except etree.XMLSyntaxError as exc:
@@ -104,7 +106,9 @@ def parse_bytes(data: bytes, where: str, *, max_bytes: int = MAX_BYTES, max_dept
     while stack:
         el, depth = stack.pop()
         if isinstance(el, etree._Entity):
-            raise DataFormatError(f"entity reference {el.text!r} is not allowed", path=where, line=el.sourceline)
+            raise DataFormatError(
+                f"entity reference {el.text!r} is not allowed", path=where, line=el.sourceline
+            )
         if depth > max_depth:
             raise DataFormatError(f"element nesting deeper than {max_depth}", path=where, line=el.sourceline)
         stack.extend((child, depth + 1) for child in el)
@@ -134,7 +138,9 @@ def validate(tree, where: str, kind: str | None = None) -> str:
     root_tag = etree.QName(tree.getroot()).localname
     if root_tag not in SCHEMAS:
         raise DataFormatError(
-            f"root element <{root_tag}> is not one of {sorted(SCHEMAS)}", path=where, line=tree.getroot().sourceline
+            f"root element <{root_tag}> is not one of {sorted(SCHEMAS)}",
+            path=where,
+            line=tree.getroot().sourceline,
         )
     if kind is not None and root_tag != kind:
         raise DataFormatError(f"expected a <{kind}> document, got <{root_tag}>", path=where)
@@ -208,7 +214,9 @@ def fetch(
         with urllib.request.urlopen(req, timeout=timeout_s) as resp:
             length = resp.headers.get("Content-Length")
             if length is not None and length.isdigit() and int(length) > max_bytes:
-                raise DataFormatError(f"Content-Length {length} exceeds the limit of {max_bytes} bytes", path=url)
+                raise DataFormatError(
+                    f"Content-Length {length} exceeds the limit of {max_bytes} bytes", path=url
+                )
             data = resp.read(max_bytes + 1)
             if len(data) > max_bytes:
                 raise DataFormatError(f"document exceeds the limit of {max_bytes} bytes", path=url)

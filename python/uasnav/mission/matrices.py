@@ -143,7 +143,11 @@ def load_matrices(source: str | os.PathLike | None = None, **fetch_kw) -> Matric
             fid = v.get("feature")
             levels = tuple(v.get("levels").split())
             if fid not in features or any(lv not in features[fid] for lv in levels):
-                raise DataFormatError(f"mission {m.get('id')}: unknown feature/level {fid}:{levels}", path=where, line=v.sourceline)
+                raise DataFormatError(
+                    f"mission {m.get('id')}: unknown feature/level {fid}:{levels}",
+                    path=where,
+                    line=v.sourceline,
+                )
             feats[fid] = levels
         missions[m.get("id")] = Mission(m.get("id"), m.get("name"), feats)
     equipment = {}
@@ -153,8 +157,12 @@ def load_matrices(source: str | os.PathLike | None = None, **fetch_kw) -> Matric
             id=it.get("id"),
             name=it.get("name"),
             group=it.get("group"),
-            necessary_when=_cells(nec.get("when"), features, where, nec.sourceline) if nec is not None else frozenset(),
-            incompatible_when=_cells(inc.get("when"), features, where, inc.sourceline) if inc is not None else frozenset(),
+            necessary_when=_cells(nec.get("when"), features, where, nec.sourceline)
+            if nec is not None
+            else frozenset(),
+            incompatible_when=_cells(inc.get("when"), features, where, inc.sourceline)
+            if inc is not None
+            else frozenset(),
             always_necessary=it.get("always") == "necessary",
             note=(it.findtext("note") or "").strip(),
             table20_name=it.get("table20"),
@@ -165,10 +173,16 @@ def load_matrices(source: str | os.PathLike | None = None, **fetch_kw) -> Matric
         sym = (r.text or "").strip()
         if len(sym) != len(order):
             raise DataFormatError(
-                f"Table 20 row {r.get('label')!r} has {len(sym)} symbols for {len(order)} missions", path=where, line=r.sourceline
+                f"Table 20 row {r.get('label')!r} has {len(sym)} symbols for {len(order)} missions",
+                path=where,
+                line=r.sourceline,
             )
         eq = r.get("equipment")
         if eq is not None and eq not in equipment:
-            raise DataFormatError(f"Table 20 row names unknown equipment {eq!r}", path=where, line=r.sourceline)
-        rows.append(Table20Row(r.get("label"), eq, {mid: _SYMBOL[s] for mid, s in zip(order, sym, strict=True)}))
+            raise DataFormatError(
+                f"Table 20 row names unknown equipment {eq!r}", path=where, line=r.sourceline
+            )
+        rows.append(
+            Table20Row(r.get("label"), eq, {mid: _SYMBOL[s] for mid, s in zip(order, sym, strict=True)})
+        )
     return Matrices(features, names, missions, equipment, rows, (root.findtext("source") or "").strip())

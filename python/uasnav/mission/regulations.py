@@ -93,11 +93,15 @@ class Regulations:
         try:
             jur = self.jurisdictions[jurisdiction]
         except KeyError:
-            raise InputError(f"unknown jurisdiction {jurisdiction!r}; known: {', '.join(self.jurisdictions)}") from None
+            raise InputError(
+                f"unknown jurisdiction {jurisdiction!r}; known: {', '.join(self.jurisdictions)}"
+            ) from None
         try:
             return jur.categories[category]
         except KeyError:
-            raise InputError(f"{jurisdiction}: unknown category {category!r}; known: {', '.join(jur.categories)}") from None
+            raise InputError(
+                f"{jurisdiction}: unknown category {category!r}; known: {', '.join(jur.categories)}"
+            ) from None
 
     def max_height_m(self, jurisdiction: str, category: str) -> float:
         """Highest flight height (m above ground) allowed by the category (inf if none)."""
@@ -178,7 +182,11 @@ def load_regulations(source: str | os.PathLike | None = None, **fetch_kw) -> Reg
                 for s in c.iterfind("subcategory")
             }
             cats[c.get("id")] = Category(
-                c.get("id"), c.get("vlos") == "required", tuple(_limit(x) for x in c.iterfind("limit")), subs, c.get("source")
+                c.get("id"),
+                c.get("vlos") == "required",
+                tuple(_limit(x) for x in c.iterfind("limit")),
+                subs,
+                c.get("source"),
             )
         jurs[j.get("id")] = Jurisdiction(j.get("id"), j.get("name"), refs, classes, cats)
     return Regulations(jurs, where)

@@ -34,7 +34,9 @@ def transfer(x, target: float, limit: float) -> np.ndarray:
         ``clip((x - target) / (limit - target), 0, 1)``, same shape as ``x``.
     """
     if not (np.isfinite(target) and np.isfinite(limit)) or target == limit:
-        raise InputError(f"transfer function needs finite target != limit, got target={target}, limit={limit}")
+        raise InputError(
+            f"transfer function needs finite target != limit, got target={target}, limit={limit}"
+        )
     s = (np.asarray(x, dtype=float) - target) / (limit - target)
     # + 0.0 turns the -0.0 that clip keeps for values just inside the target into 0.0.
     return np.clip(s, 0.0, 1.0) + 0.0

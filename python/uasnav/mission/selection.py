@@ -114,7 +114,15 @@ def _reject(tests: list[TestResult], kind: str, labels, ids) -> tuple[np.ndarray
     for t in tests:
         for i in np.flatnonzero(~t.ok):
             out.append(
-                Rejection(kind, ids[i], t.name, float(t.value[i]), float(t.limit[i]), t.unit, describe(t, i, labels(i)))
+                Rejection(
+                    kind,
+                    ids[i],
+                    t.name,
+                    float(t.value[i]),
+                    float(t.limit[i]),
+                    t.unit,
+                    describe(t, i, labels(i)),
+                )
             )
         ok &= t.ok
     return ok, out
@@ -178,7 +186,9 @@ def select(
                 )
             )
     if cat.vlos_required:
-        notes.append(f"{req.jurisdiction}/{req.category}: VLOS required ({cat.source}); range {req.range_m:g} m must stay in sight")
+        notes.append(
+            f"{req.jurisdiction}/{req.category}: VLOS required ({cat.source}); range {req.range_m:g} m must stay in sight"
+        )
     # eq. 60 at the highest height the regulations allow (thesis §5.2.3.4); if the category sets
     # no height limit the required altitude is used instead.
     h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
