@@ -9,6 +9,7 @@ import threading
 import time
 from importlib import resources
 from pathlib import Path
+from typing import ClassVar
 
 import pytest
 
@@ -112,8 +113,8 @@ def test_duplicate_id_and_wrong_kind(tmp_path: Path) -> None:
 
 
 class _Handler(http.server.BaseHTTPRequestHandler):
-    routes: dict[str, bytes] = {}
-    hits: list[tuple[str, str | None]] = []
+    routes: ClassVar[dict[str, bytes]] = {}
+    hits: ClassVar[list[tuple[str, str | None]]] = []
 
     def log_message(self, *args) -> None:  # keep pytest output clean
         pass
@@ -201,7 +202,7 @@ def test_url_timeout_size_limit_and_invalid_body(server: str, tmp_path: Path) ->
         fetch(server + "/slow", cache_dir=tmp_path, timeout_s=0.2)
     assert time.perf_counter() - t0 < 0.9
     _Handler.routes["/big.xml"] = data_file("database.xml")
-    with pytest.raises(DataFormatError, match="Content-Length .* exceeds the limit of 1000 bytes"):
+    with pytest.raises(DataFormatError, match=r"Content-Length .* exceeds the limit of 1000 bytes"):
         fetch(server + "/big.xml", cache_dir=tmp_path, max_bytes=1000)
     _Handler.routes["/evil.xml"] = LAUGHS
     with pytest.raises(DataFormatError, match="DTD"):

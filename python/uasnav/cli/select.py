@@ -58,7 +58,8 @@ def _parse_pairs(text: str, what: str, allowed: tuple[str, ...]) -> dict[str, st
 @click.option(
     "--targets",
     default=None,
-    help="TARGET:LIMIT per parameter, e.g. range=5000:1500,weight=800:1600,cost=4000:7000,resolution=0.01:0.06.",
+    help="TARGET:LIMIT per parameter, e.g. range=5000:1500,weight=800:1600,cost=4000:7000,"
+    "resolution=0.01:0.06.",
 )
 @click.option("--jurisdiction", default="easa", show_default=True, help="Regulations: easa | faa.")
 @click.option("--category", default=None, help="Category (default: open for easa, part107 for faa).")
@@ -185,7 +186,8 @@ def command(
     click.echo(f"  {'#':>2} {'UAS':<30} {'camera':<26} {'score':>6} {'mass g':>7} {'cost $':>7}  open")
     for k, c in enumerate(sel.ranking, 1):
         click.echo(
-            f"  {k:>2} {c.uas:<30} {c.camera:<26} {c.score:6.2f} {c.mass_g:7.0f} {c.cost_usd:7.0f}  {c.open_subcategory or '-'}"
+            f"  {k:>2} {c.uas:<30} {c.camera:<26} {c.score:6.2f} {c.mass_g:7.0f} {c.cost_usd:7.0f}"
+            f"  {c.open_subcategory or '-'}"
         )
     if not sel.ranking:
         click.echo("  (no feasible configuration)")

@@ -202,4 +202,7 @@ def describe(test: TestResult, i, label: str) -> str:
         return (
             f"{label}: endurance: needs {lim:.0f} s, has {v:.0f} s after reserve (short by {lim - v:.0f} s)"
         )
-    return f"{label}: {test.name}: {v:.4g} {test.unit} not {test.relation} {lim:.4g} {test.unit} (by {abs(lim - v):.3g} {test.unit})"
+    return (
+        f"{label}: {test.name}: {v:.4g} {test.unit} not {test.relation} {lim:.4g} {test.unit} "
+        f"(by {abs(lim - v):.3g} {test.unit})"
+    )

@@ -134,8 +134,8 @@ def select(
     database: Database | None = None,
     matrices: Matrices | None = None,
     regulations: Regulations | None = None,
-    targets: Targets = Targets(),
-    weights: Weights = Weights(),
+    targets: Targets | None = None,
+    weights: Weights | None = None,
     top: int = 10,
 ) -> Selection:
     """Run the whole selection for ``req``.
@@ -154,6 +154,8 @@ def select(
     -------
     Selection
     """
+    targets = targets if targets is not None else Targets()
+    weights = weights if weights is not None else Weights()
     db = database if database is not None else load_database()
     mx = matrices if matrices is not None else load_matrices()
     regs = regulations if regulations is not None else load_regulations()
@@ -187,7 +189,8 @@ def select(
             )
     if cat.vlos_required:
         notes.append(
-            f"{req.jurisdiction}/{req.category}: VLOS required ({cat.source}); range {req.range_m:g} m must stay in sight"
+            f"{req.jurisdiction}/{req.category}: VLOS required ({cat.source}); "
+            f"range {req.range_m:g} m must stay in sight"
         )
     # eq. 60 at the highest height the regulations allow (thesis §5.2.3.4); if the category sets
     # no height limit the required altitude is used instead.
