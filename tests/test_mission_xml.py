@@ -217,3 +217,20 @@ def test_other_documents_load() -> None:
     assert set(load_regulations().jurisdictions) == {"easa", "faa"}
     tree, where = load_document(None, default="matrices.xml")
     assert where.endswith("matrices.xml") and tree.getroot().tag == "matrices"
+
+
+def test_cli_db_validate_url_and_schema_error(server: str, tmp_path: Path, monkeypatch) -> None:
+    from click.testing import CliRunner
+
+    from uasnav.cli import main
+
+    monkeypatch.setenv("UASNAV_CACHE_DIR", str(tmp_path))
+    _Handler.routes["/m.xml"] = data_file("matrices.xml")
+    res = CliRunner().invoke(main, ["db", "validate", server + "/m.xml"])
+    assert res.exit_code == 0 and "valid <matrices>" in res.output
+    _Handler.routes["/bad.xml"] = data_file("regulations.xml").replace(
+        b'op="lt" value="250"', b'op="lte" value="250"'
+    )
+    res = CliRunner().invoke(main, ["db", "validate", server + "/bad.xml"])
+    assert res.exit_code == 1
+    assert "line 18" in res.output and "SCHEMAV_CVC_ENUMERATION_VALID" in res.output
