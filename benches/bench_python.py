@@ -61,12 +61,42 @@ def bench_sim(n: int, repeat: int) -> None:
     print(
         f"flicker n={n:.0e}: uasnav GM sum (3 axes) {t_gm * 1e3:8.1f} ms | allantools.noise.pink (1 axis)"
         f" {t_pink * 1e3:8.1f} ms | ratio per axis {t_pink / (t_gm / 3):5.1f}x"
+def bench_mission(n_uas: int, n_cam: int, repeat: int) -> None:
+    from uasnav.mission import Targets, Weights, rank, score_matrix
+
+    ur, um, uc = rng.uniform(500, 8000, n_uas), rng.uniform(250, 9000, n_uas), rng.uniform(300, 20000, n_uas)
+    cm, cc, ci = rng.uniform(40, 700, n_cam), rng.uniform(300, 16000, n_cam), rng.uniform(0.005, 0.08, n_cam)
+    feasible = (um[:, None] * 0.3 >= cm[None, :]) & (ur[:, None] > 1500)
+    t, w = Targets(), Weights()
+
+    def ours() -> object:
+        s = score_matrix(ur, um, uc, cm, cc, ci, t, w, feasible)
+        return rank(s.total, 10)
+
+    def loop(rows: int) -> None:
+        # The same eq. 61 as a plain Python double loop (the thesis tool's per-pair approach).
+        for i in range(rows):
+            for j in range(n_cam):
+                if feasible[i, j]:
+                    _ = (
+                        w.range * min(max((ur[i] - 5000) / -3500, 0), 1)
+                        + w.weight * min(max((um[i] + cm[j] - 800) / 800, 0), 1)
+                        + w.cost * min(max((uc[i] + cc[j] - 4000) / 3000, 0), 1)
+                        + w.resolution * min(max((ci[j] - 0.01) / 0.05, 0), 1)
+                    )
+
+    t_ours = median_time(ours, repeat)
+    rows = max(1, n_uas // 100)
+    t_loop = median_time(lambda: loop(rows), 1) * n_uas / rows
+        f"mission score+rank {n_uas}x{n_cam}: uasnav {t_ours * 1e3:8.1f} ms | python loop (extrapolated "
+        f"from {rows} rows) {t_loop * 1e3:8.0f} ms | speed-up {t_loop / t_ours:5.0f}x"
     )
 
 
 CASES: dict[str, Callable[[bool], None]] = {
     "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
     "sim": lambda quick: bench_sim(10**6 if quick else 10**7, 3),
+    "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
 }
 
 

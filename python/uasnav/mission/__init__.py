@@ -1,0 +1,50 @@
+"""Mission selector (thesis §5.2): compliance matrices, UAS/camera database, regulations,
+feasibility tests and scoring.
+
+>>> from uasnav.mission import Requirements, select
+>>> sel = select(Requirements())          # the thesis' precision-agriculture case
+>>> sel.ranking[0].score >= 0
+True
+"""
+
+from uasnav.mission.database import CameraTable, Database, UasTable, load_database
+from uasnav.mission.feasibility import (
+    Rejection,
+    Requirements,
+    ground_resolution_m,
+    mission_time_s,
+    required_hfov_deg,
+)
+from uasnav.mission.loading import fetch, load_document, parse_bytes, validate
+from uasnav.mission.matrices import Matrices, load_matrices
+from uasnav.mission.regulations import Regulations, load_regulations
+from uasnav.mission.scoring import Targets, Weights, rank, score_matrix, transfer
+from uasnav.mission.selection import Configuration, Selection, select
+
+__all__ = [
+    "CameraTable",
+    "Configuration",
+    "Database",
+    "Matrices",
+    "Regulations",
+    "Rejection",
+    "Requirements",
+    "Selection",
+    "Targets",
+    "UasTable",
+    "Weights",
+    "fetch",
+    "ground_resolution_m",
+    "load_database",
+    "load_document",
+    "load_matrices",
+    "load_regulations",
+    "mission_time_s",
+    "parse_bytes",
+    "rank",
+    "required_hfov_deg",
+    "score_matrix",
+    "select",
+    "transfer",
+    "validate",
+]

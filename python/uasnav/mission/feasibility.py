@@ -1,0 +1,208 @@
+"""Feasibility tests of §5.2.3.4 (Figures 71–73), vectorised over the database.
+
+Each test gives a boolean mask plus the value and the limit it was compared with, so that a
+rejection can say which test failed and by how much.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from uasnav.errors import InputError
+from uasnav.mission.database import CameraTable, UasTable
+
+
+@dataclass(frozen=True)
+class Requirements:
+    """Mission requirements and weather (thesis Table 22; defaults are that case).
+
+    Parameters
+    ----------
+    mission : str
+        Mission id of Table 18 (e.g. ``"precision-agriculture"``).
+    range_m : float
+        Largest distance from the take-off point (m).
+    resolution_m : float
+        Required ground resolution (m/px).
+    image_size_m : (float, float)
+        Size of the target on the ground, length × width (m); the length sets the HFOV.
+    altitude_m : float
+        Required flight altitude above ground (m).
+    imagery : str or None
+        Camera type required (rgb, multispectral, thermal …); None accepts any.
+    wind_ms : float
+        Wind speed (m/s).
+    rain : bool
+        Whether the flight must be possible in rain (UAS needs IPX3 or a rain rating).
+    speed_ms : float or None
+        Required ground speed against the wind (m/s); None: no requirement.
+    jurisdiction, category : str
+        Regulations applied (``easa``/``open``, ``easa``/``specific``, ``faa``/``part107``).
+    cruise_fraction : float
+        Cruise airspeed as a fraction of the maximum speed, for the endurance test.
+    reserve : float
+        Fraction of the endurance kept in reserve.
+    """
+
+    mission: str = "precision-agriculture"
+    range_m: float = 1500.0
+    resolution_m: float = 0.05
+    image_size_m: tuple[float, float] = (70.0, 70.0)
+    altitude_m: float = 50.0
+    imagery: str | None = "multispectral"
+    wind_ms: float = 5.0
+    rain: bool = False
+    speed_ms: float | None = None
+    jurisdiction: str = "easa"
+    category: str = "open"
+    cruise_fraction: float = 0.7
+    reserve: float = 0.2
+
+    def __post_init__(self) -> None:
+        checks = {
+            "range_m": (self.range_m, 0.0),
+            "resolution_m": (self.resolution_m, 0.0),
+            "altitude_m": (self.altitude_m, 0.0),
+            "image_size_m[0]": (self.image_size_m[0], 0.0),
+            "image_size_m[1]": (self.image_size_m[1], 0.0),
+        }
+        for name, (v, lo) in checks.items():
+            if not math.isfinite(v) or v <= lo:
+                raise InputError(f"requirement {name}={v}: must be finite and > {lo}")
+        if not math.isfinite(self.wind_ms) or self.wind_ms < 0:
+            raise InputError(f"requirement wind_ms={self.wind_ms}: must be finite and >= 0")
+        if self.speed_ms is not None and (not math.isfinite(self.speed_ms) or self.speed_ms < 0):
+            raise InputError(f"requirement speed_ms={self.speed_ms}: must be finite and >= 0")
+        if not 0.0 < self.cruise_fraction <= 1.0:
+            raise InputError(f"cruise_fraction={self.cruise_fraction}: must be in (0, 1]")
+        if not 0.0 <= self.reserve < 1.0:
+            raise InputError(f"reserve={self.reserve}: must be in [0, 1)")
+
+
+@dataclass(frozen=True)
+class TestResult:
+    """One test over n items: ``ok`` mask, compared ``value`` and ``limit`` arrays, unit."""
+
+    name: str
+    ok: np.ndarray
+    value: np.ndarray
+    limit: np.ndarray
+    unit: str
+    relation: str  # how value must relate to limit: ">", ">=", "<=", "=="
+
+
+@dataclass(frozen=True)
+class Rejection:
+    """Why one UAS, camera or pair was rejected."""
+
+    kind: str  # "uas" | "camera" | "pair" | "mission"
+    item: str
+    test: str
+    value: float
+    limit: float
+    unit: str
+    message: str
+
+
+def required_hfov_deg(length_m: float, height_m: float) -> float:
+    """HFOV needed to cover a target of length L from height h: α = 2·atan(L/2h) (eq. 60), deg."""
+    if length_m <= 0 or height_m <= 0:
+        raise InputError(f"required_hfov_deg: L={length_m} m and h={height_m} m must be > 0")
+    return math.degrees(2.0 * math.atan(length_m / (2.0 * height_m)))
+
+
+def ground_resolution_m(hfov_deg: np.ndarray, pixels: np.ndarray, height_m: float) -> np.ndarray:
+    """Ground sample distance (m/px) at nadir: footprint 2·h·tan(HFOV/2) over the pixels across."""
+    return 2.0 * height_m * np.tan(np.radians(hfov_deg) / 2.0) / pixels
+
+
+def mission_time_s(range_m: float, airspeed_ms: np.ndarray, wind_ms: float) -> np.ndarray:
+    """Time (s) to fly out and back over ``range_m`` with the wind against one leg.
+
+    t = R/(V − W) + R/(V + W), the worst wind direction for a straight out-and-back leg; inf
+    where the airspeed does not exceed the wind (Figure 71: no progress upwind).
+    """
+    v = np.asarray(airspeed_ms, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = range_m / (v - wind_ms) + range_m / (v + wind_ms)
+    return np.where(v > wind_ms, t, np.inf)
+
+
+def uas_tests(u: UasTable, req: Requirements, max_mtom_g: float) -> list[TestResult]:
+    """Tests on the aircraft alone, in the thesis' order (wind, endurance, altitude, speed)."""
+    n = len(u)
+    full = np.full(n, 1.0)
+    out = [
+        TestResult("wind", u.max_speed_ms > req.wind_ms, u.max_speed_ms, full * req.wind_ms, "m/s", ">"),
+    ]
+    t_req = mission_time_s(req.range_m, req.cruise_fraction * u.max_speed_ms, req.wind_ms)
+    t_avail = u.endurance_min * 60.0 * (1.0 - req.reserve)
+    out.append(TestResult("endurance", t_req <= t_avail, t_avail, t_req, "s", ">="))
+    out.append(
+        TestResult("link-range", u.max_range_m >= req.range_m, u.max_range_m, full * req.range_m, "m", ">=")
+    )
+    out.append(
+        TestResult(
+            "altitude", u.max_altitude_m >= req.altitude_m, u.max_altitude_m, full * req.altitude_m, "m", ">="
+        )
+    )
+    if req.speed_ms is not None:
+        rel = u.max_speed_ms - req.wind_ms
+        out.append(TestResult("speed", rel >= req.speed_ms, rel, full * req.speed_ms, "m/s", ">="))
+    out.append(TestResult("regulation-mass", u.mass_g < max_mtom_g, u.mass_g, full * max_mtom_g, "g", "<"))
+    if req.rain:
+        out.append(TestResult("rain", u.rain.copy(), u.rain.astype(float), full, "rated", "=="))
+    return out
+
+
+def camera_tests(c: CameraTable, req: Requirements, height_m: float) -> list[TestResult]:
+    """Camera tests: imagery type, HFOV (eq. 60) and ground resolution at ``height_m``.
+
+    ``height_m`` is the maximum height the regulations allow (thesis §5.2.3.4).
+    """
+    n = len(c)
+    full = np.full(n, 1.0)
+    out = []
+    if req.imagery is not None:
+        ok = np.array([t == req.imagery for t in c.types], dtype=bool)
+        out.append(TestResult("imagery", ok, ok.astype(float), full, req.imagery, "=="))
+    alpha = required_hfov_deg(req.image_size_m[0], height_m)
+    out.append(TestResult("hfov", c.hfov_deg >= alpha, c.hfov_deg, full * alpha, "deg", ">="))
+    gsd = ground_resolution_m(c.hfov_deg, c.resolution_w_px, height_m)
+    out.append(TestResult("resolution", gsd <= req.resolution_m, gsd, full * req.resolution_m, "m/px", "<="))
+    return out
+
+
+def pair_tests(u: UasTable, c: CameraTable, max_mtom_g: float) -> list[TestResult]:
+    """Tests on each UAS × camera pair: payload capacity, published MTOM, regulatory mass."""
+    cam = c.mass_g[None, :]
+    mass = u.mass_g[:, None] + cam
+    payload = np.broadcast_to(u.payload_g[:, None], mass.shape)
+    mtom = np.where(np.isnan(u.max_takeoff_g), np.inf, u.max_takeoff_g)[:, None]
+    return [
+        TestResult("payload", payload >= cam, payload, np.broadcast_to(cam, mass.shape), "g", ">="),
+        TestResult("max-takeoff", mass <= mtom, np.broadcast_to(mtom, mass.shape), mass, "g", ">="),
+        TestResult("regulation-mass", mass < max_mtom_g, mass, np.full(mass.shape, max_mtom_g), "g", "<"),
+    ]
+
+
+def describe(test: TestResult, i, label: str) -> str:
+    """One-line reason: what failed and by how much."""
+    v, lim = float(test.value[i]), float(test.limit[i])
+    if test.name == "imagery":
+        return f"{label}: imagery is not {test.unit}"
+    if test.name == "rain":
+        return f"{label}: not rated for rain (needs IPX3 or better)"
+    if test.name == "endurance":
+        if not math.isfinite(lim):
+            return f"{label}: endurance: cruise airspeed does not exceed the wind"
+        return (
+            f"{label}: endurance: needs {lim:.0f} s, has {v:.0f} s after reserve (short by {lim - v:.0f} s)"
+        )
+    return (
+        f"{label}: {test.name}: {v:.4g} {test.unit} not {test.relation} {lim:.4g} {test.unit} "
+        f"(by {abs(lim - v):.3g} {test.unit})"
+    )

@@ -1,0 +1,188 @@
+"""Compliance matrices: missions × features (Table 18), features × equipment (Table 19,
+reconstructed) and the derived missions × equipment matrix compared with Table 20.
+
+Derivation rule (the thesis' step 4, made explicit because §5.2.2.4 gives none): a mission
+feature may span several levels (e.g. range "<1 km to >5 km"). For one equipment item and one
+feature, the item is *necessary* if any of the mission's levels makes it necessary (the hardest
+case sets the requirement) and *incompatible* only if every level is incompatible (the mission
+can be flown in a compatible case). Across features, necessary wins over incompatible (a
+requirement cannot be waived), incompatible over optional.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+from uasnav.errors import DataFormatError, InputError
+from uasnav.mission.loading import load_document
+
+NECESSARY, OPTIONAL, INCOMPATIBLE = "necessary", "optional", "incompatible"
+_SYMBOL = {"N": NECESSARY, "o": OPTIONAL, "-": INCOMPATIBLE}
+
+
+@dataclass(frozen=True)
+class Equipment:
+    """One equipment item of Table 19 with its reconstructed rules."""
+
+    id: str
+    name: str
+    group: str
+    necessary_when: frozenset[tuple[str, str]]
+    incompatible_when: frozenset[tuple[str, str]]
+    always_necessary: bool
+    note: str
+    table20_name: str | None = None
+
+
+@dataclass(frozen=True)
+class Mission:
+    """One mission of Table 18: feature id → tuple of levels."""
+
+    id: str
+    name: str
+    features: dict[str, tuple[str, ...]]
+
+
+@dataclass(frozen=True)
+class Table20Row:
+    """One printed row of Table 20: status per mission id."""
+
+    label: str
+    equipment: str | None
+    status: dict[str, str]
+
+
+@dataclass
+class Matrices:
+    """The three matrices as loaded from ``matrices.xml``."""
+
+    features: dict[str, tuple[str, ...]]
+    feature_names: dict[str, str]
+    missions: dict[str, Mission]
+    equipment: dict[str, Equipment]
+    table20: list[Table20Row] = field(default_factory=list)
+    source: str = ""
+
+    def mission(self, mission_id: str) -> Mission:
+        """The mission ``mission_id`` or an InputError listing the known ones."""
+        try:
+            return self.missions[mission_id]
+        except KeyError:
+            raise InputError(f"unknown mission {mission_id!r}; known: {', '.join(self.missions)}") from None
+
+    def equipment_status(self, mission_id: str, equipment_id: str) -> str:
+        """Derived status (necessary / optional / incompatible) of one item for one mission."""
+        mission = self.mission(mission_id)
+        item = self.equipment[equipment_id]
+        if item.always_necessary:
+            return NECESSARY
+        incompatible = False
+        for feat, levels in mission.features.items():
+            cells = [(feat, lv) for lv in levels]
+            if any(c in item.necessary_when for c in cells):
+                return NECESSARY
+            if cells and all(c in item.incompatible_when for c in cells):
+                incompatible = True
+        return INCOMPATIBLE if incompatible else OPTIONAL
+
+    def derive(self, mission_id: str) -> dict[str, str]:
+        """Missions × equipment for one mission: equipment id → status (thesis step 4)."""
+        return {eid: self.equipment_status(mission_id, eid) for eid in self.equipment}
+
+    def compare_table20(self) -> list[dict]:
+        """Every cell where the derivation and the printed Table 20 disagree.
+
+        Returns a list of ``{"equipment", "label", "mission", "derived", "table20"}``.
+        """
+        out = []
+        for row in self.table20:
+            if row.equipment is None:
+                continue
+            for mid, printed in row.status.items():
+                derived = self.equipment_status(mid, row.equipment)
+                if derived != printed:
+                    out.append(
+                        {
+                            "equipment": row.equipment,
+                            "label": row.label,
+                            "mission": mid,
+                            "derived": derived,
+                            "table20": printed,
+                        }
+                    )
+        return out
+
+
+def _cells(text: str, features: dict[str, tuple[str, ...]], where: str, line: int | None) -> frozenset:
+    cells = set()
+    for tok in text.split():
+        feat, _, level = tok.partition(":")
+        if feat not in features or level not in features[feat]:
+            raise DataFormatError(f"unknown feature cell {tok!r}", path=where, line=line)
+        cells.add((feat, level))
+    return frozenset(cells)
+
+
+def load_matrices(source: str | os.PathLike | None = None, **fetch_kw) -> Matrices:
+    """Load the compliance matrices (default: the copy shipped in the package).
+
+    Beyond the XSD, checks the cross-references: feature ids and levels used by missions and
+    rules exist, Table 20 rows have one symbol per mission and name known equipment.
+    """
+    tree, where = load_document(source, "matrices", default="matrices.xml", **fetch_kw)
+    root = tree.getroot()
+    features, names = {}, {}
+    for f in root.iterfind("features/feature"):
+        features[f.get("id")] = tuple(f.get("levels").split())
+        names[f.get("id")] = (f.text or "").strip()
+    missions = {}
+    for m in root.iterfind("missions/mission"):
+        feats = {}
+        for v in m.iterfind("value"):
+            fid = v.get("feature")
+            levels = tuple(v.get("levels").split())
+            if fid not in features or any(lv not in features[fid] for lv in levels):
+                raise DataFormatError(
+                    f"mission {m.get('id')}: unknown feature/level {fid}:{levels}",
+                    path=where,
+                    line=v.sourceline,
+                )
+            feats[fid] = levels
+        missions[m.get("id")] = Mission(m.get("id"), m.get("name"), feats)
+    equipment = {}
+    for it in root.iterfind("equipment/item"):
+        nec, inc = it.find("necessary"), it.find("incompatible")
+        equipment[it.get("id")] = Equipment(
+            id=it.get("id"),
+            name=it.get("name"),
+            group=it.get("group"),
+            necessary_when=_cells(nec.get("when"), features, where, nec.sourceline)
+            if nec is not None
+            else frozenset(),
+            incompatible_when=_cells(inc.get("when"), features, where, inc.sourceline)
+            if inc is not None
+            else frozenset(),
+            always_necessary=it.get("always") == "necessary",
+            note=(it.findtext("note") or "").strip(),
+            table20_name=it.get("table20"),
+        )
+    order = list(missions)
+    rows = []
+    for r in root.iterfind("table20/row"):
+        sym = (r.text or "").strip()
+        if len(sym) != len(order):
+            raise DataFormatError(
+                f"Table 20 row {r.get('label')!r} has {len(sym)} symbols for {len(order)} missions",
+                path=where,
+                line=r.sourceline,
+            )
+        eq = r.get("equipment")
+        if eq is not None and eq not in equipment:
+            raise DataFormatError(
+                f"Table 20 row names unknown equipment {eq!r}", path=where, line=r.sourceline
+            )
+        rows.append(
+            Table20Row(r.get("label"), eq, {mid: _SYMBOL[s] for mid, s in zip(order, sym, strict=True)})
+        )
+    return Matrices(features, names, missions, equipment, rows, (root.findtext("source") or "").strip())
