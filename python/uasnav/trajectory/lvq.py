@@ -37,21 +37,23 @@ _ALGORITHMS = ("lvq1", "lvq2.1", "glvq")
 def neurons_per_class(counts: np.ndarray, n_prototypes: int) -> np.ndarray:
     """Share ``n_prototypes`` among classes in proportion to ``counts`` (≥ 1 each).
 
-    Largest-remainder rounding of ``n_prototypes · counts / Σcounts`` after giving every class
-    one neuron, as MATLAB's lvqnet does with its class percentages.
+    Largest-remainder rounding of ``n_prototypes · counts / Σcounts`` (MATLAB lvqnet's class
+    percentages); a class left with none takes one from the class holding most.
     """
     c = np.asarray(counts, dtype=float)
     k = c.size
     if n_prototypes < k:
         raise InputError(f"n_prototypes = {n_prototypes} is fewer than the {k} classes")
-    extra = n_prototypes - k
-    share = extra * c / c.sum()
+    share = n_prototypes * c / c.sum()
     n = np.floor(share).astype(int)
-    rest = extra - int(n.sum())
+    rest = n_prototypes - int(n.sum())
     # Ties broken by class order (stable) so the split is deterministic.
     order = np.argsort(-(share - n), kind="stable")
     n[order[:rest]] += 1
-    return n + 1
+    for i in np.flatnonzero(n == 0):
+        n[int(np.argmax(n))] -= 1
+        n[i] = 1
+    return n
 
 
 class LVQClassifier(ClassifierMixin, BaseEstimator):

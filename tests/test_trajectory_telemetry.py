@@ -1,0 +1,93 @@
+"""Real telemetry: the ArduCopter tlog (mission, reached events, 1 Hz positions), PX4 ULog, CLI."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from uasnav.cli import main
+from uasnav.errors import InputError
+from uasnav.trajectory.samples import ElementSamples
+from uasnav.trajectory.telemetry import flown_runs, read_flight, run_samples
+
+TLOG = "flights/phoenix_mission1_arducopter.tlog"
+
+
+@pytest.fixture(scope="module")
+def tlog(shared_data):
+    return read_flight(shared_data / TLOG)
+
+
+def test_tlog_mission_runs(tlog):
+    assert sorted(tlog.waypoints) == [2, 3]
+    assert tlog.cruise_ms == pytest.approx(5.0)  # WPNAV_SPEED 500 cm/s
+    assert tlog.wind_ne is None
+    runs = flown_runs(tlog)
+    assert len(runs) == 5
+    for r in runs:
+        assert r.seqs == [2, 3]
+        assert np.hypot(*np.diff(r.plan_ne, axis=0)[0]) == pytest.approx(100.5, abs=0.5)
+        assert 19.0 < r.reached_t[1] - r.reached_t[0] < 23.0
+
+
+def test_tlog_elements_and_leave_one_out_beats_distance_over_speed(tlog):
+    from uasnav.trajectory.baselines import evaluate_methods
+
+    runs, samples = run_samples(tlog)
+    assert [len(s) for s in samples] == [5] * 5
+    # Straight middle elements are flown at about the 5 m/s waypoint speed.
+    mid = np.concatenate([s.t_real_s[1:4] for s in samples])
+    assert 3.4 < np.median(20.0 / mid) < 5.5
+    leg_lvq, leg_ds = [], []
+    for k in range(5):
+        train = ElementSamples.concat([s for i, s in enumerate(samples) if i != k])
+        res = {m.name: m for m in evaluate_methods(train, samples[k])}
+        real = samples[k].t_real_s.sum()
+        leg_lvq.append(abs(res["LVQ (thesis)"].time_s.sum() - real) / real)
+        leg_ds.append(abs(res["distance ÷ speed"].time_s.sum() - real) / real)
+    assert np.mean(leg_lvq) < np.mean(leg_ds)
+
+
+def test_ulog_has_wind_but_no_mission(shared_data):
+    log = read_flight(shared_data / "logs/px4_sample_log_small.ulg")
+    assert log.wind_ne is not None and np.isfinite(log.wind_ne).all()
+    with pytest.raises(InputError, match="no mission waypoints"):
+        flown_runs(log)
+
+
+def test_unknown_extension(tmp_path):
+    p = tmp_path / "x.txt"
+    p.write_text("1")
+    with pytest.raises(InputError, match="unknown telemetry format"):
+        read_flight(p)
+
+
+def test_cli_train_predict_evaluate(shared_data, tmp_path):
+    model = tmp_path / "m.json"
+    r = CliRunner().invoke(main, ["trajectory", "train", str(shared_data / TLOG), "--out", str(model)])
+    assert r.exit_code == 0, r.output
+    assert "25 elements of 5 run(s)" in r.output
+    plan = tmp_path / "plan.csv"
+    plan.write_text("north,east\n0,0\n0,40\n40,40\n")
+    r = CliRunner().invoke(
+        main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "0@0", "--json"]
+    )
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["eta_s"] == pytest.approx(sum(e["time_s"] for e in out["elements"]))
+    assert len(out["waypoint_times_s"]) == 3
+    # The corner was never flown in training: flagged, not silent.
+    assert any(e["low_confidence"] for e in out["elements"] if e["kind"] == "corner")
+    r = CliRunner().invoke(main, ["trajectory", "evaluate", str(shared_data / TLOG), "--json"])
+    assert r.exit_code == 0, r.output
+    ev = json.loads(r.output)
+    assert ev["n_runs"] == 5 and "distance ÷ speed" in ev["methods"]
+    # bad input: one-waypoint plan, bad wind syntax
+    plan.write_text("north,east\n0,0\n")
+    r = CliRunner().invoke(main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3@0"])
+    assert r.exit_code == 1 and "at least two waypoints" in r.output
+    r = CliRunner().invoke(main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3"])
+    assert r.exit_code == 1 and "SPEED@DIR" in r.output
