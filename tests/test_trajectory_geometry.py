@@ -58,14 +58,16 @@ def test_left_turn_and_mirror_folding_figure53():
     assert left.theta_deg[0] == pytest.approx(90.0) and left.mirrored[0]
     assert left.theta_w_deg[0] == pytest.approx(270.0)
     assert cell_index(left)[0] == cell_index(right)[0]
-    th, tw, m = fold(np.array([0.0, 0.0]), np.array([300.0, 60.0]))
+    _th, tw, m = fold(np.array([0.0, 0.0]), np.array([300.0, 60.0]))
     np.testing.assert_allclose(tw, [60.0, 60.0])
     assert m.tolist() == [True, False]
 
 
 def test_theta_w_eq56_and_cells():
     # First segment heading east, wind blowing toward north-east: θ_w = 315° (counter-clockwise 45°).
-    f = features(np.array([90.0]), np.array([45.0]), np.array(["corner"]), np.array([1.0, 1.0]) * 5 / np.sqrt(2))
+    f = features(
+        np.array([90.0]), np.array([45.0]), np.array(["corner"]), np.array([1.0, 1.0]) * 5 / np.sqrt(2)
+    )
     assert f.theta_w_deg[0] == pytest.approx(315.0)
     assert f.wind_ms[0] == pytest.approx(5.0)
     c = cell_index(f)[0]

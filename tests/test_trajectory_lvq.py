@@ -78,7 +78,9 @@ def test_deterministic_with_seed_and_midpoint_init():
     a = LVQClassifier(n_prototypes=4, random_state=7).fit(X, y).prototypes_
     b = LVQClassifier(n_prototypes=4, random_state=7).fit(X, y).prototypes_
     np.testing.assert_array_equal(a, b)
-    m = LVQClassifier(n_prototypes=4, init="midpoint", max_iter=4000, learning_rate=0.05, random_state=0).fit(X, y)
+    m = LVQClassifier(n_prototypes=4, init="midpoint", max_iter=4000, learning_rate=0.05, random_state=0).fit(
+        X, y
+    )
     assert m.score(X, y) > 0.85
 
 
@@ -94,7 +96,11 @@ def test_predict_proba_and_distances_consistent():
 
 @pytest.mark.parametrize(
     ("kw", "msg"),
-    [({"algorithm": "lvq3"}, "algorithm"), ({"window": 1.5}, "window"), ({"learning_rate": -1}, "learning_rate")],
+    [
+        ({"algorithm": "lvq3"}, "algorithm"),
+        ({"window": 1.5}, "window"),
+        ({"learning_rate": -1}, "learning_rate"),
+    ],
 )
 def test_bad_params(kw, msg):
     with pytest.raises(InputError, match=msg):

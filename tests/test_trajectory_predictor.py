@@ -38,7 +38,7 @@ def test_measured_times_match_simulator_ground_truth():
     # measured middle elements take 20 m / 3.33 m/s = 6.006 s, and the sum equals the flight.
     plan = np.array([[0.0, 0.0], [100.0, 0.0]])
     tel = simulate_flight(plan, wind=WindModel(0, 0, 0, 1, 0), pos_noise_m=0, vel_noise_ms=0, seed=0)
-    el, s = measure_elements(plan, tel.t, tel.pos_ne, tel.vel_ne, tel.wind_ne, 3.33, end_tolerance_m=0.05)
+    _el, s = measure_elements(plan, tel.t, tel.pos_ne, tel.vel_ne, tel.wind_ne, 3.33, end_tolerance_m=0.05)
     np.testing.assert_allclose(s.t_real_s[2], 20 / 3.33, rtol=5e-3)  # PI loop overshoot ≈ 0.3 %
     # Elements cover the flight up to 5 cm before the waypoint; the rest is the final settling.
     assert tel.t[-1] - 1.5 < s.t_real_s.sum() < tel.t[-1]
@@ -48,7 +48,9 @@ def test_measured_times_match_simulator_ground_truth():
 def test_crossing_times_interpolates():
     t = np.array([0.0, 1.0, 2.0])
     s = np.array([0.0, 10.0, 10.0])
-    np.testing.assert_allclose(crossing_times(t, s, np.array([0.0, 5.0, 10.0, 11.0])), [0.0, 0.5, 1.0, np.nan])
+    np.testing.assert_allclose(
+        crossing_times(t, s, np.array([0.0, 5.0, 10.0, 11.0])), [0.0, 0.5, 1.0, np.nan]
+    )
 
 
 def test_table17_reproduced_within_thesis_errors(experiment):

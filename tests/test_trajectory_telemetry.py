@@ -36,7 +36,7 @@ def test_tlog_mission_runs(tlog):
 def test_tlog_elements_and_leave_one_out_beats_distance_over_speed(tlog):
     from uasnav.trajectory.baselines import evaluate_methods
 
-    runs, samples = run_samples(tlog)
+    _runs, samples = run_samples(tlog)
     assert [len(s) for s in samples] == [5] * 5
     # Straight middle elements are flown at about the 5 m/s waypoint speed.
     mid = np.concatenate([s.t_real_s[1:4] for s in samples])
@@ -87,7 +87,19 @@ def test_cli_train_predict_evaluate(shared_data, tmp_path):
     assert ev["n_runs"] == 5 and "distance ÷ speed" in ev["methods"]
     # bad input: one-waypoint plan, bad wind syntax
     plan.write_text("north,east\n0,0\n")
-    r = CliRunner().invoke(main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3@0"])
+    r = CliRunner().invoke(
+        main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3@0"]
+    )
     assert r.exit_code == 1 and "at least two waypoints" in r.output
-    r = CliRunner().invoke(main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3"])
+    r = CliRunner().invoke(
+        main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3"]
+    )
     assert r.exit_code == 1 and "SPEED@DIR" in r.output
+
+
+def test_report_section_quick(tmp_path):
+    r = CliRunner().invoke(main, ["report", "--quick", "--only", "trajectory", "--out", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    data = json.loads((tmp_path / "report.json").read_text())["sections"]["trajectory"]
+    assert len(data["table17"]) == 2
+    assert data["methods"]["LVQ (thesis)"]["mean"] < data["methods"]["distance ÷ speed"]["mean"]

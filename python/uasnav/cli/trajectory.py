@@ -16,7 +16,9 @@ def parse_wind(text: str) -> np.ndarray:
     try:
         speed, direction = (float(x) for x in text.split("@"))
     except ValueError:
-        raise InputError(f"--wind must be SPEED@DIR (m/s @ deg from north, wind from), got {text!r}") from None
+        raise InputError(
+            f"--wind must be SPEED@DIR (m/s @ deg from north, wind from), got {text!r}"
+        ) from None
     return wind_vector(speed, direction)
 
 
@@ -42,7 +44,9 @@ def _flight_samples(paths, plan, speed, wind, segment, max_gap):  # type: ignore
                 raise InputError(f"{path}: no waypoint speed in the log; give --speed")
             pos = geodetic_to_local(log.lat, log.lon, log.alt, origin=origin)[:, :2]
             w = wind if wind is not None else (log.wind_ne if log.wind_ne is not None else np.zeros(2))
-            _, s = measure_elements(plan_ne, log.t, pos, log.vel_ned[:, :2], w, speed, segment, max_gap_s=max_gap)
+            _, s = measure_elements(
+                plan_ne, log.t, pos, log.vel_ned[:, :2], w, speed, segment, max_gap_s=max_gap
+            )
             runs, samples = [None], [s]
         for r, s in zip(runs, samples, strict=True):
             k = len(samples_all)
@@ -58,11 +62,21 @@ def command() -> None:
 
 
 _common_opts = [
-    click.option("--plan", type=click.Path(dir_okay=False), help="Plan CSV (lat,lon,alt) for logs without a mission."),
+    click.option(
+        "--plan", type=click.Path(dir_okay=False), help="Plan CSV (lat,lon,alt) for logs without a mission."
+    ),
     click.option("--speed", type=float, help="Commanded speed (m/s); default from the log (WPNAV_SPEED …)."),
-    click.option("--wind", "wind_text", help="Wind SPEED@DIR (m/s, deg wind comes from); default the log's or calm."),
+    click.option(
+        "--wind", "wind_text", help="Wind SPEED@DIR (m/s, deg wind comes from); default the log's or calm."
+    ),
     click.option("--segment", type=float, default=10.0, show_default=True, help="Segment length L (m)."),
-    click.option("--max-gap", type=float, default=5.0, show_default=True, help="Largest telemetry gap in an element (s)."),
+    click.option(
+        "--max-gap",
+        type=float,
+        default=5.0,
+        show_default=True,
+        help="Largest telemetry gap in an element (s).",
+    ),
 ]
 
 
@@ -151,7 +165,9 @@ def predict(model_path, plan_path, wind_text, speed, as_json):  # type: ignore[n
             f"{r['element']:>3} {r['kind']:8} {r['length_m']:6.1f} {r['theta_deg']:6.1f} "
             f"{r['theta_w_deg']:6.1f} {r['dv_ms']:7.2f} {r['time_s']:7.2f}{mark}"
         )
-    click.echo(f"ETA {p.eta_s:.1f} s; waypoint times (s): " + ", ".join(f"{x:.1f}" for x in p.waypoint_times_s))
+    click.echo(
+        f"ETA {p.eta_s:.1f} s; waypoint times (s): " + ", ".join(f"{x:.1f}" for x in p.waypoint_times_s)
+    )
 
 
 @command.command("evaluate")
@@ -174,7 +190,10 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
 
         r = run_phantom4(seed=seed)
         table = {
-            m.name: {"element_e_pct_mean": float(m.error_pct.mean()), "element_e_pct_max": float(m.error_pct.max())}
+            m.name: {
+                "element_e_pct_mean": float(m.error_pct.mean()),
+                "element_e_pct_max": float(m.error_pct.max()),
+            }
             for m in r.methods
         }
         t17 = [{"piece": n, "t_nn_s": t, "t_real_s": reals} for n, t, reals in r.table17]
@@ -194,7 +213,10 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             if run is not None:
                 el = discretise(run.plan_ne, segment)
                 kin = kinematic_times(
-                    run.plan_ne, el.s_start_m[test.element], el.s_start_m[test.element] + test.length_m, test.v_ref_ms[0]
+                    run.plan_ne,
+                    el.s_start_m[test.element],
+                    el.s_start_m[test.element] + test.length_m,
+                    test.v_ref_ms[0],
                 )
             for m in evaluate_methods(train, test, kinematic_s=kin, random_state=seed):
                 d = per.setdefault(m.name, {"element": [], "run": []})
@@ -217,4 +239,7 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         extra = f"  run e% {d['run_e_pct_mean']:6.2f}" if "run_e_pct_mean" in d else ""
         click.echo(f"{name:24s} element e% mean {d['element_e_pct_mean']:6.2f}{extra}")
     for row in out.get("table17", []):
-        click.echo(f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real " + ", ".join(f"{x:.2f}" for x in row["t_real_s"]))
+        click.echo(
+            f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
+            + ", ".join(f"{x:.2f}" for x in row["t_real_s"])
+        )

@@ -75,8 +75,8 @@ def kinematic_times(
     accel_ms2: float = 1.0,
     ds_m: float = 0.1,
 ) -> np.ndarray:
-    """Times (s) to fly arc-length intervals [s_start, s_end] (m) of the plan for a point mass: v(s) = min(V, √(2a s), √(v_k² + 2a|s − s_k|)
-    around each waypoint k) with corner speed v_k = V·max(cos(θ_k/2), 0.1), 0 at the ends."""
+    """Times (s) to fly arc-length intervals [s_start, s_end] (m) of the plan for a point mass:
+    v(s) = min(V, √(2a s), √(v_k² + 2a|s − s_k|)) around each waypoint k) with corner speed v_k = V·max(cos(θ_k/2), 0.1), 0 at the ends."""
     p = np.asarray(plan_ne, dtype=float)[:, :2]
     d = np.diff(p, axis=0)
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
@@ -123,7 +123,11 @@ def evaluate_methods(
 
     lvq = (lvq_factory() if lvq_factory else TrajectoryPredictor(random_state=random_state)).fit(train)  # type: ignore[attr-defined]
     out = [
-        MethodResult("LVQ (thesis)", t := lvq.element_times(test.features, test.length_m, test.v_ref_ms), percent_error(t, test.t_real_s))
+        MethodResult(
+            "LVQ (thesis)",
+            t := lvq.element_times(test.features, test.length_m, test.v_ref_ms),
+            percent_error(t, test.t_real_s),
+        )
     ]
     for name, factor in (("distance ÷ speed", 1.0), ("distance ÷ 0.8·speed", 0.8)):
         t = distance_over_speed(test.length_m, test.v_ref_ms, factor)
@@ -137,7 +141,9 @@ def evaluate_methods(
         t = test.length_m / np.maximum(test.v_ref_ms + dv, 0.2)
         out.append(MethodResult(name, t, percent_error(t, test.t_real_s)))
     if kinematic_s is not None:
-        out.append(MethodResult("kinematic point mass", kinematic_s, percent_error(kinematic_s, test.t_real_s)))
+        out.append(
+            MethodResult("kinematic point mass", kinematic_s, percent_error(kinematic_s, test.t_real_s))
+        )
     return out
 
 

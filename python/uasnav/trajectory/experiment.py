@@ -26,12 +26,21 @@ class ExperimentResult:
     table17: list[tuple[str, float, list[float]]]
 
 
-def samples_of(flights: list[Telemetry], first_index: int = 0, segment_m: float = DEFAULT_SEGMENT_M) -> list[ElementSamples]:
+def samples_of(
+    flights: list[Telemetry], first_index: int = 0, segment_m: float = DEFAULT_SEGMENT_M
+) -> list[ElementSamples]:
     """Measured elements of each simulated flight."""
     out = []
     for i, tel in enumerate(flights):
         _, s = measure_elements(
-            tel.plan_ne, tel.t, tel.pos_ne, tel.vel_ne, tel.wind_ne, tel.cruise_ms, segment_m, flight=first_index + i
+            tel.plan_ne,
+            tel.t,
+            tel.pos_ne,
+            tel.vel_ne,
+            tel.wind_ne,
+            tel.cruise_ms,
+            segment_m,
+            flight=first_index + i,
         )
         out.append(s)
     return out
@@ -49,25 +58,35 @@ def table17_piece(plan_ne: np.ndarray, segment_m: float = DEFAULT_SEGMENT_M) -> 
     return np.flatnonzero((el.s_start_m >= lo) & (el.s_end_m <= hi))
 
 
-def run_phantom4(n_flights: int = 10, n_train: int = 7, seed: int = 0, **predictor_kw: object) -> ExperimentResult:
+def run_phantom4(
+    n_flights: int = 10, n_train: int = 7, seed: int = 0, **predictor_kw: object
+) -> ExperimentResult:
     """Both trajectories flown ``n_flights`` times; the first ``n_train`` train, the rest test."""
     flights = phantom4_experiment(n_flights, seed=seed)
     train_parts, test_parts, kin = [], [], []
     table_rows = []
-    for j, (name, fl) in enumerate(flights.items()):
+    for j, fl in enumerate(flights.values()):
         parts = samples_of(fl, first_index=100 * j)
         train_parts += parts[:n_train]
         test_parts += parts[n_train:]
         plan = fl[0].plan_ne
         el = discretise(plan)
         for s in parts[n_train:]:
-            kin.append(kinematic_times(plan, el.s_start_m[s.element], el.s_start_m[s.element] + s.length_m, fl[0].cruise_ms))
+            kin.append(
+                kinematic_times(
+                    plan, el.s_start_m[s.element], el.s_start_m[s.element] + s.length_m, fl[0].cruise_ms
+                )
+            )
     train = ElementSamples.concat(train_parts)
     test = ElementSamples.concat(test_parts)
     kw = {"random_state": seed, **predictor_kw}
     pred = TrajectoryPredictor(**kw).fit(train)  # type: ignore[arg-type]
     methods = evaluate_methods(
-        train, test, lvq_factory=lambda: TrajectoryPredictor(**kw), kinematic_s=np.concatenate(kin), random_state=seed  # type: ignore[arg-type]
+        train,
+        test,
+        lvq_factory=lambda: TrajectoryPredictor(**kw),
+        kinematic_s=np.concatenate(kin),
+        random_state=seed,  # type: ignore[arg-type]
     )
     for j, (name, fl) in enumerate(flights.items()):
         plan = fl[0].plan_ne

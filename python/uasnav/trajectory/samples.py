@@ -178,7 +178,10 @@ def measure_elements(
     dt = t1 - t0
     # Largest telemetry gap inside each element.
     gap = np.array(
-        [np.diff(t[(t >= a) & (t <= b)], prepend=a, append=b).max() if b > a else np.inf for a, b in zip(t0, t1)]
+        [
+            np.diff(t[(t >= a) & (t <= b)], prepend=a, append=b).max() if b > a else np.inf
+            for a, b in zip(t0, t1, strict=False)
+        ]
     )
     ok = np.isfinite(dt) & (dt > 0) & (gap <= max_gap_s)
     if not ok.any():

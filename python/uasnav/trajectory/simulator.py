@@ -127,7 +127,7 @@ def simulate_flight(
     total = seg_len.sum()
     t_end = max_time_s or 20.0 + 4.0 * total / prm.cruise_ms
     n_steps = int(t_end / dt)
-    every = max(int(round(1.0 / (rate_hz * dt))), 1)
+    every = max(round(1.0 / (rate_hz * dt)), 1)
     pos = p_plan[0].copy()
     vel = np.zeros(2)
     integ = np.zeros(2)
@@ -221,7 +221,9 @@ def phantom4_experiment(
         raise InputError(f"n_flights must be ≥ 1, got {n_flights}")
     out: dict[str, list[Telemetry]] = {}
     for j, (name, plan) in enumerate(phantom4_plans().items()):
-        out[name] = [simulate_flight(plan, wind=wind, seed=seed * 1000 + 100 * j + i) for i in range(n_flights)]
+        out[name] = [
+            simulate_flight(plan, wind=wind, seed=seed * 1000 + 100 * j + i) for i in range(n_flights)
+        ]
     return out
 
 

@@ -97,7 +97,9 @@ def read_csv(path: str | Path) -> FlightLog:
             try:
                 data[i, j] = float(r[k])
             except (ValueError, IndexError):
-                raise DataFormatError("not a number", path=str(path), line=i + 2, column=CSV_COLUMNS[j]) from None
+                raise DataFormatError(
+                    "not a number", path=str(path), line=i + 2, column=CSV_COLUMNS[j]
+                ) from None
     bad = ~np.isfinite(data)
     if bad.any():
         i, j = np.argwhere(bad)[0]
@@ -278,9 +280,7 @@ class FlownRun:
     vel_ne: np.ndarray
 
 
-def flown_runs(
-    log: FlightLog, origin: tuple[float, float, float] | None = None
-) -> list[FlownRun]:
+def flown_runs(log: FlightLog, origin: tuple[float, float, float] | None = None) -> list[FlownRun]:
     """Cut a log into mission runs between reached navigation waypoints (local NED plan).
 
     Raises :class:`InputError` if the log has no mission waypoints or no run reaching two of
