@@ -76,7 +76,8 @@ def kinematic_times(
     ds_m: float = 0.1,
 ) -> np.ndarray:
     """Times (s) to fly arc-length intervals [s_start, s_end] (m) of the plan for a point mass:
-    v(s) = min(V, √(2a s), √(v_k² + 2a|s − s_k|)) around each waypoint k) with corner speed v_k = V·max(cos(θ_k/2), 0.1), 0 at the ends."""
+    v(s) = min(V, √(2a s), √(v_k² + 2a|s − s_k|)) around each waypoint k)
+    with corner speed v_k = V·max(cos(θ_k/2), 0.1), 0 at the ends."""
     p = np.asarray(plan_ne, dtype=float)[:, :2]
     d = np.diff(p, axis=0)
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
