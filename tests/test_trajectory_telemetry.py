@@ -103,3 +103,11 @@ def test_report_section_quick(tmp_path):
     data = json.loads((tmp_path / "report.json").read_text())["sections"]["trajectory"]
     assert len(data["table17"]) == 2
     assert data["methods"]["LVQ (thesis)"]["mean"] < data["methods"]["distance ÷ speed"]["mean"]
+
+
+def test_dataflash_without_mission(shared_data):
+    log = read_flight(shared_data / "logs/ardupilot_log171.bin")
+    assert log.t.size > 1000 and np.all(np.diff(log.t) > 0)
+    assert -35.4 < np.median(log.lat) < -35.3  # CMAC, Canberra
+    with pytest.raises(InputError, match="no mission waypoints"):
+        flown_runs(log)

@@ -186,14 +186,17 @@ def read_dataflash(path: str | Path) -> FlightLog:
     wind = []
     pat = re.compile(r"Reached (?:command|waypoint) #(\d+)")
     while True:
-        m = conn.recv_match(type=["GPS", "CMD", "MSG", "XKF2", "NKF2"])
+        m = conn.recv_match(type=["GPS", "CMD", "MSG", "XKF2", "NKF2", "EKF2"])
         if m is None:
             break
         kind = m.get_type()
-        tu = getattr(m, "TimeUS", None)
-        if tu is None:
+        # Copter ≥ 3.4 logs TimeUS; older logs (3.3) TimeMS.
+        if hasattr(m, "TimeUS"):
+            ts = m.TimeUS * 1e-6
+        elif hasattr(m, "TimeMS"):
+            ts = m.TimeMS * 1e-3
+        else:
             continue
-        ts = tu * 1e-6
         if kind == "GPS" and getattr(m, "Status", 3) >= 3:
             crs = np.radians(m.GCrs)
             t.append(ts)
@@ -207,7 +210,7 @@ def read_dataflash(path: str | Path) -> FlightLog:
             hit = pat.search(m.Message)
             if hit:
                 reached.append((ts, int(hit.group(1))))
-        elif kind in ("XKF2", "NKF2") and hasattr(m, "VWN"):
+        elif kind in ("XKF2", "NKF2", "EKF2") and hasattr(m, "VWN"):
             wind.append((m.VWN, m.VWE))
     if not t:
         raise DataFormatError("no GPS messages with a 3D fix", path=str(path))
