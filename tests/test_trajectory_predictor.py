@@ -148,3 +148,17 @@ def test_telemetry_errors():
     pos2 = np.array([[0.0, 0], [2, 0], [48, 0], [50, 0]])
     with pytest.raises(InputError, match="gaps"):
         measure_elements(plan, t2, pos2, np.zeros((4, 2)), np.zeros(2), 3.0, end_tolerance_m=0.5)
+
+
+def test_dv_target_variant_and_roundtrip(experiment, tmp_path):
+    e = {m.name: m.error_pct.mean() for m in experiment.methods}
+    assert e["LVQ on ΔV classes"] < 0.5 * e["distance ÷ speed"]
+    m = TrajectoryPredictor(target="dv", random_state=0).fit(experiment.train)
+    assert np.all(np.diff(m.labels_) > 0)
+    m.save(tmp_path / "dv.json")
+    back = TrajectoryPredictor.load(tmp_path / "dv.json")
+    plan = phantom4_plans()["A"]
+    w = wind_vector(2.78, 22.5)
+    np.testing.assert_array_equal(back.predict(plan, w).time_s, m.predict(plan, w).time_s)
+    with pytest.raises(InputError, match="target"):
+        TrajectoryPredictor(target="speed").fit(experiment.train)

@@ -130,6 +130,9 @@ def evaluate_methods(
             percent_error(t, test.t_real_s),
         )
     ]
+    lvq_dv = TrajectoryPredictor(random_state=random_state, target="dv").fit(train)
+    t = lvq_dv.element_times(test.features, test.length_m, test.v_ref_ms)
+    out.append(MethodResult("LVQ on ΔV classes", t, percent_error(t, test.t_real_s)))
     for name, factor in (("distance ÷ speed", 1.0), ("distance ÷ 0.8·speed", 0.8)):
         t = distance_over_speed(test.length_m, test.v_ref_ms, factor)
         out.append(MethodResult(name, t, percent_error(t, test.t_real_s)))

@@ -93,6 +93,12 @@ class TrajectoryPredictor:
         Segment length L (m), 10.
     n_prototypes, algorithm, learning_rate, lr_decay, max_iter, random_state
         Passed to :class:`LVQClassifier` (S¹ = 256, LVQ1, 0.01 as in the thesis/MATLAB).
+    target : {"cell", "dv"}
+        The network's target classes: the thesis' 4×8×4 feature cells (each carrying its mean
+        ΔV), or ΔV itself quantised in bins of ``dv_bin_ms`` (the network then learns which
+        features lead to which speed change, and may merge or split cells).
+    dv_bin_ms : float
+        ΔV bin width for ``target="dv"`` (m/s).
 
     Attributes (after fit)
     ----------------------
@@ -112,7 +118,11 @@ class TrajectoryPredictor:
         lr_decay: str = "none",
         max_iter: int | None = None,
         random_state: int = 0,
+        target: str = "cell",
+        dv_bin_ms: float = 0.1,
     ) -> None:
+        self.target = target
+        self.dv_bin_ms = dv_bin_ms
         self.segment_m = segment_m
         self.n_prototypes = n_prototypes
         self.algorithm = algorithm
@@ -135,7 +145,17 @@ class TrajectoryPredictor:
         with np.errstate(invalid="ignore", divide="ignore"):
             self.dv_table_ = np.where(self.count_table_ > 0, sums / np.maximum(self.count_table_, 1), np.nan)
         self.dv_global_ = float(samples.dv_ms.mean())
-        populated = np.flatnonzero(self.count_table_)
+        if self.target not in ("cell", "dv"):
+            raise InputError(f"target must be 'cell' or 'dv', got {self.target!r}")
+        if self.target == "dv":
+            if not (np.isfinite(self.dv_bin_ms) and self.dv_bin_ms > 0):
+                raise InputError(f"dv_bin_ms must be > 0, got {self.dv_bin_ms}")
+            y = np.rint(samples.dv_ms / self.dv_bin_ms).astype(int)
+        else:
+            y = cells
+        populated, inv = np.unique(y, return_inverse=True)
+        self.labels_ = populated
+        self.label_dv_ = np.bincount(inv, weights=samples.dv_ms) / np.bincount(inv)
         if populated.size >= 2:
             self.lvq_: LVQClassifier | None = LVQClassifier(
                 n_prototypes=max(int(self.n_prototypes), populated.size),
@@ -144,7 +164,7 @@ class TrajectoryPredictor:
                 lr_decay=self.lr_decay,
                 max_iter=self.max_iter,
                 random_state=self.random_state,
-            ).fit(samples.features.matrix(), cells)
+            ).fit(samples.features.matrix(), y)
         else:
             self.lvq_ = None
             self.single_cell_ = int(populated[0])
@@ -159,7 +179,8 @@ class TrajectoryPredictor:
 
     # -- prediction ----------------------------------------------------------------------
     def classify(self, f: Features) -> tuple[np.ndarray, np.ndarray]:
-        """(own cell, network cell) of each element, vectorised."""
+        """(own cell, network class) of each element, vectorised (the class is a cell or, with
+        ``target="dv"``, a ΔV bin index)."""
         self._check_fitted()
         cell = cell_index(f)
         if self.lvq_ is None:
@@ -169,7 +190,7 @@ class TrajectoryPredictor:
     def predict_dv(self, f: Features) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """ΔV (m/s) of elements with features ``f``: (dv, own cell, network cell)."""
         cell, used = self.classify(f)
-        return self.dv_table_[used], cell, used
+        return self.label_dv_[np.searchsorted(self.labels_, used)], cell, used
 
     def element_times(self, f: Features, length_m: np.ndarray, v_ref_ms: float | np.ndarray) -> np.ndarray:
         """Eq. (47) for many elements at once: t = L/(V_ref + ΔV), s (clamped at MIN_SPEED_MS)."""
@@ -202,8 +223,10 @@ class TrajectoryPredictor:
         flags: list[list[str]] = []
         for i in range(len(el)):
             r = []
-            if used[i] != cell[i]:
+            if self.target == "cell" and used[i] != cell[i]:
                 r.append(f"no training data in class {int(cell[i])}: nearest populated class {int(used[i])}")
+            elif self.target == "dv" and self.count_table_[cell[i]] == 0:
+                r.append(f"no training data in class {int(cell[i])}: ΔV from the nearest prototype")
             if f.wind_ms[i] > WIND_MAX_MS:
                 r.append(f"wind {f.wind_ms[i]:.1f} m/s above the highest wind class ({WIND_MAX_MS} m/s)")
             elif f.wind_ms[i] > hi + 1.25 or f.wind_ms[i] < lo - 1.25:
@@ -259,7 +282,10 @@ class TrajectoryPredictor:
                 "lr_decay": self.lr_decay,
                 "max_iter": self.max_iter,
                 "random_state": self.random_state,
+                "target": self.target,
+                "dv_bin_ms": self.dv_bin_ms,
             },
+            "label_dv_ms": {str(int(k)): float(v) for k, v in zip(self.labels_, self.label_dv_, strict=True)},
             "cruise_ms": self.cruise_ms_,
             "wind_range_ms": list(self.wind_range_ms_),
             "n_train": self.n_train_,
@@ -292,6 +318,9 @@ class TrajectoryPredictor:
             self.wind_range_ms_ = (float(d["wind_range_ms"][0]), float(d["wind_range_ms"][1]))
             self.n_train_ = int(d["n_train"])
             self.dv_global_ = float(d["dv_global_ms"])
+            lab = sorted((int(k), float(v)) for k, v in d["label_dv_ms"].items())
+            self.labels_ = np.array([k for k, _ in lab], dtype=int)
+            self.label_dv_ = np.array([v for _, v in lab])
             self.dv_table_ = np.full(_N_TABLE, np.nan)
             self.count_table_ = np.zeros(_N_TABLE, dtype=int)
             for k, v in d["dv_table_ms"].items():
@@ -310,7 +339,7 @@ class TrajectoryPredictor:
                 self.single_cell_ = int(d["single_cell"])
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise DataFormatError(f"malformed model: {exc!r}", path=source) from None
-        if self.lvq_ is not None and np.isnan(self.dv_table_[self.lvq_.classes_]).any():
+        if self.lvq_ is not None and not np.isin(self.lvq_.classes_, self.labels_).all():
             raise DataFormatError("model class without a ΔV entry", path=source)
         return self
 
