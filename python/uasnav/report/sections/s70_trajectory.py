@@ -49,7 +49,7 @@ def build(w: SectionWriter) -> None:
         el = discretise(plan)
         piece = table17_piece(plan)
         ax.plot(el.mid_ne[piece, 1], el.mid_ne[piece, 0], "s", color="C3", ms=4)
-        ax.annotate(f"trajectory {name}", plan[0, ::-1], fontsize=8)
+        ax.annotate(f"trajectory {name}", plan[1, ::-1], fontsize=8)
     ax.annotate(
         "",
         xy=(-20, -20),
