@@ -162,3 +162,17 @@ def test_dv_target_variant_and_roundtrip(experiment, tmp_path):
     np.testing.assert_array_equal(back.predict(plan, w).time_s, m.predict(plan, w).time_s)
     with pytest.raises(InputError, match="target"):
         TrajectoryPredictor(target="speed").fit(experiment.train)
+
+
+def test_gap_drops_elements_with_a_warning():
+    from uasnav.trajectory.samples import TelemetryGapWarning
+
+    plan = np.array([[0.0, 0.0], [100.0, 0.0]])
+    tel = simulate_flight(plan, seed=3)
+    keep = (tel.t < 10.0) | (tel.t > 18.0)  # an 8 s hole in the middle of the leg
+    with pytest.warns(TelemetryGapWarning, match="not measured"):
+        _, s = measure_elements(plan, tel.t[keep], tel.pos_ne[keep], tel.vel_ne[keep], tel.wind_ne, 3.33)
+    _, full = measure_elements(plan, tel.t, tel.pos_ne, tel.vel_ne, tel.wind_ne, 3.33)
+    assert 0 < len(s) < len(full)
+    # The elements that were measured agree with the gap-free measurement.
+    np.testing.assert_allclose(s.t_real_s, full.t_real_s[s.element], rtol=0.02)

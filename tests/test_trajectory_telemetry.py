@@ -111,3 +111,74 @@ def test_dataflash_without_mission(shared_data):
     assert -35.4 < np.median(log.lat) < -35.3  # CMAC, Canberra
     with pytest.raises(InputError, match="no mission waypoints"):
         flown_runs(log)
+
+
+def test_cli_csv_flight_with_plan(tmp_path):
+    import pymap3d
+
+    from uasnav.trajectory.simulator import phantom4_plans, simulate_flight
+
+    plan = phantom4_plans()["A"]
+    lat0, lon0, h0 = 40.85, 14.27, 12.0
+    tel = simulate_flight(plan, seed=5)
+    lat, lon, h = pymap3d.ned2geodetic(tel.pos_ne[:, 0], tel.pos_ne[:, 1], 0 * tel.t, lat0, lon0, h0)
+    flight = tmp_path / "f.csv"
+    rows = ["t,lat,lon,alt,v_N,v_E,v_D"] + [
+        f"{a},{b:.9f},{c:.9f},{d:.3f},{e},{f},0"
+        for a, b, c, d, e, f in zip(tel.t, lat, lon, h, *tel.vel_ne.T, strict=True)
+    ]
+    flight.write_text("\n".join(rows) + "\n")
+    plat, plon, ph = pymap3d.ned2geodetic(plan[:, 0], plan[:, 1], 0 * plan[:, 0], lat0, lon0, h0)
+    plan_csv = tmp_path / "plan.csv"
+    plan_csv.write_text(
+        "lat,lon,alt\n"
+        + "".join(f"{a:.9f},{b:.9f},{c:.3f}\n" for a, b, c in zip(plat, plon, ph, strict=True))
+    )
+    model = tmp_path / "m.json"
+    args = [
+        "trajectory",
+        "train",
+        str(flight),
+        "--plan",
+        str(plan_csv),
+        "--speed",
+        "3.33",
+        "--wind",
+        "2.78@22.5",
+    ]
+    r = CliRunner().invoke(main, [*args, "--out", str(model), "--json"])
+    assert r.exit_code == 0, r.output
+    from uasnav.trajectory.geometry import discretise
+
+    assert json.loads(r.output)["n_elements"] == len(discretise(plan)) == 9
+    r = CliRunner().invoke(
+        main,
+        [
+            "trajectory",
+            "predict",
+            "--model",
+            str(model),
+            "--plan",
+            str(plan_csv),
+            "--wind",
+            "2.78@22.5",
+            "--json",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    # Predicting the very flight it was trained on: the 4D times of the interior waypoints are
+    # those at which the flown track passed them, within 2 %.
+    from uasnav.trajectory.geometry import arc_length_along
+    from uasnav.trajectory.samples import crossing_times
+
+    s_wp = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(plan, axis=0).T))])
+    flown = crossing_times(tel.t, arc_length_along(plan, tel.pos_ne), s_wp[1:-1])
+    np.testing.assert_allclose(out["waypoint_times_s"][1:-1], flown, rtol=0.02)
+    # The ETA is to the end of the last element (the waypoint); the simulated vehicle then
+    # settles onto it for a few seconds more.
+    assert tel.t[-1] - 8.0 < out["eta_s"] < tel.t[-1]
+    assert not any(e["low_confidence"] for e in out["elements"])
+    # No --plan for a CSV flight: a clear error.
+    r = CliRunner().invoke(main, ["trajectory", "train", str(flight), "--out", str(model)])
+    assert r.exit_code == 1 and "give --plan" in r.output

@@ -82,13 +82,13 @@ def check_plan(plan_ne: np.ndarray, min_leg_m: float = 0.0) -> np.ndarray:
     if np.any(legs < 1e-6):
         i = int(np.flatnonzero(legs < 1e-6)[0])
         raise InputError(f"plan waypoints {i} and {i + 1} coincide (repeated waypoint)")
-    if np.any(legs < min_leg_m):
-        i = int(np.flatnonzero(legs < min_leg_m)[0])
+    if np.any(legs < min_leg_m - 1e-3):
+        i = int(np.flatnonzero(legs < min_leg_m - 1e-3)[0])
         raise InputError(
             f"plan leg {i} (waypoints {i}→{i + 1}) is {legs[i]:.2f} m, shorter than the segment "
             f"length L = {min_leg_m:g} m"
         )
-    if min_leg_m > 0 and legs.sum() < 2 * min_leg_m - 1e-9:
+    if min_leg_m > 0 and legs.sum() < 2 * min_leg_m - 1e-3:
         raise InputError(
             f"plan is {legs.sum():.2f} m long: fewer than two segments of L = {min_leg_m:g} m (one element)"
         )
@@ -202,7 +202,7 @@ def discretise(plan_ne: np.ndarray, segment_m: float = DEFAULT_SEGMENT_M) -> Ele
         after = legs[k] if k == n_wp - 2 else legs[k] / 2.0
         a = min(segment_m, before)
         b = min(segment_m, after)
-        corners.append((cum[k] - a, cum[k], cum[k] + b, a < segment_m - 1e-9 or b < segment_m - 1e-9))
+        corners.append((cum[k] - a, cum[k], cum[k] + b, a < segment_m - 1e-3 or b < segment_m - 1e-3))
     # Straight stretches between corners (and the plan ends) → pieces of 2 L.
     pieces: list[tuple[float, float, float, str, bool]] = []
     edges = [(0.0, 0.0)] + [(c[0], c[2]) for c in corners] + [(total, total)]
@@ -211,10 +211,12 @@ def discretise(plan_ne: np.ndarray, segment_m: float = DEFAULT_SEGMENT_M) -> Ele
         s1 = edges[j + 1][0]
         stretch = []
         s = s0
-        while s1 - s > 1e-9:
+        # Comparisons carry a 1 mm tolerance so that plans of round lengths give the same
+        # elements after a geodetic round trip (floating-point noise of ~1e-5 m).
+        while s1 - s > 1e-3:
             e = min(s + 2 * segment_m, s1)
             # Do not leave a sliver shorter than L/2 at the end of a stretch: merge it.
-            if s1 - e <= 0.5 * segment_m + 1e-9 and e < s1:
+            if s1 - e <= 0.5 * segment_m + 1e-3 and e < s1:
                 e = s1
             stretch.append((s, (s + e) / 2.0, e, "straight", False))
             s = e

@@ -13,6 +13,7 @@ too (``v_init_ms``).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,6 +21,10 @@ import numpy as np
 from uasnav.errors import InputError
 from uasnav.trajectory.features import Features, cell_index, features
 from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, Elements, arc_length_along, discretise
+
+
+class TelemetryGapWarning(UserWarning):
+    """Elements were left out of the measured samples because telemetry had a gap inside them."""
 
 
 @dataclass
@@ -176,16 +181,25 @@ def measure_elements(
     t0 = crossing_times(t, s, el.s_start_m)
     t1 = crossing_times(t, s, s_end)
     dt = t1 - t0
-    # Largest telemetry gap inside each element.
-    gap = np.array(
-        [
-            np.diff(t[(t >= a) & (t <= b)], prepend=a, append=b).max() if b > a else np.inf
-            for a, b in zip(t0, t1, strict=False)
-        ]
-    )
+    # Largest telemetry gap over the samples bracketing each element (an element inside a hole
+    # has interpolated, not measured, times).
+    gap = np.full(dt.shape, np.inf)
+    for k, (a, b) in enumerate(zip(t0, t1, strict=True)):
+        if np.isfinite(a) and np.isfinite(b) and b > a:
+            i0 = max(int(np.searchsorted(t, a, side="right")) - 1, 0)
+            i1 = min(int(np.searchsorted(t, b, side="left")), t.size - 1)
+            gap[k] = np.diff(t[i0 : i1 + 1]).max() if i1 > i0 else 0.0
     ok = np.isfinite(dt) & (dt > 0) & (gap <= max_gap_s)
     if not ok.any():
         raise InputError(f"flight {flight}: no element measurable (telemetry gaps > {max_gap_s} s?)")
+    if not ok.all():
+        bad = np.flatnonzero(~ok)
+        warnings.warn(
+            f"flight {flight}: element(s) {bad.tolist()} not measured (telemetry gap > {max_gap_s} s "
+            "inside the element)",
+            TelemetryGapWarning,
+            stacklevel=2,
+        )
     length = s_end - el.s_start_m
     speed = np.hypot(vel[:, 0], vel[:, 1])
     v_init = np.interp(t0, t, speed)
@@ -204,4 +218,4 @@ def measure_elements(
     return el, samples
 
 
-__all__ = ["ElementSamples", "crossing_times", "measure_elements"]
+__all__ = ["ElementSamples", "TelemetryGapWarning", "crossing_times", "measure_elements"]
