@@ -176,3 +176,12 @@ def test_gap_drops_elements_with_a_warning():
     assert 0 < len(s) < len(full)
     # The elements that were measured agree with the gap-free measurement.
     np.testing.assert_allclose(s.t_real_s, full.t_real_s[s.element], rtol=0.02)
+
+
+def test_lvq_fallback_beats_cell_table_on_unseen_trajectory(experiment):
+    from uasnav.trajectory.experiment import cross_trajectory
+
+    for res in cross_trajectory(experiment).values():
+        e = {m.name: m.error_pct.mean() for m in res}
+        assert e["LVQ (thesis)"] < e["per-cell mean ΔV"]
+        assert e["LVQ (thesis)"] < 0.5 * e["distance ÷ speed"]
