@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from uasnav.errors import InputError
 from uasnav.trajectory.features import cell_centre, cell_index, features, fold, wind_vector
@@ -109,3 +111,32 @@ def test_arc_length_follows_crossing_legs():
     pos = np.array([[0.0, 5], [0.5, 20], [0, 35], [10, 40], [20, 30], [10, 20], [0, 20]])
     s = arc_length_along(plan, pos)
     np.testing.assert_allclose(s, [5, 20, 35, 50, 70, 90, 100], atol=0.6)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    headings=st.lists(st.floats(0, 360), min_size=2, max_size=5),
+    legs=st.lists(st.floats(25, 80), min_size=5, max_size=5),
+    wind_speed=st.floats(0, 11),
+    wind_from=st.floats(0, 360),
+)
+def test_mirror_image_plan_has_identical_folded_features(headings, legs, wind_speed, wind_from):
+    # Reflecting a whole plan and the wind about the north axis (east → −east) must give the
+    # same folded features and cells (Figure 53), element by element.
+    pts = [np.zeros(2)]
+    for h, length in zip(headings, legs, strict=False):
+        pts.append(pts[-1] + length * np.array([np.cos(np.radians(h)), np.sin(np.radians(h))]))
+    plan = np.array(pts)
+    legs_len = np.hypot(*np.diff(plan, axis=0).T)
+    assume(np.all(legs_len > 20))
+    mirror = plan * [1.0, -1.0]
+    w = wind_vector(wind_speed, wind_from)
+    a = discretise(plan)
+    b = discretise(mirror)
+    fa = features(a.heading1_deg, a.turn_deg, a.kind, w)
+    fb = features(b.heading1_deg, b.turn_deg, b.kind, w * [1.0, -1.0])
+    np.testing.assert_allclose(fa.theta_deg, fb.theta_deg, atol=1e-6)
+    # θ_w agrees on the circle (0° and 360° are the same direction)
+    d = np.mod(fa.theta_w_deg - fb.theta_w_deg + 180.0, 360.0) - 180.0
+    np.testing.assert_allclose(d, 0.0, atol=1e-6)
+    np.testing.assert_allclose(fa.matrix(), fb.matrix(), atol=1e-6)
