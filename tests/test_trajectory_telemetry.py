@@ -85,6 +85,16 @@ def test_cli_train_predict_evaluate(shared_data, tmp_path):
     assert r.exit_code == 0, r.output
     ev = json.loads(r.output)
     assert ev["n_runs"] == 5 and "distance ÷ speed" in ev["methods"]
+    # 4D feasibility: the predicted times themselves are feasible, half of them are not.
+    times = ",".join(f"{x:.3f}" for x in out["waypoint_times_s"])
+    half = ",".join(f"{x / 2:.3f}" for x in out["waypoint_times_s"])
+    base = ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "0@0", "--json"]
+    r = CliRunner().invoke(main, [*base, "--required", times, "--tolerance", "0.5"])
+    assert r.exit_code == 0 and json.loads(r.output)["feasible"] is True
+    r = CliRunner().invoke(main, [*base, "--required", half, "--tolerance", "0.5"])
+    assert r.exit_code == 0 and json.loads(r.output)["waypoint_ok"] == [True, False, False]
+    r = CliRunner().invoke(main, [*base, "--required", "0,1"])
+    assert r.exit_code == 1 and "one finite required time per waypoint" in r.output
     # bad input: one-waypoint plan, bad wind syntax
     plan.write_text("north,east\n0,0\n")
     r = CliRunner().invoke(

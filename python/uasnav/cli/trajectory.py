@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from uasnav.cli._common import echo_json
+from uasnav.cli._common import echo_json, parse_float_list
 from uasnav.errors import InputError
 
 
@@ -127,9 +127,15 @@ def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, pro
 @click.option("--plan", "plan_path", required=True, type=click.Path(dir_okay=False))
 @click.option("--wind", "wind_text", required=True, help="SPEED@DIR: m/s @ degrees the wind comes from.")
 @click.option("--speed", type=float, help="Commanded speed (m/s); default the model's.")
+@click.option("--required", help="4D plan: required time (s from start) at each waypoint, T0,T1,….")
+@click.option("--tolerance", type=float, default=5.0, show_default=True, help="4D time tolerance (s).")
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def predict(model_path, plan_path, wind_text, speed, as_json):  # type: ignore[no-untyped-def]
-    """Per-element times, ETA and 4D waypoint times of PLAN (CSV lat,lon,alt or north,east)."""
+def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_json):  # type: ignore[no-untyped-def]
+    """Per-element times, ETA and 4D waypoint times of PLAN (CSV lat,lon,alt or north,east).
+
+    With --required, also checks the 4D plan's feasibility: each waypoint reached within
+    --tolerance of its required time (exit code 0 either way; see "feasible").
+    """
     from uasnav.trajectory.geometry import KINDS
     from uasnav.trajectory.plans import read_plan
     from uasnav.trajectory.predictor import TrajectoryPredictor
@@ -137,6 +143,10 @@ def predict(model_path, plan_path, wind_text, speed, as_json):  # type: ignore[n
     model = TrajectoryPredictor.load(model_path)
     plan_ne, _ = read_plan(plan_path)
     p = model.predict(plan_ne, parse_wind(wind_text), speed)
+    feas = None
+    if required:
+        req = parse_float_list(required, "--required")
+        feas = model.feasibility(plan_ne, np.array(req), parse_wind(wind_text), tolerance, speed)
     el, f = p.elements, p.features
     rows = [
         {
@@ -155,7 +165,11 @@ def predict(model_path, plan_path, wind_text, speed, as_json):  # type: ignore[n
         for i in range(len(el))
     ]
     if as_json:
-        echo_json({"eta_s": p.eta_s, "waypoint_times_s": p.waypoint_times_s, "elements": rows})
+        out = {"eta_s": p.eta_s, "waypoint_times_s": p.waypoint_times_s, "elements": rows}
+        if feas is not None:
+            out["feasible"] = feas.feasible
+            out["waypoint_ok"] = feas.ok
+        echo_json(out)
         return
     del KINDS
     click.echo(f"{'#':>3} {'kind':8} {'L m':>6} {'θ°':>6} {'θw°':>6} {'ΔV m/s':>7} {'t s':>7}")
