@@ -90,10 +90,52 @@ def bench_mission(n_uas: int, n_cam: int, repeat: int) -> None:
     t_loop = median_time(lambda: loop(rows), 1) * n_uas / rows
         f"mission score+rank {n_uas}x{n_cam}: uasnav {t_ours * 1e3:8.1f} ms | python loop (extrapolated "
         f"from {rows} rows) {t_loop * 1e3:8.0f} ms | speed-up {t_loop / t_ours:5.0f}x"
+def bench_trajectory(n_predict: int, n_train: int, repeat: int) -> None:
+    from sklearn.neighbors import KNeighborsClassifier
+
+    from uasnav.trajectory.features import Features, cell_index
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+    from uasnav.trajectory.samples import ElementSamples
+
+
+    def random_features(n: int) -> Features:
+        return Features(
+            theta_deg=rng.uniform(0, 180, n),
+            theta_w_deg=rng.uniform(0, 360, n),
+            wind_ms=rng.uniform(0, 11, n),
+            kind=np.zeros(n, dtype=int),
+            mirrored=np.zeros(n, dtype=bool),
+        )
+
+    f = random_features(n_train)
+    dv = -0.5 * np.sin(np.radians(f.theta_deg) / 2) + 0.05 * f.wind_ms * np.cos(np.radians(f.theta_w_deg))
+    samples = ElementSamples(
+        features=f,
+        length_m=np.full(n_train, 20.0),
+        t_real_s=20.0 / (3.33 + dv),
+        v_init_ms=np.full(n_train, 3.33),
+        v_ref_ms=np.full(n_train, 3.33),
+        dv_ms=dv,
+        flight=np.zeros(n_train, dtype=int),
+        element=np.arange(n_train),
+    t_fit = median_time(lambda: TrajectoryPredictor(random_state=0).fit(samples), repeat)
+    model = TrajectoryPredictor(random_state=0).fit(samples)
+    g = random_features(n_predict)
+    length = np.full(n_predict, 20.0)
+    t_pred = median_time(lambda: model.element_times(g, length, 3.33), repeat)
+    acc = float(np.mean(model.lvq_.predict(g.matrix()) == cell_index(g)))
+    # Peer: a 1-nearest-neighbour classifier on the same prototypes (what LVQ prediction is).
+    knn = KNeighborsClassifier(n_neighbors=1).fit(model.lvq_.prototypes_, model.lvq_.prototype_labels_)
+    X = g.matrix()
+    t_knn = median_time(lambda: knn.predict(X), repeat)
+        f"trajectory LVQ fit n={n_train:.0e} (256 prototypes, 1 epoch LVQ1): {t_fit:6.2f} s | "
+        f"predict n={n_predict:.0e} elements: uasnav {t_pred * 1e3:7.1f} ms, sklearn 1-NN on the same "
+        f"prototypes {t_knn * 1e3:7.1f} ms (ratio {t_knn / t_pred:4.1f}x) | cell accuracy {acc:.3f}"
     )
 
 
 CASES: dict[str, Callable[[bool], None]] = {
+    "trajectory": lambda quick: bench_trajectory(10**5 if quick else 10**6, 10**4 if quick else 10**5, 3),
     "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
     "sim": lambda quick: bench_sim(10**6 if quick else 10**7, 3),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),

@@ -1,0 +1,259 @@
+"""``uasnav trajectory``: train, predict and evaluate LVQ element-time models (thesis §5.1)."""
+
+from __future__ import annotations
+
+import click
+import numpy as np
+
+from uasnav.cli._common import echo_json, parse_float_list
+from uasnav.errors import InputError
+
+
+def parse_wind(text: str) -> np.ndarray:
+    """``SPEED@DIR`` → wind velocity (north, east) m/s; DIR is where the wind comes *from* (deg)."""
+    from uasnav.trajectory.features import wind_vector
+
+    try:
+        speed, direction = (float(x) for x in text.split("@"))
+    except ValueError:
+        raise InputError(
+            f"--wind must be SPEED@DIR (m/s @ deg from north, wind from), got {text!r}"
+        ) from None
+    return wind_vector(speed, direction)
+
+
+def _flight_samples(paths, plan, speed, wind, segment, max_gap):  # type: ignore[no-untyped-def]
+    """Element samples of every mission run of every flight file (run index across files)."""
+    from uasnav.trajectory.geometry import geodetic_to_local
+    from uasnav.trajectory.plans import read_plan
+    from uasnav.trajectory.samples import ElementSamples, measure_elements
+    from uasnav.trajectory.telemetry import read_flight, run_samples
+
+    runs_all, samples_all = [], []
+    for path in paths:
+        log = read_flight(path)
+        if log.waypoints:
+            runs, samples = run_samples(log, segment, speed, wind, max_gap_s=max_gap)
+        else:
+            if plan is None:
+                raise InputError(f"{path}: no mission waypoints in the log; give --plan")
+            plan_ne, origin = read_plan(plan)
+            if origin is None:
+                raise InputError("--plan for telemetry must be geodetic (lat,lon,alt)")
+            if speed is None:
+                raise InputError(f"{path}: no waypoint speed in the log; give --speed")
+            pos = geodetic_to_local(log.lat, log.lon, log.alt, origin=origin)[:, :2]
+            w = wind if wind is not None else (log.wind_ne if log.wind_ne is not None else np.zeros(2))
+            _, s = measure_elements(
+                plan_ne, log.t, pos, log.vel_ned[:, :2], w, speed, segment, max_gap_s=max_gap
+            )
+            runs, samples = [None], [s]
+        for r, s in zip(runs, samples, strict=True):
+            k = len(samples_all)
+            s.flight[:] = k
+            runs_all.append((path, r))
+            samples_all.append(s)
+    return runs_all, samples_all, ElementSamples
+
+
+@click.group("trajectory")
+def command() -> None:
+    """Trajectory prediction with LVQ networks: element times, ETA and 4D waypoint times."""
+
+
+_common_opts = [
+    click.option(
+        "--plan", type=click.Path(dir_okay=False), help="Plan CSV (lat,lon,alt) for logs without a mission."
+    ),
+    click.option("--speed", type=float, help="Commanded speed (m/s); default from the log (WPNAV_SPEED …)."),
+    click.option(
+        "--wind", "wind_text", help="Wind SPEED@DIR (m/s, deg wind comes from); default the log's or calm."
+    ),
+    click.option("--segment", type=float, default=10.0, show_default=True, help="Segment length L (m)."),
+    click.option(
+        "--max-gap",
+        type=float,
+        default=5.0,
+        show_default=True,
+        help="Largest telemetry gap in an element (s).",
+    ),
+]
+
+
+def _apply(opts):  # type: ignore[no-untyped-def]
+    def deco(f):  # type: ignore[no-untyped-def]
+        for o in reversed(opts):
+            f = o(f)
+        return f
+
+    return deco
+
+
+@command.command("train")
+@click.argument("flights", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Model JSON to write.")
+@_apply(_common_opts)
+@click.option("--algorithm", type=click.Choice(["lvq1", "lvq2.1", "glvq"]), default="lvq1", show_default=True)
+@click.option("--prototypes", type=int, default=256, show_default=True, help="Competitive neurons S¹.")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, prototypes, seed, as_json):  # type: ignore[no-untyped-def]
+    """Train a model on the flown elements of FLIGHT... (.tlog, .bin, .ulg, .csv) and write it."""
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+
+    wind = parse_wind(wind_text) if wind_text else None
+    _, samples, es = _flight_samples(flights, plan, speed, wind, segment, max_gap)
+    all_s = es.concat(samples)
+    model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
+    model.save(out)
+    info = {
+        "model": out,
+        "n_runs": len(samples),
+        "n_elements": len(all_s),
+        "n_classes": int((model.count_table_ > 0).sum()),
+        "cruise_ms": model.cruise_ms_,
+    }
+    if as_json:
+        echo_json(info)
+    else:
+        click.echo(
+            f"trained on {info['n_elements']} elements of {info['n_runs']} run(s), "
+            f"{info['n_classes']} populated classes → {out}"
+        )
+
+
+@command.command("predict")
+@click.option("--model", "model_path", required=True, type=click.Path(dir_okay=False))
+@click.option("--plan", "plan_path", required=True, type=click.Path(dir_okay=False))
+@click.option("--wind", "wind_text", required=True, help="SPEED@DIR: m/s @ degrees the wind comes from.")
+@click.option("--speed", type=float, help="Commanded speed (m/s); default the model's.")
+@click.option("--required", help="4D plan: required time (s from start) at each waypoint, T0,T1,….")
+@click.option("--tolerance", type=float, default=5.0, show_default=True, help="4D time tolerance (s).")
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_json):  # type: ignore[no-untyped-def]
+    """Per-element times, ETA and 4D waypoint times of PLAN (CSV lat,lon,alt or north,east).
+
+    With --required, also checks the 4D plan's feasibility: each waypoint reached within
+    --tolerance of its required time (exit code 0 either way; see "feasible").
+    """
+    from uasnav.trajectory.geometry import KINDS
+    from uasnav.trajectory.plans import read_plan
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+
+    model = TrajectoryPredictor.load(model_path)
+    plan_ne, _ = read_plan(plan_path)
+    p = model.predict(plan_ne, parse_wind(wind_text), speed)
+    feas = None
+    if required:
+        req = parse_float_list(required, "--required")
+        feas = model.feasibility(plan_ne, np.array(req), parse_wind(wind_text), tolerance, speed)
+    el, f = p.elements, p.features
+    rows = [
+        {
+            "element": i,
+            "kind": str(el.kind[i]),
+            "length_m": float(el.length_m[i]),
+            "theta_deg": float(f.theta_deg[i]),
+            "theta_w_deg": float(f.theta_w_deg[i]),
+            "wind_ms": float(f.wind_ms[i]),
+            "class": int(p.cell_used[i]),
+            "dv_ms": float(p.dv_ms[i]),
+            "time_s": float(p.time_s[i]),
+            "low_confidence": bool(p.flags[i]),
+            "flags": p.flags[i],
+        }
+        for i in range(len(el))
+    ]
+    if as_json:
+        out = {"eta_s": p.eta_s, "waypoint_times_s": p.waypoint_times_s, "elements": rows}
+        if feas is not None:
+            out["feasible"] = feas.feasible
+            out["waypoint_ok"] = feas.ok
+        echo_json(out)
+        return
+    del KINDS
+    click.echo(f"{'#':>3} {'kind':8} {'L m':>6} {'θ°':>6} {'θw°':>6} {'ΔV m/s':>7} {'t s':>7}")
+    for r in rows:
+        mark = "  *low confidence: " + "; ".join(r["flags"]) if r["flags"] else ""
+        click.echo(
+            f"{r['element']:>3} {r['kind']:8} {r['length_m']:6.1f} {r['theta_deg']:6.1f} "
+            f"{r['theta_w_deg']:6.1f} {r['dv_ms']:7.2f} {r['time_s']:7.2f}{mark}"
+        )
+    click.echo(
+        f"ETA {p.eta_s:.1f} s; waypoint times (s): " + ", ".join(f"{x:.1f}" for x in p.waypoint_times_s)
+    )
+
+
+@command.command("evaluate")
+@click.argument("flights", nargs=-1, type=click.Path(dir_okay=False))
+@_apply(_common_opts)
+@click.option("--simulated", is_flag=True, help="Run the simulated Phantom-4 experiment (Table 17) instead.")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed, as_json):  # type: ignore[no-untyped-def]
+    """e% (eq. 59) per element and per run of LVQ vs the baselines.
+
+    Real FLIGHT...: leave-one-run-out (each mission run predicted by a model trained on the
+    others). --simulated: the thesis' experiment, 7 flights per trajectory train, 3 test.
+    """
+    from uasnav.trajectory.baselines import evaluate_methods, kinematic_times
+    from uasnav.trajectory.geometry import discretise
+
+    if simulated:
+        from uasnav.trajectory.experiment import run_phantom4
+
+        r = run_phantom4(seed=seed)
+        table = {
+            m.name: {
+                "element_e_pct_mean": float(m.error_pct.mean()),
+                "element_e_pct_max": float(m.error_pct.max()),
+            }
+            for m in r.methods
+        }
+        t17 = [{"piece": n, "t_nn_s": t, "t_real_s": reals} for n, t, reals in r.table17]
+        out = {"methods": table, "table17": t17, "n_train": len(r.train), "n_test": len(r.test)}
+    else:
+        if not flights:
+            raise click.UsageError("give FLIGHT files or --simulated")
+        wind = parse_wind(wind_text) if wind_text else None
+        runs, samples, es = _flight_samples(flights, plan, speed, wind, segment, max_gap)
+        if len(samples) < 2:
+            raise InputError("leave-one-run-out needs at least two mission runs")
+        per: dict[str, dict[str, list[float]]] = {}
+        for k, test in enumerate(samples):
+            train = es.concat([s for i, s in enumerate(samples) if i != k])
+            _, run = runs[k]
+            kin = None
+            if run is not None:
+                el = discretise(run.plan_ne, segment)
+                kin = kinematic_times(
+                    run.plan_ne,
+                    el.s_start_m[test.element],
+                    el.s_start_m[test.element] + test.length_m,
+                    test.v_ref_ms[0],
+                )
+            for m in evaluate_methods(train, test, kinematic_s=kin, random_state=seed):
+                d = per.setdefault(m.name, {"element": [], "run": []})
+                d["element"] += m.error_pct.tolist()
+                d["run"].append(abs(m.time_s.sum() - test.t_real_s.sum()) / test.t_real_s.sum() * 100)
+        table = {
+            n: {
+                "element_e_pct_mean": float(np.mean(d["element"])),
+                "element_e_pct_median": float(np.median(d["element"])),
+                "run_e_pct_mean": float(np.mean(d["run"])),
+                "run_e_pct": d["run"],
+            }
+            for n, d in per.items()
+        }
+        out = {"methods": table, "n_runs": len(samples), "n_elements": int(sum(len(s) for s in samples))}
+    if as_json:
+        echo_json(out)
+        return
+    for name, d in out["methods"].items():
+        extra = f"  run e% {d['run_e_pct_mean']:6.2f}" if "run_e_pct_mean" in d else ""
+        click.echo(f"{name:24s} element e% mean {d['element_e_pct_mean']:6.2f}{extra}")
+    for row in out.get("table17", []):
+        click.echo(
+            f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
+            + ", ".join(f"{x:.2f}" for x in row["t_real_s"])
+        )

@@ -1,0 +1,1 @@
+"""Trajectory prediction for small UAS with LVQ networks (thesis §5.1)."""

@@ -1,0 +1,162 @@
+"""Baselines the LVQ predictor must beat, and a common evaluation (e%, eq. 59).
+
+* distance ÷ speed: what ground stations print (QGroundControl uses the hover/cruise speed;
+  Mission Planner's survey tool 0.8 × speed);
+* per-cell mean-ΔV table: the 128-cell grid without a network (empty cell → global mean);
+* regression on the same features: k-nearest neighbours and gradient boosting (scikit-learn);
+* kinematic point mass: a speed profile along the plan with acceleration from rest, braking
+  to a corner speed V·cos(θ/2) and to a stop at the end, no wind.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from uasnav.trajectory.geometry import plan_length
+from uasnav.trajectory.samples import ElementSamples
+
+
+def percent_error(t_pred: np.ndarray, t_real: np.ndarray) -> np.ndarray:
+    """e% = |t_pred − t_real| / t_real · 100 (eq. 59)."""
+    return np.abs(np.asarray(t_pred) - np.asarray(t_real)) / np.asarray(t_real) * 100.0
+
+
+def distance_over_speed(length_m: np.ndarray, speed_ms: np.ndarray, factor: float = 1.0) -> np.ndarray:
+    """t = L / (factor · V) (s); factor 0.8 is Mission Planner's survey estimate."""
+    return np.asarray(length_m) / (factor * np.asarray(speed_ms))
+
+
+class CellMeanDV:
+    """ΔV = mean ΔV of the training elements in the element's own cell; global mean if empty."""
+
+    def fit(self, train: ElementSamples) -> CellMeanDV:
+        c = train.cell
+        n = np.bincount(c, minlength=384)
+        s = np.bincount(c, weights=train.dv_ms, minlength=384)
+        self.table_ = np.where(n > 0, s / np.maximum(n, 1), train.dv_ms.mean())
+        return self
+
+    def predict_dv(self, test: ElementSamples) -> np.ndarray:
+        return self.table_[test.cell]
+
+
+class RegressorDV:
+    """A scikit-learn regressor of ΔV on the network's input features."""
+
+    def __init__(self, kind: str = "knn", random_state: int = 0) -> None:
+        self.kind = kind
+        self.random_state = random_state
+
+    def fit(self, train: ElementSamples) -> RegressorDV:
+        from sklearn.ensemble import GradientBoostingRegressor
+        from sklearn.neighbors import KNeighborsRegressor
+
+        if self.kind == "knn":
+            self.model_ = KNeighborsRegressor(n_neighbors=min(5, len(train)))
+        else:
+            self.model_ = GradientBoostingRegressor(
+                n_estimators=100, max_depth=2, learning_rate=0.1, random_state=self.random_state
+            )
+        self.model_.fit(train.features.matrix(), train.dv_ms)
+        return self
+
+    def predict_dv(self, test: ElementSamples) -> np.ndarray:
+        return np.asarray(self.model_.predict(test.features.matrix()))
+
+
+def kinematic_times(
+    plan_ne: np.ndarray,
+    s_start_m: np.ndarray,
+    s_end_m: np.ndarray,
+    cruise_ms: float,
+    accel_ms2: float = 1.0,
+    ds_m: float = 0.1,
+) -> np.ndarray:
+    """Times (s) to fly arc-length intervals [s_start, s_end] (m) of the plan for a point mass:
+    v(s) = min(V, √(2a s), √(v_k² + 2a|s − s_k|)) around each waypoint k)
+    with corner speed v_k = V·max(cos(θ_k/2), 0.1), 0 at the ends."""
+    p = np.asarray(plan_ne, dtype=float)[:, :2]
+    d = np.diff(p, axis=0)
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
+    total = plan_length(p)
+    s = np.arange(0.0, total + ds_m, ds_m)
+    s[-1] = min(s[-1], total)
+    v = np.full(s.shape, float(cruise_ms))
+    for k in range(p.shape[0]):
+        if k in (0, p.shape[0] - 1):
+            vk = 0.0
+        else:
+            c = d[k - 1] @ d[k] / (np.hypot(*d[k - 1]) * np.hypot(*d[k]))
+            theta = np.arccos(np.clip(c, -1.0, 1.0))
+            vk = cruise_ms * max(np.cos(theta / 2.0), 0.1)
+        v = np.minimum(v, np.sqrt(vk**2 + 2.0 * accel_ms2 * np.abs(s - cum[k])))
+    v = np.maximum(v, 0.05)
+    # Time to each grid point by the trapezoid rule on 1/v.
+    tau = np.concatenate([[0.0], np.cumsum(np.diff(s) * 0.5 * (1 / v[1:] + 1 / v[:-1]))])
+    return np.interp(s_end_m, s, tau) - np.interp(s_start_m, s, tau)
+
+
+@dataclass
+class MethodResult:
+    """Predicted element times (s) of one method on the test elements and their e%."""
+
+    name: str
+    time_s: np.ndarray
+    error_pct: np.ndarray
+
+
+def evaluate_methods(
+    train: ElementSamples,
+    test: ElementSamples,
+    lvq_factory: Callable[[], object] | None = None,
+    kinematic_s: np.ndarray | None = None,
+    random_state: int = 0,
+) -> list[MethodResult]:
+    """Train every method on ``train`` and predict the element times of ``test``.
+
+    ``kinematic_s`` are the point-mass times of the test elements (they need the plans; see
+    :func:`kinematic_times`). Returns one :class:`MethodResult` per method, LVQ first.
+    """
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+
+    lvq = (lvq_factory() if lvq_factory else TrajectoryPredictor(random_state=random_state)).fit(train)  # type: ignore[attr-defined]
+    out = [
+        MethodResult(
+            "LVQ (thesis)",
+            t := lvq.element_times(test.features, test.length_m, test.v_ref_ms),
+            percent_error(t, test.t_real_s),
+        )
+    ]
+    lvq_dv = TrajectoryPredictor(random_state=random_state, target="dv").fit(train)
+    t = lvq_dv.element_times(test.features, test.length_m, test.v_ref_ms)
+    out.append(MethodResult("LVQ on ΔV classes", t, percent_error(t, test.t_real_s)))
+    for name, factor in (("distance ÷ speed", 1.0), ("distance ÷ 0.8·speed", 0.8)):
+        t = distance_over_speed(test.length_m, test.v_ref_ms, factor)
+        out.append(MethodResult(name, t, percent_error(t, test.t_real_s)))
+    for name, model in (
+        ("per-cell mean ΔV", CellMeanDV()),
+        ("kNN regression", RegressorDV("knn")),
+        ("gradient boosting", RegressorDV("gbr", random_state)),
+    ):
+        dv = model.fit(train).predict_dv(test)  # type: ignore[attr-defined]
+        t = test.length_m / np.maximum(test.v_ref_ms + dv, 0.2)
+        out.append(MethodResult(name, t, percent_error(t, test.t_real_s)))
+    if kinematic_s is not None:
+        out.append(
+            MethodResult("kinematic point mass", kinematic_s, percent_error(kinematic_s, test.t_real_s))
+        )
+    return out
+
+
+__all__ = [
+    "CellMeanDV",
+    "MethodResult",
+    "RegressorDV",
+    "distance_over_speed",
+    "evaluate_methods",
+    "kinematic_times",
+    "percent_error",
+]

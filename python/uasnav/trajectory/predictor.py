@@ -1,0 +1,358 @@
+"""`TrajectoryPredictor`: LVQ classes → ΔV → element times, ETA and 4D waypoint times (§5.1.3).
+
+Training: the LVQ network learns to map element features to the 4×8×4 cells (×kind blocks) of
+the thesis; each cell's ΔV is the mean ΔV of the training elements in it. Prediction: the
+network's class gives ΔV and eq. (47) the time t = L/(V_ref + ΔV), V_ref the commanded speed.
+
+Lower-confidence predictions are flagged per element (``PlanPrediction.flags``), never hidden:
+the element's own cell had no training data (the network's nearest populated class was used),
+the wind is outside the wind classes (> 11.25 m/s) or the trained wind range, a corner element
+was shortened (leg shorter than 2 L), or the predicted speed V_ref + ΔV was not positive.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uasnav.atomicfile import atomic_write_text
+from uasnav.errors import DataFormatError, InputError
+from uasnav.trajectory.features import N_CELLS, WIND_MAX_MS, Features, cell_index, features
+from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, Elements, discretise
+from uasnav.trajectory.lvq import LVQClassifier
+from uasnav.trajectory.samples import ElementSamples
+
+MODEL_FORMAT = "uasnav-trajectory-lvq/1"
+_N_TABLE = 3 * N_CELLS
+#: Slowest speed (m/s) accepted from V_ref + ΔV before the element is flagged and clamped.
+MIN_SPEED_MS = 0.2
+
+
+@dataclass
+class PlanPrediction:
+    """Prediction for one plan.
+
+    Attributes
+    ----------
+    elements : Elements
+    features : Features
+    cell : ndarray of int, shape (m,)  — the element's own class cell.
+    cell_used : ndarray of int, shape (m,) — the network's class (its ΔV was used).
+    dv_ms : ndarray, shape (m,) — predicted ΔV (m/s).
+    time_s : ndarray, shape (m,) — predicted element times (eq. 47), s.
+    eta_s : float — sum of element times, s.
+    waypoint_times_s : ndarray, shape (n,) — predicted time at each waypoint (4D plan), s.
+    flags : list of list of str — lower-confidence reasons per element (empty = confident).
+    """
+
+    elements: Elements
+    features: Features
+    cell: np.ndarray
+    cell_used: np.ndarray
+    dv_ms: np.ndarray
+    time_s: np.ndarray
+    eta_s: float
+    waypoint_times_s: np.ndarray
+    flags: list[list[str]] = field(default_factory=list)
+
+    @property
+    def low_confidence(self) -> np.ndarray:
+        """Boolean mask of flagged elements."""
+        return np.array([bool(f) for f in self.flags], dtype=bool)
+
+
+@dataclass
+class Feasibility:
+    """Feasibility of a 4D operation plan: each waypoint's required vs predicted time (s)."""
+
+    required_s: np.ndarray
+    predicted_s: np.ndarray
+    tolerance_s: float
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Waypoints reached within the tolerance."""
+        return np.abs(self.predicted_s - self.required_s) <= self.tolerance_s
+
+    @property
+    def feasible(self) -> bool:
+        """Every waypoint reached within the tolerance."""
+        return bool(self.ok.all())
+
+
+class TrajectoryPredictor:
+    """Element-time predictor trained on flown elements (thesis §5.1).
+
+    Parameters
+    ----------
+    segment_m : float
+        Segment length L (m), 10.
+    n_prototypes, algorithm, learning_rate, lr_decay, max_iter, random_state
+        Passed to :class:`LVQClassifier` (S¹ = 256, LVQ1, 0.01 as in the thesis/MATLAB).
+    target : {"cell", "dv"}
+        The network's target classes: the thesis' 4×8×4 feature cells (each carrying its mean
+        ΔV), or ΔV itself quantised in bins of ``dv_bin_ms`` (the network then learns which
+        features lead to which speed change, and may merge or split cells).
+    dv_bin_ms : float
+        ΔV bin width for ``target="dv"`` (m/s).
+
+    Attributes (after fit)
+    ----------------------
+    lvq_ : LVQClassifier or None (None if the training data fill a single cell)
+    dv_table_ : ndarray, shape (384,) — mean ΔV per cell, NaN where no data (m/s).
+    count_table_ : ndarray of int, shape (384,)
+    cruise_ms_ : float — median commanded speed of the training flights (m/s).
+    wind_range_ms_ : (float, float) — trained wind speeds.
+    """
+
+    def __init__(
+        self,
+        segment_m: float = DEFAULT_SEGMENT_M,
+        n_prototypes: int = 256,
+        algorithm: str = "lvq1",
+        learning_rate: float = 0.01,
+        lr_decay: str = "none",
+        max_iter: int | None = None,
+        random_state: int = 0,
+        target: str = "cell",
+        dv_bin_ms: float = 0.1,
+    ) -> None:
+        self.target = target
+        self.dv_bin_ms = dv_bin_ms
+        self.segment_m = segment_m
+        self.n_prototypes = n_prototypes
+        self.algorithm = algorithm
+        self.learning_rate = learning_rate
+        self.lr_decay = lr_decay
+        self.max_iter = max_iter
+        self.random_state = random_state
+
+    # -- training ------------------------------------------------------------------------
+    def fit(self, samples: ElementSamples) -> TrajectoryPredictor:
+        """Train the network and the per-cell ΔV table on measured elements. Returns self."""
+        if len(samples) == 0:
+            raise InputError("no training elements")
+        good = np.isfinite(samples.dv_ms)
+        if not good.all():
+            raise InputError(f"{int((~good).sum())} training element(s) have a NaN ΔV")
+        cells = samples.cell
+        self.count_table_ = np.bincount(cells, minlength=_N_TABLE)
+        sums = np.bincount(cells, weights=samples.dv_ms, minlength=_N_TABLE)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            self.dv_table_ = np.where(self.count_table_ > 0, sums / np.maximum(self.count_table_, 1), np.nan)
+        self.dv_global_ = float(samples.dv_ms.mean())
+        if self.target not in ("cell", "dv"):
+            raise InputError(f"target must be 'cell' or 'dv', got {self.target!r}")
+        if self.target == "dv":
+            if not (np.isfinite(self.dv_bin_ms) and self.dv_bin_ms > 0):
+                raise InputError(f"dv_bin_ms must be > 0, got {self.dv_bin_ms}")
+            y = np.rint(samples.dv_ms / self.dv_bin_ms).astype(int)
+        else:
+            y = cells
+        populated, inv = np.unique(y, return_inverse=True)
+        self.labels_ = populated
+        self.label_dv_ = np.bincount(inv, weights=samples.dv_ms) / np.bincount(inv)
+        if populated.size >= 2:
+            self.lvq_: LVQClassifier | None = LVQClassifier(
+                n_prototypes=max(int(self.n_prototypes), populated.size),
+                algorithm=self.algorithm,
+                learning_rate=self.learning_rate,
+                lr_decay=self.lr_decay,
+                max_iter=self.max_iter,
+                random_state=self.random_state,
+            ).fit(samples.features.matrix(), y)
+        else:
+            self.lvq_ = None
+            self.single_cell_ = int(populated[0])
+        self.cruise_ms_ = float(np.median(samples.v_ref_ms))
+        self.wind_range_ms_ = (float(samples.features.wind_ms.min()), float(samples.features.wind_ms.max()))
+        self.n_train_ = len(samples)
+        return self
+
+    def _check_fitted(self) -> None:
+        if not hasattr(self, "dv_table_"):
+            raise InputError("TrajectoryPredictor is not fitted: call fit() or load a model")
+
+    # -- prediction ----------------------------------------------------------------------
+    def classify(self, f: Features) -> tuple[np.ndarray, np.ndarray]:
+        """(own cell, network class) of each element, vectorised (the class is a cell or, with
+        ``target="dv"``, a ΔV bin index)."""
+        self._check_fitted()
+        cell = cell_index(f)
+        if self.lvq_ is None:
+            return cell, np.full(cell.shape, self.single_cell_)
+        return cell, self.lvq_.predict(f.matrix()).astype(int)
+
+    def predict_dv(self, f: Features) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """ΔV (m/s) of elements with features ``f``: (dv, own cell, network cell)."""
+        cell, used = self.classify(f)
+        return self.label_dv_[np.searchsorted(self.labels_, used)], cell, used
+
+    def element_times(self, f: Features, length_m: np.ndarray, v_ref_ms: float | np.ndarray) -> np.ndarray:
+        """Eq. (47) for many elements at once: t = L/(V_ref + ΔV), s (clamped at MIN_SPEED_MS)."""
+        dv, _, _ = self.predict_dv(f)
+        return np.asarray(length_m) / np.maximum(np.asarray(v_ref_ms) + dv, MIN_SPEED_MS)
+
+    def predict(
+        self, plan_ne: np.ndarray, wind_ne: np.ndarray, cruise_ms: float | None = None
+    ) -> PlanPrediction:
+        """Predict element times, ETA and 4D waypoint times of a plan (north/east m).
+
+        Parameters
+        ----------
+        plan_ne : ndarray, shape (n, 2)
+        wind_ne : ndarray, shape (2,)
+            Wind velocity (m/s, toward); see :func:`uasnav.trajectory.features.wind_vector`.
+        cruise_ms : float, optional
+            Commanded speed; default the training flights' speed.
+        """
+        self._check_fitted()
+        v_ref = self.cruise_ms_ if cruise_ms is None else float(cruise_ms)
+        if not (np.isfinite(v_ref) and v_ref > 0):
+            raise InputError(f"cruise speed must be > 0 m/s, got {cruise_ms}")
+        el = discretise(plan_ne, self.segment_m)
+        f = features(el.heading1_deg, el.turn_deg, el.kind, wind_ne)
+        dv, cell, used = self.predict_dv(f)
+        v = v_ref + dv
+        t = el.length_m / np.maximum(v, MIN_SPEED_MS)
+        lo, hi = self.wind_range_ms_
+        flags: list[list[str]] = []
+        for i in range(len(el)):
+            r = []
+            if self.target == "cell" and used[i] != cell[i]:
+                r.append(f"no training data in class {int(cell[i])}: nearest populated class {int(used[i])}")
+            elif self.target == "dv" and self.count_table_[cell[i]] == 0:
+                r.append(f"no training data in class {int(cell[i])}: ΔV from the nearest prototype")
+            if f.wind_ms[i] > WIND_MAX_MS:
+                r.append(f"wind {f.wind_ms[i]:.1f} m/s above the highest wind class ({WIND_MAX_MS} m/s)")
+            elif f.wind_ms[i] > hi + 1.25 or f.wind_ms[i] < lo - 1.25:
+                r.append(f"wind {f.wind_ms[i]:.1f} m/s outside the trained range {lo:.1f}–{hi:.1f} m/s")
+            if el.shortened[i]:
+                r.append("corner element shortened (leg shorter than 2 L)")
+            if v[i] < MIN_SPEED_MS:
+                r.append(f"predicted speed {v[i]:.2f} m/s clamped to {MIN_SPEED_MS} m/s")
+            flags.append(r)
+        p = np.asarray(plan_ne, dtype=float)[:, :2]
+        s_wp = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+        s_knots = np.concatenate([[el.s_start_m[0]], el.s_end_m])
+        t_knots = np.concatenate([[0.0], np.cumsum(t)])
+        return PlanPrediction(
+            elements=el,
+            features=f,
+            cell=cell,
+            cell_used=used,
+            dv_ms=dv,
+            time_s=t,
+            eta_s=float(t.sum()),
+            waypoint_times_s=np.interp(s_wp, s_knots, t_knots),
+            flags=flags,
+        )
+
+    def feasibility(
+        self,
+        plan_ne: np.ndarray,
+        required_times_s: np.ndarray,
+        wind_ne: np.ndarray,
+        tolerance_s: float = 5.0,
+        cruise_ms: float | None = None,
+    ) -> Feasibility:
+        """Is each 4D waypoint (required time from the start, s) reached within ``tolerance_s``?"""
+        req = np.asarray(required_times_s, dtype=float)
+        p = np.asarray(plan_ne)
+        if req.shape != (p.shape[0],) or not np.isfinite(req).all():
+            raise InputError(f"need one finite required time per waypoint ({p.shape[0]}), got {req.shape}")
+        pred = self.predict(p, wind_ne, cruise_ms)
+        return Feasibility(required_s=req, predicted_s=pred.waypoint_times_s, tolerance_s=float(tolerance_s))
+
+    # -- persistence ---------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The fitted model as JSON-able data."""
+        self._check_fitted()
+        d: dict[str, Any] = {
+            "format": MODEL_FORMAT,
+            "params": {
+                "segment_m": self.segment_m,
+                "n_prototypes": self.n_prototypes,
+                "algorithm": self.algorithm,
+                "learning_rate": self.learning_rate,
+                "lr_decay": self.lr_decay,
+                "max_iter": self.max_iter,
+                "random_state": self.random_state,
+                "target": self.target,
+                "dv_bin_ms": self.dv_bin_ms,
+            },
+            "label_dv_ms": {str(int(k)): float(v) for k, v in zip(self.labels_, self.label_dv_, strict=True)},
+            "cruise_ms": self.cruise_ms_,
+            "wind_range_ms": list(self.wind_range_ms_),
+            "n_train": self.n_train_,
+            "dv_global_ms": self.dv_global_,
+            "dv_table_ms": {str(c): float(self.dv_table_[c]) for c in np.flatnonzero(self.count_table_)},
+            "count_table": {str(c): int(self.count_table_[c]) for c in np.flatnonzero(self.count_table_)},
+        }
+        if self.lvq_ is not None:
+            d["lvq"] = {
+                "classes": self.lvq_.classes_.tolist(),
+                "prototypes": self.lvq_.prototypes_.tolist(),
+                "prototype_labels": self.lvq_.prototype_labels_.tolist(),
+            }
+        else:
+            d["single_cell"] = self.single_cell_
+        return d
+
+    def save(self, path: str | Path) -> None:
+        """Write the model as JSON, atomically."""
+        atomic_write_text(path, json.dumps(self.to_dict(), indent=1))
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], source: str = "<dict>") -> TrajectoryPredictor:
+        """Rebuild a fitted predictor from :meth:`to_dict` data."""
+        if not isinstance(d, dict) or d.get("format") != MODEL_FORMAT:
+            raise DataFormatError(f"not a {MODEL_FORMAT} model", path=source)
+        try:
+            self = cls(**d["params"])
+            self.cruise_ms_ = float(d["cruise_ms"])
+            self.wind_range_ms_ = (float(d["wind_range_ms"][0]), float(d["wind_range_ms"][1]))
+            self.n_train_ = int(d["n_train"])
+            self.dv_global_ = float(d["dv_global_ms"])
+            lab = sorted((int(k), float(v)) for k, v in d["label_dv_ms"].items())
+            self.labels_ = np.array([k for k, _ in lab], dtype=int)
+            self.label_dv_ = np.array([v for _, v in lab])
+            self.dv_table_ = np.full(_N_TABLE, np.nan)
+            self.count_table_ = np.zeros(_N_TABLE, dtype=int)
+            for k, v in d["dv_table_ms"].items():
+                self.dv_table_[int(k)] = float(v)
+                self.count_table_[int(k)] = int(d["count_table"][k])
+            if "lvq" in d:
+                lvq = LVQClassifier(n_prototypes=len(d["lvq"]["prototype_labels"]))
+                lvq.classes_ = np.asarray(d["lvq"]["classes"], dtype=int)
+                lvq.prototypes_ = np.asarray(d["lvq"]["prototypes"], dtype=float)
+                lvq.prototype_labels_ = np.asarray(d["lvq"]["prototype_labels"], dtype=int)
+                lvq.n_features_in_ = lvq.prototypes_.shape[1]
+                lvq.n_iter_ = 0
+                self.lvq_ = lvq
+            else:
+                self.lvq_ = None
+                self.single_cell_ = int(d["single_cell"])
+        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            raise DataFormatError(f"malformed model: {exc!r}", path=source) from None
+        if self.lvq_ is not None and not np.isin(self.lvq_.classes_, self.labels_).all():
+            raise DataFormatError("model class without a ΔV entry", path=source)
+        return self
+
+    @classmethod
+    def load(cls, path: str | Path) -> TrajectoryPredictor:
+        """Read a model written by :meth:`save`."""
+        try:
+            d = json.loads(Path(path).read_text())
+        except json.JSONDecodeError as exc:
+            raise DataFormatError(f"invalid JSON: {exc.msg}", path=str(path), line=exc.lineno) from None
+        except OSError as exc:
+            raise InputError(f"cannot read model {path}: {exc.strerror}") from None
+        return cls.from_dict(d, source=str(path))
+
+
+__all__ = ["MIN_SPEED_MS", "MODEL_FORMAT", "Feasibility", "PlanPrediction", "TrajectoryPredictor"]

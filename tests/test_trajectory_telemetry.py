@@ -1,0 +1,194 @@
+"""Real telemetry: the ArduCopter tlog (mission, reached events, 1 Hz positions), PX4 ULog, CLI."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from uasnav.cli import main
+from uasnav.errors import InputError
+from uasnav.trajectory.samples import ElementSamples
+from uasnav.trajectory.telemetry import flown_runs, read_flight, run_samples
+
+TLOG = "flights/phoenix_mission1_arducopter.tlog"
+
+
+@pytest.fixture(scope="module")
+def tlog(shared_data):
+    return read_flight(shared_data / TLOG)
+
+
+def test_tlog_mission_runs(tlog):
+    assert sorted(tlog.waypoints) == [2, 3]
+    assert tlog.cruise_ms == pytest.approx(5.0)  # WPNAV_SPEED 500 cm/s
+    assert tlog.wind_ne is None
+    runs = flown_runs(tlog)
+    assert len(runs) == 5
+    for r in runs:
+        assert r.seqs == [2, 3]
+        assert np.hypot(*np.diff(r.plan_ne, axis=0)[0]) == pytest.approx(100.5, abs=0.5)
+        assert 19.0 < r.reached_t[1] - r.reached_t[0] < 23.0
+
+
+def test_tlog_elements_and_leave_one_out_beats_distance_over_speed(tlog):
+    from uasnav.trajectory.baselines import evaluate_methods
+
+    _runs, samples = run_samples(tlog)
+    assert [len(s) for s in samples] == [5] * 5
+    # Straight middle elements are flown at about the 5 m/s waypoint speed.
+    mid = np.concatenate([s.t_real_s[1:4] for s in samples])
+    assert 3.4 < np.median(20.0 / mid) < 5.5
+    leg_lvq, leg_ds = [], []
+    for k in range(5):
+        train = ElementSamples.concat([s for i, s in enumerate(samples) if i != k])
+        res = {m.name: m for m in evaluate_methods(train, samples[k])}
+        real = samples[k].t_real_s.sum()
+        leg_lvq.append(abs(res["LVQ (thesis)"].time_s.sum() - real) / real)
+        leg_ds.append(abs(res["distance ÷ speed"].time_s.sum() - real) / real)
+    assert np.mean(leg_lvq) < np.mean(leg_ds)
+
+
+def test_ulog_has_wind_but_no_mission(shared_data):
+    log = read_flight(shared_data / "logs/px4_sample_log_small.ulg")
+    assert log.wind_ne is not None and np.isfinite(log.wind_ne).all()
+    with pytest.raises(InputError, match="no mission waypoints"):
+        flown_runs(log)
+
+
+def test_unknown_extension(tmp_path):
+    p = tmp_path / "x.txt"
+    p.write_text("1")
+    with pytest.raises(InputError, match="unknown telemetry format"):
+        read_flight(p)
+
+
+def test_cli_train_predict_evaluate(shared_data, tmp_path):
+    model = tmp_path / "m.json"
+    r = CliRunner().invoke(main, ["trajectory", "train", str(shared_data / TLOG), "--out", str(model)])
+    assert r.exit_code == 0, r.output
+    assert "25 elements of 5 run(s)" in r.output
+    plan = tmp_path / "plan.csv"
+    plan.write_text("north,east\n0,0\n0,40\n40,40\n")
+    r = CliRunner().invoke(
+        main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "0@0", "--json"]
+    )
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["eta_s"] == pytest.approx(sum(e["time_s"] for e in out["elements"]))
+    assert len(out["waypoint_times_s"]) == 3
+    # The corner was never flown in training: flagged, not silent.
+    assert any(e["low_confidence"] for e in out["elements"] if e["kind"] == "corner")
+    r = CliRunner().invoke(main, ["trajectory", "evaluate", str(shared_data / TLOG), "--json"])
+    assert r.exit_code == 0, r.output
+    ev = json.loads(r.output)
+    assert ev["n_runs"] == 5 and "distance ÷ speed" in ev["methods"]
+    # 4D feasibility: the predicted times themselves are feasible, half of them are not.
+    times = ",".join(f"{x:.3f}" for x in out["waypoint_times_s"])
+    half = ",".join(f"{x / 2:.3f}" for x in out["waypoint_times_s"])
+    base = ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "0@0", "--json"]
+    r = CliRunner().invoke(main, [*base, "--required", times, "--tolerance", "0.5"])
+    assert r.exit_code == 0 and json.loads(r.output)["feasible"] is True
+    r = CliRunner().invoke(main, [*base, "--required", half, "--tolerance", "0.5"])
+    assert r.exit_code == 0 and json.loads(r.output)["waypoint_ok"] == [True, False, False]
+    r = CliRunner().invoke(main, [*base, "--required", "0,1"])
+    assert r.exit_code == 1 and "one finite required time per waypoint" in r.output
+    # bad input: one-waypoint plan, bad wind syntax
+    plan.write_text("north,east\n0,0\n")
+    r = CliRunner().invoke(
+        main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3@0"]
+    )
+    assert r.exit_code == 1 and "at least two waypoints" in r.output
+    r = CliRunner().invoke(
+        main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3"]
+    )
+    assert r.exit_code == 1 and "SPEED@DIR" in r.output
+
+
+def test_report_section_quick(tmp_path):
+    r = CliRunner().invoke(main, ["report", "--quick", "--only", "trajectory", "--out", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    data = json.loads((tmp_path / "report.json").read_text())["sections"]["trajectory"]
+    assert len(data["table17"]) == 2
+    assert data["methods"]["LVQ (thesis)"]["mean"] < data["methods"]["distance ÷ speed"]["mean"]
+
+
+def test_dataflash_without_mission(shared_data):
+    log = read_flight(shared_data / "logs/ardupilot_log171.bin")
+    assert log.t.size > 1000 and np.all(np.diff(log.t) > 0)
+    assert -35.4 < np.median(log.lat) < -35.3  # CMAC, Canberra
+    with pytest.raises(InputError, match="no mission waypoints"):
+        flown_runs(log)
+
+
+def test_cli_csv_flight_with_plan(tmp_path):
+    import pymap3d
+
+    from uasnav.trajectory.simulator import phantom4_plans, simulate_flight
+
+    plan = phantom4_plans()["A"]
+    lat0, lon0, h0 = 40.85, 14.27, 12.0
+    tel = simulate_flight(plan, seed=5)
+    lat, lon, h = pymap3d.ned2geodetic(tel.pos_ne[:, 0], tel.pos_ne[:, 1], 0 * tel.t, lat0, lon0, h0)
+    flight = tmp_path / "f.csv"
+    rows = ["t,lat,lon,alt,v_N,v_E,v_D"] + [
+        f"{a},{b:.9f},{c:.9f},{d:.3f},{e},{f},0"
+        for a, b, c, d, e, f in zip(tel.t, lat, lon, h, *tel.vel_ne.T, strict=True)
+    ]
+    flight.write_text("\n".join(rows) + "\n")
+    plat, plon, ph = pymap3d.ned2geodetic(plan[:, 0], plan[:, 1], 0 * plan[:, 0], lat0, lon0, h0)
+    plan_csv = tmp_path / "plan.csv"
+    plan_csv.write_text(
+        "lat,lon,alt\n"
+        + "".join(f"{a:.9f},{b:.9f},{c:.3f}\n" for a, b, c in zip(plat, plon, ph, strict=True))
+    )
+    model = tmp_path / "m.json"
+    args = [
+        "trajectory",
+        "train",
+        str(flight),
+        "--plan",
+        str(plan_csv),
+        "--speed",
+        "3.33",
+        "--wind",
+        "2.78@22.5",
+    ]
+    r = CliRunner().invoke(main, [*args, "--out", str(model), "--json"])
+    assert r.exit_code == 0, r.output
+    from uasnav.trajectory.geometry import discretise
+
+    assert json.loads(r.output)["n_elements"] == len(discretise(plan)) == 9
+    r = CliRunner().invoke(
+        main,
+        [
+            "trajectory",
+            "predict",
+            "--model",
+            str(model),
+            "--plan",
+            str(plan_csv),
+            "--wind",
+            "2.78@22.5",
+            "--json",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    # Predicting the very flight it was trained on: the 4D times of the interior waypoints are
+    # those at which the flown track passed them, within 2 %.
+    from uasnav.trajectory.geometry import arc_length_along
+    from uasnav.trajectory.samples import crossing_times
+
+    s_wp = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(plan, axis=0).T))])
+    flown = crossing_times(tel.t, arc_length_along(plan, tel.pos_ne), s_wp[1:-1])
+    np.testing.assert_allclose(out["waypoint_times_s"][1:-1], flown, rtol=0.02)
+    # The ETA is to the end of the last element (the waypoint); the simulated vehicle then
+    # settles onto it for a few seconds more.
+    assert tel.t[-1] - 8.0 < out["eta_s"] < tel.t[-1]
+    assert not any(e["low_confidence"] for e in out["elements"])
+    # No --plan for a CSV flight: a clear error.
+    r = CliRunner().invoke(main, ["trajectory", "train", str(flight), "--out", str(model)])
+    assert r.exit_code == 1 and "give --plan" in r.output
