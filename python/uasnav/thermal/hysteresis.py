@@ -28,7 +28,7 @@ def branch_from_temperature(t: ArrayLike, temp: ArrayLike, smooth_s: float = 30.
     if tt.size != tc.size:
         raise InputError(f"t and temp: lengths differ ({tt.size} vs {tc.size})")
     dt = float(np.median(np.diff(tt))) if tt.size > 1 else 1.0
-    w = max(1, int(round(smooth_s / dt)))
+    w = max(1, round(smooth_s / dt))
     kern = np.ones(w) / w
     pad = np.pad(tc, (w // 2, w - 1 - w // 2), mode="edge")
     sm = np.convolve(pad, kern, mode="valid")

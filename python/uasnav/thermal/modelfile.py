@@ -118,7 +118,8 @@ def loads_model(text: str, source: str = "<string>") -> Any:
     digest = hashlib.sha256(_canonical(d)).hexdigest()
     if digest != ck.get("value"):
         raise DataFormatError(
-            f"{source}: checksum mismatch (file edited or corrupted): expected {ck.get('value')}, got {digest}",
+            f"{source}: checksum mismatch (file edited or corrupted): "
+            f"expected {ck.get('value')}, got {digest}",
             path=source,
         )
     if d.get("units") != UNITS:

@@ -225,7 +225,7 @@ def train_lm(
 
     def mse(p: FloatArray, idx: FloatArray) -> float:
         net = unpack(p, hidden, hidden, base)
-        a1, a2 = _hidden(net, u[idx])
+        _, a2 = _hidden(net, u[idx])
         return float(np.mean((y[idx] - (a2 @ net.w3 + net.b3)) ** 2))
 
     for r in range(max(1, restarts)):
