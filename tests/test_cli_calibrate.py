@@ -87,3 +87,23 @@ def test_usage_and_domain_errors(logs, tmp_path) -> None:
     bad.write_text('{"format": "uasnav.thermal-model"}')
     r = CliRunner().invoke(main, ["calibrate", "--model", str(bad), "--test", str(test)])
     assert r.exit_code == 1 and "error:" in r.output and "schema_version" in r.output
+
+
+def test_report_section_quick(tmp_path) -> None:
+    from uasnav.report.sections.s40_calibration import standin_bias, standin_derivative
+
+    r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--quick", "--only", "calibration"])
+    assert r.exit_code == 0, r.output
+    d = json.loads((tmp_path / "report.json").read_text())["sections"]["calibration"]
+    res = d["ramp_residuals_rad_s"]
+    # The BPNN beats the thesis' quadratic and the PX4 cubic on the ramp; Δω lies in the ramp range.
+    assert res["BPNN 2-2 (thesis)"]["sr"] < res["polynomial m=2 (thesis)"]["sr"]
+    assert res["BPNN 2-2 (thesis)"]["sr"] < res["PX4 TC cubic"]["sr"]
+    assert 27.28 <= d["delta_omega"]["t_max"] <= 34.08 and d["delta_omega"]["max"] > d["delta_omega"]["rms"]
+    # Table 7 rows: t_PF is the first crossing of a constant residual: θ = |r|·t.
+    assert len(d["table7"]["rows"]) == 4
+    assert (tmp_path / "figures" / "calibration-fig34-delta-omega.png").exists()
+    # The stand-in's derivative is the derivative of its bias.
+    t = np.linspace(-20, 37, 50)
+    fd = (standin_bias(t + 1e-4) - standin_bias(t - 1e-4)) / 2e-4
+    np.testing.assert_allclose(standin_derivative(t), fd, rtol=1e-6, atol=1e-12)

@@ -182,6 +182,12 @@ def test_hysteresis_width_recovered() -> None:
     b = np.stack([shape + np.where(heating, -1e-4, 1e-4)] * 3, 1)
     h = fit_hysteresis(t, b, heating, order=2)
     np.testing.assert_allclose(h.width, 2e-4, rtol=1e-9)
+    assert np.all(h.width_std < 1e-12)  # noise-free data
+    noisy = b + np.random.default_rng(0).normal(0, 1e-5, b.shape)
+    hn = fit_hysteresis(t, noisy, heating, order=2)
+    # σ_width ≈ σ·√(1/400 + 1/400) for two offsets of 400 samples each (shape adds a little).
+    assert 0.9 * 1e-5 * np.sqrt(2 / 400) < hn.width_std[0] < 1.5 * 1e-5 * np.sqrt(2 / 400)
+    assert np.all(np.abs(hn.width - 2e-4) < 4 * hn.width_std)
     np.testing.assert_allclose(h.derivative(np.array([30.0]))[0], 2e-5, rtol=1e-9)
     with pytest.raises(InputError, match="only one branch"):
         fit_hysteresis(t, b, np.ones(t.size, bool))

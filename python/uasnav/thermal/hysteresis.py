@@ -58,6 +58,9 @@ class HysteresisFit:
         Centring of the temperature variable (°C).
     rms_residual : ndarray, shape (k,)
         RMS residual of the fit (rad/s).
+    width_std : ndarray, shape (k,)
+        1-σ standard error of ``width`` for white residuals (rad/s); correlated noise makes
+        the true uncertainty larger.
     """
 
     coef: FloatArray
@@ -66,6 +69,7 @@ class HysteresisFit:
     center_c: float
     scale_c: float
     rms_residual: FloatArray
+    width_std: FloatArray
 
     def predict(self, temp: ArrayLike, heating: ArrayLike) -> FloatArray:
         """Bias (n, k) rad/s at temperatures (n,) on the given branches (n,) bool."""
@@ -116,6 +120,12 @@ def fit_hysteresis(temp: ArrayLike, bias: ArrayLike, heating: ArrayLike, order: 
     sol, *_ = np.linalg.lstsq(x, b, rcond=None)
     res = b - x @ sol
     offsets = sol[order:]
+    # Var(c_cool − c_heat) = σ² gᵀ(XᵀX)⁻¹g with g selecting the two offsets.
+    g = np.zeros(x.shape[1])
+    g[-1], g[-2] = 1.0, -1.0
+    gcg = float(g @ np.linalg.solve(x.T @ x, g))
+    dof = max(t.size - x.shape[1], 1)
+    sigma2 = np.sum(res**2, axis=0) / dof
     return HysteresisFit(
         coef=sol[:order],
         offsets=offsets,
@@ -123,4 +133,5 @@ def fit_hysteresis(temp: ArrayLike, bias: ArrayLike, heating: ArrayLike, order: 
         center_c=float(c),
         scale_c=float(s),
         rms_residual=np.sqrt(np.mean(res**2, axis=0)),
+        width_std=np.sqrt(sigma2 * gcg),
     )

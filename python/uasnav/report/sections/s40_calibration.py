@@ -332,7 +332,7 @@ def build(w: SectionWriter) -> None:
         ("Δω_RMS", dw.t_rms_c, TABLE8, 36),
     ):
         truth = d["truth_fn"](np.array([t_pt]), True)[0]
-        dc = drift_at(nn, pf, truth, t_pt, dt=0.01, duration=60.0 if quick else 600.0)
+        dc = drift_at(nn, pf, truth, t_pt, dt=0.01, duration=60.0 if quick else 300.0)
         fig, ax = new_figure()
         drift_axes([("BPNN residual", dc.drift_nn), ("polynomial residual", dc.drift_pf)], ax=ax)
         ax.set_title(f"θ(t) at T = {t_pt:.2f} °C ({label})")
@@ -402,8 +402,11 @@ def build(w: SectionWriter) -> None:
     hy = fit_hysteresis(rtemp, d["ramp_gyro"], d["ramp_heating"], order=3)
     true_w = d["hysteresis_true"]
     w.table(
-        ["axis", "width fitted (µrad/s)", "width true (µrad/s)"],
-        [("xyz"[a], hy.width[a] * 1e6, None if true_w is None else true_w[a] * 1e6) for a in range(3)],
+        ["axis", "width fitted (µrad/s)", "± 1σ (µrad/s)", "width true (µrad/s)"],
+        [
+            ("xyz"[a], hy.width[a] * 1e6, hy.width_std[a] * 1e6, None if true_w is None else true_w[a] * 1e6)
+            for a in range(3)
+        ],
         caption="Hysteresis-aware fit on the ramp: shared shape, heating/cooling offsets",
         fmt="{:.2f}",
     )
