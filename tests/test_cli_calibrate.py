@@ -107,3 +107,51 @@ def test_report_section_quick(tmp_path) -> None:
     t = np.linspace(-20, 37, 50)
     fd = (standin_bias(t + 1e-4) - standin_bias(t - 1e-4)) / 2e-4
     np.testing.assert_allclose(standin_derivative(t), fd, rtol=1e-6, atol=1e-12)
+
+
+def test_report_section_uses_simulator_contract(monkeypatch) -> None:
+    """The section's simulator path against a fake ``uasnav.sim`` that follows the issue-3
+    contract (simulate → ImuLog with truth rate_true / gyro_bias / gyro_bias_thermal,
+    thermal_bias, thermal_bias_derivative), built from the stand-in curves."""
+    import sys
+    import types
+
+    from uasnav.report.sections import s40_calibration as sec
+
+    def simulate(preset, *, profile="static", rate=100.0, seed=0, **_):
+        if profile == "soak":
+            temp, _ = sec.standin_soak(seed, hold_s=300.0, rate=rate * 10)
+            heating = np.ones(temp.size, bool)
+        else:
+            _, temp, heating, _ = sec.standin_ramp(seed, rate=rate)
+        n = temp.size
+        earth = np.tile([5e-5, 0.0, -5e-5], (n, 1))
+        thermal = sec.standin_bias(temp, heating)
+        total = thermal + 1e-4  # turn-on bias
+        gyro = earth + total + np.random.default_rng(seed).normal(0, 1e-4, (n, 3))
+        return ImuLog(
+            t=np.arange(n) / rate,
+            gyro=gyro,
+            accel=np.tile([0.0, 0.0, -9.81], (n, 1)),
+            temp=np.round(temp, 2),
+            truth={"rate_true": earth, "gyro_bias": total, "gyro_bias_thermal": thermal, "temp_die": temp},
+        )
+
+    fake = types.ModuleType("uasnav.sim")
+    fake.simulate = simulate  # type: ignore[attr-defined]
+    fake.thermal_bias = lambda preset, t, branch="heating": sec.standin_bias(t, branch == "heating")  # type: ignore[attr-defined]
+    fake.thermal_bias_derivative = lambda preset, t, branch="heating": sec.standin_derivative(t)  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "uasnav.sim", fake)
+    import uasnav
+
+    monkeypatch.setattr(uasnav, "sim", fake, raising=False)
+
+    class W:
+        quick, seed = True, 3
+
+    d = sec._data(W())  # type: ignore[arg-type]
+    assert d["source"].startswith("uasnav.sim")
+    # Earth rate and turn-on bias are removed: what is left is the thermal bias plus noise.
+    assert np.abs(d["ramp_gyro"] - d["ramp_truth"]).mean() < 2e-4
+    np.testing.assert_allclose(d["truth_fn"](np.array([30.0]), True), sec.standin_bias(np.array([30.0])))
+    assert d["soak_temp"].size == d["soak_bias"].shape[0] > 50
