@@ -255,3 +255,34 @@ def test_bad_inputs() -> None:
         NeuralBiasModel(17).fit(np.arange(50.0), np.zeros((50, 3)))
     with pytest.raises(AttributeError, match="call fit"):
         PolynomialBiasModel(2).predict([1.0])
+
+
+def test_nguyen_widrow_spreads_the_first_layer() -> None:
+    from uasnav.thermal.neural import nguyen_widrow
+
+    p = nguyen_widrow(5, 5, np.random.default_rng(0))
+    w1, b1 = p[:5], p[5:10]
+    beta = 0.7 * 5
+    np.testing.assert_allclose(np.abs(w1), beta)
+    assert np.all(np.abs(b1) <= 1.1 * beta) and np.ptp(b1) > beta  # transitions cover [−1, 1]
+    w2 = p[10:35].reshape(5, 5)
+    np.testing.assert_allclose(np.linalg.norm(w2, axis=1), 0.7 * 5 ** (1 / 5))
+
+
+def test_apply_subtracts_model_bias_and_counts_clipping(nn: NeuralBiasModel) -> None:
+    from uasnav.imu import ImuLog
+    from uasnav.thermal import apply
+
+    temp = np.array([-30.0, 0.0, 20.0, 50.0])
+    b = truth(np.clip(temp, -20, 37))
+    log = ImuLog(t=np.arange(4.0), gyro=b + 1e-3, accel=np.zeros((4, 3)), temp=temp)
+    with pytest.warns(TemperatureRangeWarning):
+        cal = apply(nn, log)
+    np.testing.assert_allclose(cal.gyro, 1e-3, atol=2e-5)
+    assert cal.meta["thermal_calibration"]["clipped"] == 2
+    with pytest.raises(InputError, match="no temperature"):
+        apply(nn, ImuLog(t=np.arange(4.0), gyro=b, accel=np.zeros((4, 3))))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = nn.derivative(temp, method="network")
+    assert np.all(d[[0, 3]] == 0.0) and np.all(d[[1, 2]] != 0.0)

@@ -16,7 +16,6 @@ the NumPy reference it is tested against.
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -457,7 +456,10 @@ class NeuralBiasModel:
         if method == "analytic":
             return self._eval(temp, False)[1]
         if method == "network":
-            return self._eval(temp, True)[0]
+            # Outside the calibrated range the clipped model is constant: its derivative is 0.
+            v, _, clipped = self._eval(temp, True)
+            v[clipped] = 0.0
+            return v
         raise InputError(f"method: expected 'analytic' or 'network', got {method!r}")
 
     def to_dict(self) -> dict[str, Any]:
@@ -543,8 +545,3 @@ def select_hidden_neurons(
         srs.append(sr(res))
     arr = np.asarray(srs)
     return SelectionResult(tuple(candidates), arr, choose(tuple(candidates), arr, rel_tol), rel_tol)
-
-
-def network_summary(net: Network) -> str:
-    """One-line JSON of a network (debugging aid)."""
-    return json.dumps(net.to_dict())
