@@ -230,8 +230,17 @@ def test_model_file_errors(tmp_path, nn: NeuralBiasModel) -> None:
     d["schema_version"] = 2
     with pytest.raises(DataFormatError, match="schema_version 2"):
         loads_model(json.dumps(d))
-    with pytest.raises(InputError, match="schema_version 2"):  # the Rust loader agrees
+    with pytest.raises(InputError, match="checksum mismatch"):  # the Rust loader verifies too
         _core.mlp_evaluate_model(json.dumps(d), T_TEST)
+    from uasnav.thermal.modelfile import ZEROS, file_checksum
+
+    d["checksum"]["value"] = ZEROS
+    resigned = json.dumps(d)
+    resigned = resigned.replace(ZEROS, file_checksum(resigned, ZEROS))
+    with pytest.raises(InputError, match="schema_version 2"):  # a well-signed file of schema 2
+        _core.mlp_evaluate_model(resigned, T_TEST)
+    with pytest.raises(DataFormatError, match="schema_version 2"):
+        loads_model(resigned)
     with pytest.raises(InputError, match="not a valid model file"):
         _core.mlp_evaluate_model(text[:100], T_TEST)
     from uasnav.thermal import dumps_model

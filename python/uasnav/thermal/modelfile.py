@@ -13,9 +13,9 @@ Layout (schema version 1)::
      "training": {... free-form metadata ...},
      "checksum": {"algorithm": "sha256", "value": "<hex>"}}
 
-The checksum is the SHA-256 of the canonical serialisation of everything else
-(``json.dumps(sort_keys=True, separators=(",", ":"), allow_nan=False)``), so any edit or
-truncation is detected on load. Files are written atomically.
+The checksum is the SHA-256 of the file's bytes with its own hex value replaced by 64 ``0``
+characters, so Python and Rust (``nav_core::mlp::json``) verify it byte-exactly without
+re-serialising; any edit or truncation is detected on load. Files are written atomically.
 """
 
 from __future__ import annotations
@@ -37,8 +37,12 @@ UNITS = {"input": "degC", "output": "rad/s", "derivative": "rad/s/degC"}
 AXES = ("x", "y", "z")
 
 
-def _canonical(payload: dict[str, Any]) -> bytes:
-    return json.dumps(payload, sort_keys=True, separators=(",", ":"), allow_nan=False).encode("utf-8")
+ZEROS = "0" * 64
+
+
+def file_checksum(text: str, value: str) -> str:
+    """SHA-256 hex of ``text`` with the one occurrence of ``value`` replaced by 64 zeros."""
+    return hashlib.sha256(text.replace(value, ZEROS, 1).encode("utf-8")).hexdigest()
 
 
 def _plain(x: Any) -> Any:
@@ -76,17 +80,17 @@ def model_payload(model: Any, training: dict[str, Any] | None = None) -> dict[st
     if recs:
         payload["training"].setdefault("networks", [{**r.__dict__} for r in recs])
     payload = _plain(payload)
-    try:
-        digest = hashlib.sha256(_canonical(payload)).hexdigest()
-    except ValueError as e:
-        raise DataFormatError(f"model holds non-finite numbers and cannot be saved: {e}") from e
-    payload["checksum"] = {"algorithm": "sha256", "value": digest}
+    payload["checksum"] = {"algorithm": "sha256", "value": ZEROS}
     return payload
 
 
 def dumps_model(model: Any, training: dict[str, Any] | None = None) -> str:
-    """The model file text."""
-    return json.dumps(model_payload(model, training), indent=1, allow_nan=False) + "\n"
+    """The model file text (checksum filled in)."""
+    try:
+        text = json.dumps(model_payload(model, training), indent=1, allow_nan=False) + "\n"
+    except ValueError as e:
+        raise DataFormatError(f"model holds non-finite numbers and cannot be saved: {e}") from e
+    return text.replace(ZEROS, file_checksum(text, ZEROS), 1)
 
 
 def save_model(model: Any, path: str | os.PathLike[str], training: dict[str, Any] | None = None) -> None:
@@ -115,11 +119,13 @@ def loads_model(text: str, source: str = "<string>") -> Any:
     ck = d.pop("checksum", None)
     if not isinstance(ck, dict) or ck.get("algorithm") != "sha256":
         raise DataFormatError(f"{source}: missing or unknown checksum", path=source)
-    digest = hashlib.sha256(_canonical(d)).hexdigest()
-    if digest != ck.get("value"):
+    value = ck.get("value")
+    if not (isinstance(value, str) and len(value) == 64 and text.count(value) == 1):
+        raise DataFormatError(f"{source}: checksum value is not a unique 64-digit hex string", path=source)
+    digest = file_checksum(text, value)
+    if digest != value:
         raise DataFormatError(
-            f"{source}: checksum mismatch (file edited or corrupted): "
-            f"expected {ck.get('value')}, got {digest}",
+            f"{source}: checksum mismatch (file edited or corrupted): expected {value}, got {digest}",
             path=source,
         )
     if d.get("units") != UNITS:

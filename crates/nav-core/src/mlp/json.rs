@@ -13,10 +13,11 @@
 //!  "training": {…}, "checksum": {"algorithm": "sha256", "value": "…"}}
 //! ```
 //!
-//! `weights` of a layer are `(outputs × inputs)` nested lists. The SHA-256 checksum covers the
-//! canonical Python serialisation and is verified by the Python loader; this loader checks
-//! format, schema version, kind, units, shapes and finiteness, so a corrupt or mismatched file
-//! is an error naming what is wrong, never a silently wrong network.
+//! `weights` of a layer are `(outputs × inputs)` nested lists. The checksum is the SHA-256 of
+//! the file's bytes with its own hex value replaced by 64 `0`s, so both loaders verify it
+//! byte-exactly without re-serialising. This loader checks the checksum, format, schema
+//! version, kind, units, shapes and finiteness: a corrupt or mismatched file is an error naming
+//! what is wrong, never a silently wrong network.
 use super::{Activation, Affine, LayerSpec, Mlp};
 use serde::Deserialize;
 use std::string::{String, ToString};
@@ -67,7 +68,14 @@ struct Units {
 }
 
 #[derive(Deserialize)]
+struct Checksum {
+    algorithm: String,
+    value: String,
+}
+
+#[derive(Deserialize)]
 struct FileJson {
+    checksum: Checksum,
     format: String,
     schema_version: u32,
     kind: String,
@@ -146,10 +154,42 @@ fn net_from_json(
     .map_err(|e| ModelFileError(format!("{where_}: {e}")))
 }
 
-/// Parses a thermal-model file's text into its networks.
+/// SHA-256 (lower-case hex) of `text` with the one occurrence of `value` replaced by 64 `0`s.
+pub fn file_checksum(text: &str, value: &str) -> String {
+    use sha2::{Digest, Sha256};
+    let zeros = "0".repeat(64);
+    let digest = Sha256::digest(text.replacen(value, &zeros, 1).as_bytes());
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn verify_checksum(text: &str, c: &Checksum) -> Result<(), ModelFileError> {
+    if c.algorithm != "sha256" {
+        return Err(ModelFileError(format!(
+            "checksum algorithm {:?} is not supported (expected \"sha256\")",
+            c.algorithm
+        )));
+    }
+    let is_hex = c.value.len() == 64 && c.value.bytes().all(|b| b.is_ascii_hexdigit());
+    if !is_hex || text.matches(c.value.as_str()).count() != 1 {
+        return Err(ModelFileError(
+            "checksum value is not a unique 64-digit hex string".to_string(),
+        ));
+    }
+    let got = file_checksum(text, &c.value);
+    if got != c.value {
+        return Err(ModelFileError(format!(
+            "checksum mismatch (file edited or corrupted): expected {}, got {got}",
+            c.value
+        )));
+    }
+    Ok(())
+}
+
+/// Parses a thermal-model file's text into its networks (checksum verified first).
 pub fn load_thermal_model(text: &str) -> Result<ThermalNetworks, ModelFileError> {
     let f: FileJson = serde_json::from_str(text)
         .map_err(|e| ModelFileError(format!("not a valid model file: {e}")))?;
+    verify_checksum(text, &f.checksum)?;
     if f.format != FORMAT {
         return Err(ModelFileError(format!(
             "format is {:?}, expected {FORMAT:?}",
@@ -212,11 +252,19 @@ mod tests {
                   "layers": [{"activation": "tanh", "weights": [[0.8], [-1.3]], "biases": [0.1, 0.4]},
                              {"activation": "tanh", "weights": [[0.5, -0.7], [1.1, 0.3]], "biases": [-0.2, 0.05]},
                              {"activation": "linear", "weights": [[1.5, -0.6]], "biases": [0.02]}]}],
-      "derivative_models": null, "training": {"anything": 1}, "checksum": {"algorithm": "sha256", "value": "x"}}"#;
+      "derivative_models": null, "training": {"anything": 1},
+      "checksum": {"algorithm": "sha256", "value": "0000000000000000000000000000000000000000000000000000000000000000"}}"#;
+
+    /// Signs a test file: its checksum is computed over the zero placeholder.
+    fn signed(text: &str) -> String {
+        let zeros = "0".repeat(64);
+        let c = file_checksum(text, &zeros);
+        text.replacen(&zeros, &c, 1)
+    }
 
     #[test]
     fn loads_and_matches_closed_form() {
-        let t = load_thermal_model(GOOD).unwrap();
+        let t = load_thermal_model(&signed(GOOD)).unwrap();
         assert_eq!(t.bias.len(), 1);
         assert_eq!(t.range_c, (-20.0, 40.0));
         let x: f64 = 25.0;
@@ -232,26 +280,31 @@ mod tests {
 
     #[test]
     fn rejects_corrupt_and_mismatched_files() {
+        let good = signed(GOOD);
+        let edit = |from: &str, to: &str| signed(&GOOD.replace(from, to));
         let cases = [
             (
-                GOOD.replace("\"schema_version\": 1", "\"schema_version\": 9"),
+                edit("\"schema_version\": 1", "\"schema_version\": 9"),
                 "schema_version 9",
             ),
-            (GOOD.replace("uasnav.thermal-model", "other"), "format"),
+            (edit("uasnav.thermal-model", "other"), "format"),
             (
-                GOOD.replace("\"kind\": \"neural\"", "\"kind\": \"polynomial\""),
+                edit("\"kind\": \"neural\"", "\"kind\": \"polynomial\""),
                 "kind",
             ),
             (
-                GOOD.replace("\"output\": \"rad/s\"", "\"output\": \"deg/s\""),
+                edit("\"output\": \"rad/s\"", "\"output\": \"deg/s\""),
                 "units",
             ),
             (
-                GOOD.replace("[[0.5, -0.7], [1.1, 0.3]]", "[[0.5], [1.1, 0.3]]"),
+                edit("[[0.5, -0.7], [1.1, 0.3]]", "[[0.5], [1.1, 0.3]]"),
                 "weight row 0",
             ),
-            (GOOD.replace("\"tanh\"", "\"relu\""), "activation"),
-            (GOOD[..200].to_string(), "not a valid model file"),
+            (edit("\"tanh\"", "\"relu\""), "activation"),
+            (good[..200].to_string(), "not a valid model file"),
+            (good.replace("0.8", "0.9"), "checksum mismatch"),
+            (GOOD.to_string(), "checksum mismatch"),
+            (good.replace("\"sha256\"", "\"md5\""), "algorithm"),
         ];
         for (text, needle) in cases {
             let e = load_thermal_model(&text).unwrap_err();
