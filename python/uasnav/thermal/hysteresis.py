@@ -83,8 +83,9 @@ class HysteresisFit:
         """Shared ∂b/∂T (n, k) rad/s/°C (the same on both branches)."""
         u = (check_temp(temp) - self.center_c) / self.scale_c
         c = np.vstack([np.zeros((1, self.coef.shape[1])), self.coef])
-        return (
-            np.polynomial.polynomial.polyval(u, np.polynomial.polynomial.polyder(c, axis=0)).T / self.scale_c
+        return np.asarray(
+            np.polynomial.polynomial.polyval(u, np.polynomial.polynomial.polyder(c, axis=0)).T / self.scale_c,
+            dtype=np.float64,
         )
 
 

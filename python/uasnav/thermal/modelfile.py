@@ -104,7 +104,7 @@ def loads_model(text: str, source: str = "<string>") -> Any:
         d = json.loads(text)
     except json.JSONDecodeError as e:
         raise DataFormatError(
-            f"{source}: not valid JSON ({e.msg})", path=source, line=e.lineno, column=e.colno
+            f"{source}: not valid JSON ({e.msg})", path=source, line=e.lineno, column=str(e.colno)
         ) from e
     if not isinstance(d, dict):
         raise DataFormatError(f"{source}: expected a JSON object at the top level", path=source)
@@ -134,8 +134,12 @@ def loads_model(text: str, source: str = "<string>") -> Any:
     from uasnav.thermal.polynomial import PolynomialBiasModel
     from uasnav.thermal.px4 import Px4BiasModel
 
-    kinds = {"polynomial": PolynomialBiasModel, "neural": NeuralBiasModel, "px4": Px4BiasModel}
-    cls = kinds.get(d.get("kind"))
+    kinds: dict[str, Any] = {
+        "polynomial": PolynomialBiasModel,
+        "neural": NeuralBiasModel,
+        "px4": Px4BiasModel,
+    }
+    cls = kinds.get(str(d.get("kind")))
     if cls is None:
         raise DataFormatError(f"{source}: unknown model kind {d.get('kind')!r}", path=source)
     try:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from uasnav.errors import InputError, NumericalError
 from uasnav.thermal._common import (
@@ -254,7 +254,7 @@ def _train_lm(
         a1, a2 = _hidden(net, uu)
         return net, a1, a2, a2 @ net.w3 + net.b3
 
-    def mse(p: FloatArray, idx: FloatArray) -> float:
+    def mse(p: FloatArray, idx: NDArray[np.intp]) -> float:
         out = forward_n(p, u[idx])[3]
         return float(np.mean((y[idx] - out) ** 2))
 

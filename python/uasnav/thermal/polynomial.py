@@ -85,7 +85,7 @@ class PolynomialBiasModel:
         dc = np.polynomial.polynomial.polyder(self.coef_, axis=0) / self.scale_c_
         out = np.polynomial.polynomial.polyval(u, dc).T.copy()
         out[clipped] = 0.0
-        return out
+        return np.asarray(out, dtype=np.float64)
 
     def to_dict(self) -> dict[str, Any]:
         """The ``models`` entries of the model file (one per axis)."""

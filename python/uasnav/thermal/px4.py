@@ -80,7 +80,7 @@ class Px4BiasModel:
         dc = np.polynomial.polynomial.polyder(self.coef_, axis=0)
         out = np.polynomial.polynomial.polyval(t - self.tref_c_, dc).T.copy()
         out[clipped] = 0.0
-        return out
+        return np.asarray(out, dtype=np.float64)
 
     def px4_params(self, instance: int = 0, device_id: int = 0) -> dict[str, float | int]:
         """The fitted model as PX4 parameters ``TC_G{i}_*`` (rad/s units, as PX4 stores them)."""

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import importlib
 import warnings
 from typing import Any
 
@@ -106,7 +107,7 @@ def _block_average(temp: np.ndarray, bias: np.ndarray, k: int) -> tuple[np.ndarr
 def _data(w: SectionWriter) -> dict[str, Any]:
     """Soak and ramp data from the simulator if it exists, else the stand-in."""
     try:
-        from uasnav import sim  # issue 3
+        sim = importlib.import_module("uasnav.sim")  # issue 3; absent on older trees
 
         have_sim = hasattr(sim, "simulate") and hasattr(sim, "thermal_bias")
     except ImportError:
@@ -132,7 +133,7 @@ def _data(w: SectionWriter) -> dict[str, Any]:
 
 
 def _sim_data(w: SectionWriter) -> dict[str, Any]:
-    from uasnav import sim
+    sim = importlib.import_module("uasnav.sim")
 
     # The soak lasts hours: 1 Hz (quick) or 10 Hz keeps it to a few 10⁵ samples.
     rate = 1.0 if w.quick else 10.0
