@@ -52,6 +52,10 @@ fn bench_mlp(c: &mut Criterion) {
     c.bench_function("mlp/eval_clipped_1-2-2-1_f64", |b| {
         b.iter(|| m.eval_clipped(black_box(25.3)).unwrap())
     });
+    let fast = net(2).with_fast_tanh();
+    c.bench_function("mlp/eval_1-2-2-1_f64_fast_tanh", |b| {
+        b.iter(|| fast.eval(black_box(25.3)))
+    });
     let m32 = Mlp::<f32>::new(
         &[
             LayerSpec {

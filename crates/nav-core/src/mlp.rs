@@ -38,6 +38,41 @@ pub enum Activation {
     Logistic,
     /// Identity ("linear").
     Linear,
+    /// Opt-in fast tanh: the [7/6] Padé approximant
+    /// `x(135135 + 17325x² + 378x⁴ + x⁶) / (135135 + 62370x² + 3150x⁴ + 28x⁶)`, saturated to ±1
+    /// for |x| ≥ 4.97. Maximum absolute error [`FAST_TANH_MAX_ERROR`] (at |x| ≈ 4.97; below
+    /// 1e-9 for |x| < 1.5), derivative `1 − a²` off by at most twice that. Never chosen
+    /// implicitly: only [`Mlp::with_fast_tanh`] or an explicit layer spec selects it.
+    TanhFast,
+}
+
+/// Maximum absolute error of [`Activation::TanhFast`] against the exact tanh (tested on a
+/// dense grid over ±20).
+pub const FAST_TANH_MAX_ERROR: f64 = 9.7e-5;
+
+#[inline(always)]
+fn tanh_pade<T: Real>(z: T) -> T {
+    let one = T::one();
+    let sat = crate::scalar::lit::<T>(4.97);
+    if z >= sat {
+        return one;
+    }
+    if z <= -sat {
+        return -one;
+    }
+    let l = crate::scalar::lit::<T>;
+    let z2 = z * z;
+    let num = z * (l(135135.0) + z2 * (l(17325.0) + z2 * (l(378.0) + z2)));
+    let den = l(135135.0) + z2 * (l(62370.0) + z2 * (l(3150.0) + l(28.0) * z2));
+    let a = num / den;
+    // The approximant overshoots 1 by < 1e-4 just below the saturation point.
+    if a > one {
+        one
+    } else if a < -one {
+        -one
+    } else {
+        a
+    }
 }
 
 impl Activation {
@@ -54,6 +89,10 @@ impl Activation {
                 (a, a * (T::one() - a))
             }
             Activation::Linear => (z, T::one()),
+            Activation::TanhFast => {
+                let a = tanh_pade(z);
+                (a, T::one() - a * a)
+            }
         }
     }
 
@@ -243,6 +282,17 @@ impl<T: Real> Mlp<T> {
         m.w3[..last_hidden].copy_from_slice(out.weights);
         m.b3 = out.biases[0];
         Ok(m)
+    }
+
+    /// The same network with its tanh layers evaluated by [`Activation::TanhFast`] (opt-in
+    /// speed for a documented accuracy cost, see [`FAST_TANH_MAX_ERROR`]).
+    pub fn with_fast_tanh(mut self) -> Self {
+        for f in [&mut self.f1, &mut self.f2, &mut self.g] {
+            if *f == Activation::Tanh {
+                *f = Activation::TanhFast;
+            }
+        }
+        self
     }
 
     /// Neurons per hidden layer `(n1, n2)` (`n2 == n1` for a one-hidden-layer network).
@@ -483,6 +533,35 @@ mod tests {
         .unwrap();
         let o = m.eval(0.0);
         assert!((o.value - 0.5).abs() < 1e-15 && (o.derivative - 0.25).abs() < 1e-15);
+    }
+
+    #[test]
+    fn fast_tanh_error_is_as_documented() {
+        let mut worst: f64 = 0.0;
+        let mut worst_small: f64 = 0.0;
+        for i in -200_000..=200_000 {
+            let x = f64::from(i) * 1e-4;
+            let e = (tanh_pade(x) - x.tanh()).abs();
+            worst = worst.max(e);
+            if x.abs() < 1.5 {
+                worst_small = worst_small.max(e);
+            }
+        }
+        assert!(
+            worst <= FAST_TANH_MAX_ERROR && worst > 0.9 * FAST_TANH_MAX_ERROR,
+            "{worst}"
+        );
+        assert!(worst_small < 1e-9, "{worst_small}");
+        // Whole network: output error bounded by the propagated activation error.
+        let exact = net(Activation::Tanh);
+        let fast = net(Activation::Tanh).with_fast_tanh();
+        for i in -20..=40 {
+            let x = f64::from(i);
+            let (a, b) = (exact.eval(x), fast.eval(x));
+            // |Δy| ≤ scale_out·Σ|w3|·(ε + Σ|W2|·ε) with the test weights: 2e-4·2.1·3.6·ε.
+            assert!((a.value - b.value).abs() < 2e-4 * 2.1 * 3.6 * FAST_TANH_MAX_ERROR);
+            assert!((a.derivative - b.derivative).abs() < 1e-6 * a.derivative.abs().max(1e-6));
+        }
     }
 
     #[test]
