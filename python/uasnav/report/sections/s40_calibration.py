@@ -420,6 +420,7 @@ def build(w: SectionWriter) -> None:
         fmt="{:.2f}",
     )
     w.data["hysteresis_width"] = hy.width.tolist()
+    w.data["hysteresis_width_std"] = hy.width_std.tolist()
 
     # Robustness: 1 °C quantised temperature; outside the calibrated range.
     with warnings.catch_warnings():
