@@ -131,6 +131,30 @@ def bench_trajectory(n_predict: int, n_train: int, repeat: int) -> None:
         f"trajectory LVQ fit n={n_train:.0e} (256 prototypes, 1 epoch LVQ1): {t_fit:6.2f} s | "
         f"predict n={n_predict:.0e} elements: uasnav {t_pred * 1e3:7.1f} ms, sklearn 1-NN on the same "
         f"prototypes {t_knn * 1e3:7.1f} ms (ratio {t_knn / t_pred:4.1f}x) | cell accuracy {acc:.3f}"
+def bench_thermal(n: int, repeat: int) -> None:
+    """LM training of one 1-2-2-1 network (one restart) on n samples, and batch inference
+    through the Rust engine vs the NumPy reference."""
+    from uasnav.thermal import NeuralBiasModel, train_lm
+    from uasnav.thermal.neural import forward
+
+    t = np.linspace(-20.0, 37.0, n)
+    b = 1e-3 * np.tanh((t - 10) / 8) + rng.normal(0, 5e-5, n)
+    epochs = []
+
+    def train() -> None:
+        _, rec = train_lm(t, b, 2, restarts=1, seed=0)
+        epochs.append(rec.epochs)
+
+    t_train = median_time(train, repeat)
+    m = NeuralBiasModel(2, restarts=1).fit(t[::10], np.stack([b[::10]] * 3, 1))
+    x = np.linspace(-20.0, 37.0, 10**6)
+    m.predict(x)
+    t_rust = median_time(lambda: m.predict(x), repeat)
+    t_np = median_time(lambda: [forward(net, x) for net in m.networks_], repeat)
+        f"thermal LM 1-2-2-1 n={n:.0e}: {t_train:6.2f} s per restart ({statistics.median(epochs):.0f} epochs,"
+        f" {t_train / statistics.median(epochs) * 1e3:.1f} ms/epoch)"
+        f"thermal predict 3 axes n=1e6: rust {t_rust * 1e3:7.1f} ms | numpy {t_np * 1e3:7.1f} ms"
+        f" | speed-up {t_np / t_rust:4.1f}x ({t_rust / 3e6 * 1e9:.1f} ns per evaluation incl. derivative)"
     )
 
 
@@ -139,6 +163,7 @@ CASES: dict[str, Callable[[bool], None]] = {
     "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
     "sim": lambda quick: bench_sim(10**6 if quick else 10**7, 3),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
+    "thermal": lambda quick: bench_thermal(10**4 if quick else 10**5, 1 if quick else 3),
 }
 
 

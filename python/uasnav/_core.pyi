@@ -21,6 +21,7 @@ __all__ = [
     "attitude_quat_to_dcm",
     "attitude_quat_to_euler",
     "attitude_rotation_angle",
+    "mlp_evaluate_model",
     "noise_fit_ieee952",
     "noise_read_points",
 ]
@@ -78,3 +79,13 @@ def attitude_quat_to_dcm(q: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def attitude_dcm_to_quat(dcm: NDArray[np.float64], tol: float = 1e-6) -> NDArray[np.float64]:
     """Quaternions (n, 4) of DCMs C_b^n (n, 3, 3)."""
+
+# --- mlp -----------------------------------------------------------------------------------
+def mlp_evaluate_model(
+    model_json: str,
+    temp_c: NDArray[np.float64],
+    clip: bool = True,
+    derivative_networks: bool = False,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+    """Networks of a neural thermal-model file (JSON text) at temperatures (n,) degC:
+    (value (n, k) rad/s, d/dT (n, k) rad/s/degC, clipped (n,))."""

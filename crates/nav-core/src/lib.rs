@@ -23,6 +23,7 @@ extern crate std;
 pub mod allan;
 pub mod attitude;
 pub mod error;
+pub mod mlp;
 pub mod noise;
 pub(crate) mod scalar;
 
