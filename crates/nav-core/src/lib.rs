@@ -22,8 +22,10 @@ extern crate std;
 
 pub mod allan;
 pub mod attitude;
+pub mod earth;
 pub mod error;
 pub mod noise;
+pub mod zupt;
 pub(crate) mod scalar;
 
 pub use error::NavError;
