@@ -4,6 +4,9 @@ Private API: import :mod:`uasnav.allan`, :mod:`uasnav.attitude`, … instead. Un
 quaternions scalar first, body → NED.
 """
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -23,6 +26,7 @@ __all__ = [
     "attitude_rotation_angle",
     "noise_fit_ieee952",
     "noise_read_points",
+    "zupt_run",
 ]
 
 # --- allan / noise -------------------------------------------------------------------------
@@ -78,3 +82,32 @@ def attitude_quat_to_dcm(q: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def attitude_dcm_to_quat(dcm: NDArray[np.float64], tol: float = 1e-6) -> NDArray[np.float64]:
     """Quaternions (n, 4) of DCMs C_b^n (n, 3, 3)."""
+
+def zupt_run(
+    gyro: NDArray[np.float64],
+    accel: NDArray[np.float64],
+    dt_s: float,
+    *,
+    mode: str = "zupt",
+    discretisation: str = "first_order",
+    config: dict[str, float] | None = None,
+    temp: NDArray[np.float64] | None = None,
+    dbias_dtemp: NDArray[np.float64] | None = None,
+    mag: NDArray[np.float64] | None = None,
+    stationary: NDArray[np.bool_] | None = None,
+    levelling_samples: int = 6000,
+    heading_rad: float | None = None,
+    declination_rad: float | None = None,
+    accel_bias0: Sequence[float] = ...,
+    gyro_bias0: Sequence[float] = ...,
+    decimation: int = 1,
+) -> dict[str, Any]:
+    """Run the ZUPT ('zupt') or TCZUPT ('tczupt') filter over a whole log (GIL released).
+
+    gyro, accel (n, 3) rad/s and m/s² (body); dt_s sample period (s); config: SI floats named
+    as nav_core::zupt::ZuptConfig (unknown keys raise); temp (n,) °C; dbias_dtemp (n, 3)
+    rad/s/°C (TCZUPT); mag (n, 3) for a magnetic heading with declination_rad; stationary
+    (n,) bool (updates only where true). Returns a dict: gyro_bias (m, 3), accel_bias (m, 3),
+    attitude (m, 4), cov_diag (m, 15), temp_rate (m,), initial_attitude [4], updates,
+    mean_nis; m = ceil(n / decimation).
+    """

@@ -25,8 +25,8 @@ pub mod attitude;
 pub mod earth;
 pub mod error;
 pub mod noise;
-pub mod zupt;
 pub(crate) mod scalar;
+pub mod zupt;
 
 pub use error::NavError;
 pub use scalar::Real;

@@ -4,8 +4,8 @@ use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
 use super::slope::SlopeEstimator;
 use super::{
-    BiasTemperatureDerivative, Discretisation, HeadingSource, Levelling, Mode, ZuptConfig,
-    N_MEAS, N_STATES,
+    BiasTemperatureDerivative, Discretisation, HeadingSource, Levelling, Mode, ZuptConfig, N_MEAS,
+    N_STATES,
 };
 use crate::attitude::{quat_from_rotation_vector, quat_to_array, quat_to_dcm};
 use crate::earth;
@@ -58,6 +58,8 @@ pub struct ZuptFilter<T: Real> {
     p: Mat15<T>,
     // Earth model at the frozen position.
     w_ie: Vector3<T>,
+    /// Rotation of the NED frame over one sample, `exp(−ω_ie·Ts/2)`.
+    q_earth: UnitQuaternion<T>,
     g0: T,
     grav_grad: T,
     // Γ diagonal per group (variance added per step).
@@ -136,6 +138,9 @@ impl<T: Real> ZuptFilter<T> {
             q0,
             p,
             w_ie: earth::earth_rate_ned(config.latitude_rad),
+            q_earth: quat_from_rotation_vector(
+                &(-earth::earth_rate_ned(config.latitude_rad) * dt_s),
+            ),
             g0,
             grav_grad: lit::<T>(2.0) * g0 / earth::geocentric_radius(config.latitude_rad),
             gamma,
@@ -226,9 +231,8 @@ impl<T: Real> ZuptFilter<T> {
         let c = quat_to_dcm(&self.q);
         // Attitude: body rotation on the right, Earth rotation of the NED frame on the left.
         let q_body = quat_from_rotation_vector(&(w_hat * dt));
-        let q_earth = quat_from_rotation_vector(&(-self.w_ie * dt));
         self.q = UnitQuaternion::new_normalize(
-            q_earth.into_inner() * self.q.into_inner() * q_body.into_inner(),
+            self.q_earth.into_inner() * self.q.into_inner() * q_body.into_inner(),
         );
         let f_n = c * f_hat;
         let g = self.g0 + self.grav_grad * self.pos.z;
@@ -256,34 +260,47 @@ impl<T: Real> ZuptFilter<T> {
         let a_dd = self.grav_grad * dt;
         match self.cfg.discretisation {
             Discretisation::FirstOrder => {
-                let phi_left = |m: &Mat15<T>| -> Mat15<T> {
-                    let mut out = *m;
-                    let r_v = m.fixed_rows::<3>(3);
-                    let r_p = m.fixed_rows::<3>(6);
-                    let r_ba = m.fixed_rows::<3>(9);
-                    let r_bg = m.fixed_rows::<3>(12);
-                    // δr rows: + Ts·δv rows.
-                    let top = m.fixed_rows::<3>(0) + r_v * dt;
-                    let mut vel = r_v + a_vv * r_v + a_vp * r_p + a_vb * r_ba;
-                    // Vertical gravity gradient: only the δv_D row gets (2g/r)·Ts·δr_D.
-                    for j in 0..N_STATES {
-                        vel[(2, j)] += m[(2, j)] * a_dd;
-                    }
-                    let att = r_p + a_pp * r_p + a_vb * r_bg;
-                    out.fixed_rows_mut::<3>(0).copy_from(&top);
-                    out.fixed_rows_mut::<3>(3).copy_from(&vel);
-                    out.fixed_rows_mut::<3>(6).copy_from(&att);
-                    out
-                };
-                let b = phi_left(&self.p);
-                self.p = phi_left(&b.transpose()).transpose();
+                // B = Φ·P by block rows (only δr, δv and ψ rows differ from P) …
+                let p = &self.p;
+                let mut b = *p;
+                let r_v = p.fixed_rows::<3>(3);
+                let r_p = p.fixed_rows::<3>(6);
+                let top = p.fixed_rows::<3>(0) + r_v * dt;
+                let mut vel = r_v + a_vv * r_v + a_vp * r_p + a_vb * p.fixed_rows::<3>(9);
+                // Vertical gravity gradient: only the δv_D row gets (2g/r)·Ts·δr_D.
+                for j in 0..N_STATES {
+                    vel[(2, j)] += p[(2, j)] * a_dd;
+                }
+                let att = r_p + a_pp * r_p + a_vb * p.fixed_rows::<3>(12);
+                b.fixed_rows_mut::<3>(0).copy_from(&top);
+                b.fixed_rows_mut::<3>(3).copy_from(&vel);
+                b.fixed_rows_mut::<3>(6).copy_from(&att);
+                // … then P⁻ = B·Φᵀ by block columns, with the transposed 3×3 blocks.
+                let mut out = b;
+                let c_v = b.fixed_columns::<3>(3);
+                let c_p = b.fixed_columns::<3>(6);
+                let left = b.fixed_columns::<3>(0) + c_v * dt;
+                let mut vcol = c_v
+                    + c_v * a_vv.transpose()
+                    + c_p * a_vp.transpose()
+                    + b.fixed_columns::<3>(9) * a_vb.transpose();
+                for i in 0..N_STATES {
+                    vcol[(i, 2)] += b[(i, 2)] * a_dd;
+                }
+                let pcol =
+                    c_p + c_p * a_pp.transpose() + b.fixed_columns::<3>(12) * a_vb.transpose();
+                out.fixed_columns_mut::<3>(0).copy_from(&left);
+                out.fixed_columns_mut::<3>(3).copy_from(&vcol);
+                out.fixed_columns_mut::<3>(6).copy_from(&pcol);
+                self.p = out;
             }
             Discretisation::SecondOrder => {
                 let mut f = Mat15::<T>::zeros();
                 let eye3 = Matrix3::<T>::identity();
                 f.fixed_view_mut::<3, 3>(0, 3).copy_from(&eye3);
                 f[(5, 2)] = self.grav_grad;
-                f.fixed_view_mut::<3, 3>(3, 3).copy_from(&(w * lit::<T>(-2.0)));
+                f.fixed_view_mut::<3, 3>(3, 3)
+                    .copy_from(&(w * lit::<T>(-2.0)));
                 f.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(f_n)));
                 f.fixed_view_mut::<3, 3>(3, 9).copy_from(&(-c));
                 f.fixed_view_mut::<3, 3>(6, 6).copy_from(&(-w));
@@ -306,7 +323,11 @@ impl<T: Real> ZuptFilter<T> {
     pub fn update(&mut self) -> Result<(), NavError> {
         // Attitude measurement: q̂ ⊗ q₀* = exp(ψ/2) for Ĉ = (I + [ψ×])·C₀.
         let dq = self.q.into_inner() * self.q0.conjugate().into_inner();
-        let s = if dq.w < T::zero() { -T::one() } else { T::one() };
+        let s = if dq.w < T::zero() {
+            -T::one()
+        } else {
+            T::one()
+        };
         let psi = Vector3::new(dq.i, dq.j, dq.k) * (lit::<T>(2.0) * s);
         let mut z = Vec9::<T>::zeros();
         z.fixed_rows_mut::<3>(0).copy_from(&self.pos);
@@ -523,7 +544,13 @@ impl<T: Real> ZuptFilter<T> {
         for k in 0..n {
             let temp = input.temp_c.map(|t| t[k]);
             let stat = input.stationary.is_none_or(|s| s[k]);
-            if f.step(&input.gyro_rad_s[k], &input.accel_m_s2[k], temp, stat, deriv)? {
+            if f.step(
+                &input.gyro_rad_s[k],
+                &input.accel_m_s2[k],
+                temp,
+                stat,
+                deriv,
+            )? {
                 nis_sum += f.last_nis;
             }
             if k % out.decimation == 0 {

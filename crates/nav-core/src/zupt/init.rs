@@ -111,14 +111,8 @@ impl<T: Real> Levelling<T> {
                     });
                 }
                 let m = self.sum_m / from_usize::<T>(self.n_mag);
-                let (sr, cr) = (
-                    num_traits::Float::sin(roll),
-                    num_traits::Float::cos(roll),
-                );
-                let (sp, cp) = (
-                    num_traits::Float::sin(pitch),
-                    num_traits::Float::cos(pitch),
-                );
+                let (sr, cr) = (num_traits::Float::sin(roll), num_traits::Float::cos(roll));
+                let (sp, cp) = (num_traits::Float::sin(pitch), num_traits::Float::cos(pitch));
                 let hx = m.x * cp + (m.y * sr + m.z * cr) * sp;
                 let hy = m.y * cr - m.z * sr;
                 num_traits::Float::atan2(-hy, hx) + declination_rad

@@ -90,10 +90,10 @@ fn gyro_bias_converges_and_nees_stays_inside_chi2_bounds() {
         let bg0 = rng.vec3(cfg.init_std_gyro_bias_rad_s);
         let ba0 = rng.vec3(cfg.init_std_accel_bias_m_s2 * 0.1);
         let (gy, ac, tb) = s.run(n, bg0, ba0, &mut rng);
-        let mut f =
-            ZuptFilter::new(cfg, s.q, Vector3::zeros(), Vector3::zeros(), s.dt).unwrap();
+        let mut f = ZuptFilter::new(cfg, s.q, Vector3::zeros(), Vector3::zeros(), s.dt).unwrap();
         for k in 0..n {
-            f.step(&gy[k], &ac[k], None, true, &mut NoDerivative).unwrap();
+            f.step(&gy[k], &ac[k], None, true, &mut NoDerivative)
+                .unwrap();
             if let Some(c) = checkpoints.iter().position(|&x| x == k) {
                 let e = f.gyro_bias_rad_s() - tb[k];
                 let pb = f.covariance().fixed_view::<3, 3>(12, 12).into_owned();
@@ -107,7 +107,10 @@ fn gyro_bias_converges_and_nees_stays_inside_chi2_bounds() {
     // Sum of `runs` NEES values of 3 dof is χ²(3·runs): 99 % two-sided bounds for 72 dof.
     let (lo, hi) = (46.9, 106.6);
     for (c, v) in nees.iter().enumerate() {
-        assert!(*v > lo && *v < hi, "checkpoint {c}: NEES sum {v} outside [{lo}, {hi}]");
+        assert!(
+            *v > lo && *v < hi,
+            "checkpoint {c}: NEES sum {v} outside [{lo}, {hi}]"
+        );
     }
     // σ_ARW/√T after 300 s ≈ 5.3e-5 rad/s; worst of 72 axis errors stays well inside 4σ.
     assert!(last_err < 2.5e-4, "{last_err}");
@@ -122,7 +125,8 @@ fn block_propagation_equals_dense_first_order_product() {
     let (gy, ac, _) = s.run(300, rng.vec3(1e-4), Vector3::zeros(), &mut rng);
     let mut f = ZuptFilter::new(cfg, s.q, Vector3::zeros(), Vector3::zeros(), s.dt).unwrap();
     for k in 0..250 {
-        f.step(&gy[k], &ac[k], None, true, &mut NoDerivative).unwrap();
+        f.step(&gy[k], &ac[k], None, true, &mut NoDerivative)
+            .unwrap();
     }
     // Dense reference Φ = I + F·Ts from the same linearisation point.
     let p0 = *f.covariance();
@@ -130,11 +134,13 @@ fn block_propagation_equals_dense_first_order_product() {
     let f_n = c * (Vector3::from(ac[250]) - f.accel_bias_m_s2());
     let w = super::filter_test_skew(&earth::earth_rate_ned(cfg.latitude_rad));
     let mut fm = nalgebra::SMatrix::<f64, 15, 15>::zeros();
-    fm.fixed_view_mut::<3, 3>(0, 3).copy_from(&Matrix3::identity());
+    fm.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&Matrix3::identity());
     let g = earth::normal_gravity(cfg.latitude_rad, 0.0);
     fm[(5, 2)] = 2.0 * g / earth::geocentric_radius(cfg.latitude_rad);
     fm.fixed_view_mut::<3, 3>(3, 3).copy_from(&(w * -2.0));
-    fm.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-super::filter_test_skew(&f_n)));
+    fm.fixed_view_mut::<3, 3>(3, 6)
+        .copy_from(&(-super::filter_test_skew(&f_n)));
     fm.fixed_view_mut::<3, 3>(3, 9).copy_from(&(-c));
     fm.fixed_view_mut::<3, 3>(6, 6).copy_from(&(-w));
     fm.fixed_view_mut::<3, 3>(6, 12).copy_from(&(-c));
@@ -155,7 +161,11 @@ fn block_propagation_equals_dense_first_order_product() {
     f.predict(&gy[250], &ac[250], &Vector3::zeros()).unwrap();
     let got = *f.covariance();
     let scale = want.amax();
-    assert!((got - want).amax() < 1e-12 * scale, "{}", (got - want).amax());
+    assert!(
+        (got - want).amax() < 1e-12 * scale,
+        "{}",
+        (got - want).amax()
+    );
     assert!(got.iter().all(|x| x.is_finite()));
 
     // The second-order option agrees closely (the F² term is O(Ts²)).
@@ -166,8 +176,10 @@ fn block_propagation_equals_dense_first_order_product() {
     let mut f1 = ZuptFilter::new(cfg, s.q, Vector3::zeros(), Vector3::zeros(), s.dt).unwrap();
     let mut f2 = ZuptFilter::new(cfg2, s.q, Vector3::zeros(), Vector3::zeros(), s.dt).unwrap();
     for k in 0..300 {
-        f1.step(&gy[k], &ac[k], None, true, &mut NoDerivative).unwrap();
-        f2.step(&gy[k], &ac[k], None, true, &mut NoDerivative).unwrap();
+        f1.step(&gy[k], &ac[k], None, true, &mut NoDerivative)
+            .unwrap();
+        f2.step(&gy[k], &ac[k], None, true, &mut NoDerivative)
+            .unwrap();
     }
     // Compare as correlation-normalised differences: the F² term adds the O(Ts) direct
     // gyro-bias → velocity coupling that the first-order Φ only builds over two steps.
@@ -191,7 +203,9 @@ fn tczupt_tracks_a_thermal_ramp_that_zupt_lags() {
     let k = Vector3::new(2e-5, -3e-5, 1.5e-5); // rad/s/°C
     let n = 60_000;
     let mut rng = Gauss::new(11);
-    let temps: Vec<f64> = (0..n).map(|i| 27.0 + 2.0 / 60.0 * i as f64 * s.dt).collect();
+    let temps: Vec<f64> = (0..n)
+        .map(|i| 27.0 + 2.0 / 60.0 * i as f64 * s.dt)
+        .collect();
     let quiet = StaticSim {
         noise: ProcessNoise {
             sigma_gbi_rad_s: 0.0,
@@ -221,7 +235,8 @@ fn tczupt_tracks_a_thermal_ramp_that_zupt_lags() {
         let mut deriv = |_i: usize, _t: f64| k;
         let mut se = 0.0;
         for i in 0..n {
-            f.step(&gy[i], &ac[i], Some(temps[i]), true, &mut deriv).unwrap();
+            f.step(&gy[i], &ac[i], Some(temps[i]), true, &mut deriv)
+                .unwrap();
             if i >= n / 2 {
                 se += (f.gyro_bias_rad_s() - truth[i]).norm_squared();
             }
@@ -241,11 +256,29 @@ fn non_finite_input_and_bad_config_are_errors() {
     let mut f = ZuptFilter::new(cfg, s.q, Vector3::zeros(), Vector3::zeros(), s.dt).unwrap();
     let before = f.gyro_bias_rad_s();
     let e = f
-        .step(&[f64::NAN, 0.0, 0.0], &[0.0, 0.0, -9.8], None, true, &mut NoDerivative)
+        .step(
+            &[f64::NAN, 0.0, 0.0],
+            &[0.0, 0.0, -9.8],
+            None,
+            true,
+            &mut NoDerivative,
+        )
         .unwrap_err();
-    assert!(matches!(e, NavError::NonFinite { what: "gyro_rad_s", .. }));
+    assert!(matches!(
+        e,
+        NavError::NonFinite {
+            what: "gyro_rad_s",
+            ..
+        }
+    ));
     assert!(f
-        .step(&[0.0; 3], &[f64::INFINITY, 0.0, 0.0], None, true, &mut NoDerivative)
+        .step(
+            &[0.0; 3],
+            &[f64::INFINITY, 0.0, 0.0],
+            None,
+            true,
+            &mut NoDerivative
+        )
         .is_err());
     assert_eq!(f.gyro_bias_rad_s(), before);
     let tc = ZuptConfig {
@@ -253,9 +286,17 @@ fn non_finite_input_and_bad_config_are_errors() {
         ..cfg
     };
     let mut f = ZuptFilter::new(tc, s.q, Vector3::zeros(), Vector3::zeros(), s.dt).unwrap();
-    assert!(f.step(&[0.0; 3], &[0.0, 0.0, -9.8], None, true, &mut NoDerivative).is_err());
     assert!(f
-        .step(&[0.0; 3], &[0.0, 0.0, -9.8], Some(f64::NAN), true, &mut NoDerivative)
+        .step(&[0.0; 3], &[0.0, 0.0, -9.8], None, true, &mut NoDerivative)
+        .is_err());
+    assert!(f
+        .step(
+            &[0.0; 3],
+            &[0.0, 0.0, -9.8],
+            Some(f64::NAN),
+            true,
+            &mut NoDerivative
+        )
         .is_err());
     let bad = ZuptConfig {
         meas_std_velocity_m_s: 0.0,
@@ -263,7 +304,10 @@ fn non_finite_input_and_bad_config_are_errors() {
     };
     assert!(matches!(
         ZuptFilter::new(bad, s.q, Vector3::zeros(), Vector3::zeros(), s.dt),
-        Err(NavError::InvalidParameter { what: "meas_std_velocity_m_s", .. })
+        Err(NavError::InvalidParameter {
+            what: "meas_std_velocity_m_s",
+            ..
+        })
     ));
     assert!(ZuptFilter::new(cfg, s.q, Vector3::zeros(), Vector3::zeros(), -1.0).is_err());
 }
@@ -308,7 +352,11 @@ fn batch_matches_stepwise_filter_and_recovers_turn_on_bias() {
     assert_eq!(sum.updates, 200);
     // Mean NIS of a consistent filter ≈ 9 (χ²₉); the levelled (not true) attitude biases it a
     // little, so accept a generous band.
-    assert!(sum.mean_nis > 4.0 && sum.mean_nis < 20.0, "{}", sum.mean_nis);
+    assert!(
+        sum.mean_nis > 4.0 && sum.mean_nis < 20.0,
+        "{}",
+        sum.mean_nis
+    );
     let e = Vector3::from(gb[rows - 1]) - tb[19_900];
     assert!(e.amax() < 2e-4, "{e}");
     // Bias σ shrinks monotonically-ish from the prior.
