@@ -86,6 +86,7 @@ fn bench_zupt(c: &mut Criterion) {
                 heading: HeadingSource::Given(0.0),
                 accel_bias0_m_s2: [0.0; 3],
                 gyro_bias0_rad_s: [0.0; 3],
+                zero_gyro_bias: false,
             };
             let mut out = BatchOutput {
                 decimation: 100,

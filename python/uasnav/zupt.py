@@ -102,6 +102,11 @@ class ZuptConfig:
         Frozen position (WGS-84 geodetic latitude, ellipsoidal height).
     levelling_s : float
         Initial zeroing window for coarse levelling (thesis: 60 s).
+    zeroing : bool
+        Start the gyro-bias estimate from the mean gyro output over the zeroing window minus
+        the Earth rate in the levelled body frame (the thesis' "initial zeroing procedure").
+        The default ``init_std_gyro_bias_rad_s`` (2e-4 rad/s) assumes it; without zeroing
+        set it to the turn-on bias spread.
     heading_rad : float or None
         Initial true heading. ``None`` with ``declination_rad`` set: magnetic heading (eq. 3)
         from ``log.mag``; both ``None``: heading 0 (it does not affect the bias estimates).
@@ -129,10 +134,11 @@ class ZuptConfig:
     init_std_velocity_m_s: float = 1e-3
     init_std_attitude_rad: float = 1e-4
     init_std_accel_bias_m_s2: float = 0.05
-    init_std_gyro_bias_rad_s: float = 1e-3
+    init_std_gyro_bias_rad_s: float = 2e-4
     latitude_deg: float = 45.0
     height_m: float = 0.0
     levelling_s: float = 60.0
+    zeroing: bool = True
     heading_rad: float | None = None
     declination_rad: float | None = None
     gyro_bias0_rad_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -372,6 +378,7 @@ def run(
         declination_rad=declination if heading is None else None,
         accel_bias0=[float(v) for v in cfg.accel_bias0_m_s2],
         gyro_bias0=[float(v) for v in gb0],
+        zero_gyro_bias=cfg.zeroing,
         decimation=cfg.decimation,
     )
     return ZuptResult(

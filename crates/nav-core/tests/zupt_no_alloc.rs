@@ -65,6 +65,7 @@ fn per_sample_step_and_batch_do_not_allocate() {
                 heading: HeadingSource::Given(0.5),
                 accel_bias0_m_s2: [0.0; 3],
                 gyro_bias0_rad_s: [0.0; 3],
+                zero_gyro_bias: false,
             };
             let mut out = BatchOutput {
                 decimation: 10,

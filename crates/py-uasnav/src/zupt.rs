@@ -82,7 +82,7 @@ fn config(
 #[pyo3(signature = (gyro, accel, dt_s, *, mode="zupt", discretisation="first_order",
     config=None, temp=None, dbias_dtemp=None, mag=None, stationary=None,
     levelling_samples=6000, heading_rad=None, declination_rad=None,
-    accel_bias0=[0.0; 3], gyro_bias0=[0.0; 3], decimation=1))]
+    accel_bias0=[0.0; 3], gyro_bias0=[0.0; 3], zero_gyro_bias=true, decimation=1))]
 #[allow(clippy::too_many_arguments)]
 fn zupt_run<'py>(
     py: Python<'py>,
@@ -101,6 +101,7 @@ fn zupt_run<'py>(
     declination_rad: Option<f64>,
     accel_bias0: [f64; 3],
     gyro_bias0: [f64; 3],
+    zero_gyro_bias: bool,
     decimation: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cfg = config_or_default(py, mode, discretisation, config.as_ref())?;
@@ -157,6 +158,7 @@ fn zupt_run<'py>(
         heading,
         accel_bias0_m_s2: accel_bias0,
         gyro_bias0_rad_s: gyro_bias0,
+        zero_gyro_bias,
     };
     type Hist = (
         Vec<[f64; 3]>,

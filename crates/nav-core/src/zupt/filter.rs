@@ -440,8 +440,13 @@ pub struct BatchInput<'a, T> {
     pub heading: HeadingSource<T>,
     /// Initial accelerometer bias estimate (m/s², body).
     pub accel_bias0_m_s2: [T; 3],
-    /// Initial gyro bias estimate (rad/s, body), e.g. a residual 15 deg/h scenario.
+    /// Initial gyro bias estimate (rad/s, body), e.g. a residual 15 deg/h scenario. With
+    /// `zero_gyro_bias` it is added to the zeroing estimate.
     pub gyro_bias0_rad_s: [T; 3],
+    /// Initial zeroing (thesis §4.2.6.2): start the gyro-bias estimate from the mean gyro
+    /// output over the levelling window minus the Earth rate resolved in the levelled body
+    /// frame.
+    pub zero_gyro_bias: bool,
 }
 
 /// Output buffers of [`ZuptFilter::run_batch`]: row `j` holds the state after sample
@@ -527,17 +532,25 @@ impl<T: Real> ZuptFilter<T> {
 
         let mut lev = Levelling::new();
         let m = input.levelling_samples.clamp(1, n);
+        let mut sum_w = Vector3::zeros();
         for k in 0..m {
             let mag = input.mag.map(|v| &v[k]);
             lev.push(&input.accel_m_s2[k], mag)
                 .map_err(|e| reindex(e, k))?;
+            finite3("gyro_rad_s", k, &input.gyro_rad_s[k])?;
+            sum_w += Vector3::from(input.gyro_rad_s[k]);
         }
         let q0 = lev.attitude(input.heading)?;
+        let mut bg0 = Vector3::from(input.gyro_bias0_rad_s);
+        if input.zero_gyro_bias {
+            let w_b = quat_to_dcm(&q0).transpose() * earth::earth_rate_ned(config.latitude_rad);
+            bg0 += sum_w / crate::scalar::from_usize::<T>(m) - w_b;
+        }
         let mut f = Self::new(
             config,
             q0,
             Vector3::from(input.accel_bias0_m_s2),
-            Vector3::from(input.gyro_bias0_rad_s),
+            bg0,
             input.dt_s,
         )?;
         let mut nis_sum = T::zero();
