@@ -64,6 +64,11 @@ THESIS_TCZUPT_NOISE = FilterNoise.from_datasheet(
     arw="3.18 deg/√h", gbi="5e-4 deg/s", vrw="0.05 m/s/√h", abi="2 m/s/h"
 )
 
+#: Columns of :meth:`ZuptResult.to_csv` (the CLI's EST.csv; the first seven are a contract).
+CSV_COLUMNS = (
+    "t", "bgx", "bgy", "bgz", "bax", "bay", "baz", "q0", "q1", "q2", "q3",
+    "sbgx", "sbgy", "sbgz", "sbax", "sbay", "sbaz",
+)  # fmt: skip
 STATE_NAMES = (
     "rN", "rE", "rD", "vN", "vE", "vD", "psiN", "psiE", "psiD",
     "bax", "bay", "baz", "bgx", "bgy", "bgz",
@@ -277,16 +282,18 @@ class ZuptResult:
         return ax
 
     def to_csv(self, path: str) -> None:
-        """Write ``t,bgx,bgy,bgz,bax,bay,baz`` (s, rad/s, m/s²) then ``q0..q3`` and the 1σ of
-        the gyro and accelerometer biases, atomically."""
+        """Write ``t,bgx,bgy,bgz,bax,bay,baz`` (s, rad/s, m/s²), then the attitude ``q0..q3``
+        and the 1σ of the gyro and accelerometer biases, atomically."""
+        import io
+
         from uasnav.atomicfile import atomic_write_text
 
         cols = np.column_stack(
             [self.t, self.gyro_bias, self.accel_bias, self.attitude, self.gyro_bias_std, self.accel_bias_std]
         )
-        header = "t,bgx,bgy,bgz,bax,bay,baz,q0,q1,q2,q3,sbgx,sbgy,sbgz,sbax,sbay,sbaz"
-        lines = [header] + [",".join(f"{v:.10g}" for v in row) for row in cols]
-        atomic_write_text(path, "\n".join(lines) + "\n")
+        buf = io.StringIO()
+        np.savetxt(buf, cols, fmt="%.10g", delimiter=",", header=",".join(CSV_COLUMNS), comments="")
+        atomic_write_text(path, buf.getvalue())
 
 
 def _match_rows(name: str, a: ArrayLike, m: int) -> FloatArray:
@@ -510,6 +517,7 @@ def segment_rms(
 
 __all__ = [
     "CONVERGENCE_THRESHOLD",
+    "CSV_COLUMNS",
     "REFERENCE_WINDOW_S",
     "RESIDUAL_BIAS_15DEG_H",
     "STATE_NAMES",
