@@ -53,12 +53,19 @@ def test_covariance_matches_filterpy_with_the_same_dense_model():
     F[3:6, 9:12] = -np.eye(3)
     F[6:9, 6:9] = -_skew(W_IE)
     F[6:9, 12:15] = -np.eye(3)
-    sig = [core["sigma_vrw_m_s_sqrt_s"], core["sigma_arw_rad_sqrt_s"], core["sigma_abi_m_s2"], core["sigma_gbi_rad_s"]]
+    sig = [
+        core["sigma_vrw_m_s_sqrt_s"],
+        core["sigma_arw_rad_sqrt_s"],
+        core["sigma_abi_m_s2"],
+        core["sigma_gbi_rad_s"],
+    ]
     kf = KalmanFilter(dim_x=15, dim_z=9)
     kf.F = np.eye(15) + F * dt
     kf.Q = np.diag(np.r_[np.zeros(3), np.repeat(np.square(sig), 3)]) * dt
     kf.H = np.hstack([np.eye(9), np.zeros((9, 6))])
-    kf.R = np.diag(np.repeat([cfg.meas_std_position_m, cfg.meas_std_velocity_m_s, cfg.meas_std_attitude_rad], 3) ** 2)
+    kf.R = np.diag(
+        np.repeat([cfg.meas_std_position_m, cfg.meas_std_velocity_m_s, cfg.meas_std_attitude_rad], 3) ** 2
+    )
     kf.P = np.diag(
         np.repeat(
             [
@@ -123,7 +130,9 @@ def test_stationary_mask_and_magnetic_heading(ramp):
     # of true north; a unit at true heading 0.4 reads magnetic heading 0.3, + D → 0.4.
     from uasnav.attitude import quat_to_dcm
 
-    c_bn = quat_to_dcm(zupt.run(log, "zupt", None, zupt.ZuptConfig(heading_rad=0.4)).initial_attitude[None])[0].T
+    c_bn = quat_to_dcm(zupt.run(log, "zupt", None, zupt.ZuptConfig(heading_rad=0.4)).initial_attitude[None])[
+        0
+    ].T
     rot = np.array([[np.cos(0.1), -np.sin(0.1), 0], [np.sin(0.1), np.cos(0.1), 0], [0, 0, 1]])
     mag = np.tile(c_bn @ rot @ np.array([20.0, 0.0, 40.0]), (log.n, 1))
     log_m = ImuLog(t=log.t, gyro=log.gyro, accel=log.accel, temp=log.temp, mag=mag)
@@ -134,7 +143,7 @@ def test_stationary_mask_and_magnetic_heading(ramp):
 
 
 def test_errors_name_what_is_wrong(ramp):
-    log, model = ramp
+    log, _model = ramp
     with pytest.raises(InputError, match="model"):
         zupt.run(log, "tczupt")
     with pytest.raises(InputError, match="mode"):
@@ -144,7 +153,7 @@ def test_errors_name_what_is_wrong(ramp):
     g = np.zeros((100, 3))
     a = np.tile([0.0, 0.0, -9.8], (100, 1))
     g[57, 1] = np.nan
-    with pytest.raises(InputError, match="gyro_rad_s.*57"):
+    with pytest.raises(InputError, match=r"gyro_rad_s.*57"):
         _core.zupt_run(g, a, 0.01, levelling_samples=10)
     with pytest.raises(InputError, match='unknown key "sigma_arw"'):
         _core.zupt_run(np.zeros((100, 3)), a, 0.01, config={"sigma_arw": 1.0})
@@ -162,7 +171,8 @@ def test_cli_writes_the_est_csv_contract(tmp_path):
     write_csv_v1(log, path)
     est, png = tmp_path / "EST.csv", tmp_path / "bias.png"
     r = CliRunner().invoke(
-        main, ["zupt", str(path), "--residual-bias", "15deg/h", "--out", str(est), "--json", "--plot", str(png)]
+        main,
+        ["zupt", str(path), "--residual-bias", "15deg/h", "--out", str(est), "--json", "--plot", str(png)],
     )
     assert r.exit_code == 0, r.output
     out = json.loads(r.output)

@@ -109,7 +109,7 @@ def zupt_run(
     as nav_core::zupt::ZuptConfig (unknown keys raise); temp (n,) °C; dbias_dtemp (n, 3)
     rad/s/°C (TCZUPT); mag (n, 3) for a magnetic heading with declination_rad; stationary
     (n,) bool (updates only where true); zero_gyro_bias starts the bias from the mean
-    gyro over the levelling window minus the Earth rate (plus gyro_bias0). Returns a dict: gyro_bias (m, 3), accel_bias (m, 3),
-    attitude (m, 4), cov_diag (m, 15), temp_rate (m,), initial_attitude [4], updates,
-    mean_nis; m = ceil(n / decimation).
+    gyro over the levelling window minus the Earth rate (plus gyro_bias0). Returns a dict:
+    gyro_bias (m, 3), accel_bias (m, 3), attitude (m, 4), cov_diag (m, 15), temp_rate (m,),
+    initial_attitude [4], updates, mean_nis; m = ceil(n / decimation).
     """

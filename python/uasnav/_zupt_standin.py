@@ -102,13 +102,20 @@ def static_log(
     or ``"constant"`` (30 °C). With ``hysteresis_rad_s`` the bias is offset by +h while
     heating and −h while cooling (smoothly switched on dT/dt)."""
     rng = np.random.default_rng(seed)
-    n = int(round(duration_s * rate_hz))
+    n = round(duration_s * rate_hz)
     dt = 1.0 / rate_hz
     t = np.arange(n) * dt
     temp = ramp_profile(t) if profile == "ramp" else np.full(n, T_REF_C)
     lat = np.deg2rad(latitude_deg)
     roll, pitch, yaw = euler_rad
-    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    cr, sr, cp, sp, cy, sy = (
+        np.cos(roll),
+        np.sin(roll),
+        np.cos(pitch),
+        np.sin(pitch),
+        np.cos(yaw),
+        np.sin(yaw),
+    )
     c_bn = np.array(
         [
             [cp * cy, cp * sy, -sp],

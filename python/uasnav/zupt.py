@@ -380,7 +380,7 @@ def run(
         dbias_dtemp=dbdt,
         mag=mag,
         stationary=mask,
-        levelling_samples=max(1, int(round(cfg.levelling_s * rate))),
+        levelling_samples=max(1, round(cfg.levelling_s * rate)),
         heading_rad=heading,
         declination_rad=declination if heading is None else None,
         accel_bias0=[float(v) for v in cfg.accel_bias0_m_s2],
@@ -421,7 +421,7 @@ def moving_average(x: ArrayLike, rate_hz: float, window_s: float = REFERENCE_WIN
     """Centred moving average (n, k) over ``window_s`` seconds (shrinking at the ends)."""
     a = np.asarray(x, dtype=np.float64)
     a2 = a[:, None] if a.ndim == 1 else a
-    w = max(1, int(round(window_s * rate_hz)))
+    w = max(1, round(window_s * rate_hz))
     c = np.vstack([np.zeros((1, a2.shape[1])), np.cumsum(a2, axis=0)])
     n = a2.shape[0]
     i = np.arange(n)
@@ -503,9 +503,11 @@ def segment_rms(
     """Tables 12–13: run the filter separately on ``segments`` consecutive ``segment_s``
     pieces of the log; returns (rms (segments, 3), mean (3,), std (3,)) in rad/s."""
     rate = log.uniform_rate()
-    per = int(round(segment_s * rate))
+    per = round(segment_s * rate)
     if segments * per > log.n:
-        raise InputError(f"log: {segments} × {segment_s} s segments need {segments * per} samples, got {log.n}")
+        raise InputError(
+            f"log: {segments} × {segment_s} s segments need {segments * per} samples, got {log.n}"
+        )
     ref = np.asarray(reference, dtype=np.float64)
     rms = np.empty((segments, 3))
     for s in range(segments):

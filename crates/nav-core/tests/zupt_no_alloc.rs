@@ -11,7 +11,11 @@ use std::alloc::System;
 #[global_allocator]
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
-#[test]
+fn main() {
+    per_sample_step_and_batch_do_not_allocate();
+    println!("zupt_no_alloc: ok (per-sample step and batch allocate nothing)");
+}
+
 fn per_sample_step_and_batch_do_not_allocate() {
     let q = UnitQuaternion::from_euler_angles(0.01, -0.02, 0.5);
     let f_b = q.inverse() * Vector3::new(0.0, 0.0, -9.806);

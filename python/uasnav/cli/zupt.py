@@ -110,7 +110,9 @@ def command(
     if as_json:
         echo_json(summary)
         return
-    click.echo(f"{log}: {data.n} samples at {res.meta['rate_hz']:g} Hz, {mode.upper()}, {res.updates} updates")
+    click.echo(
+        f"{log}: {data.n} samples at {res.meta['rate_hz']:g} Hz, {mode.upper()}, {res.updates} updates"
+    )
     for j, ax in enumerate("xyz"):
         click.echo(
             f"  gyro bias {ax}: {res.gyro_bias[-1, j]: .4e} ± {res.gyro_bias_std[-1, j]:.1e} rad/s   "

@@ -78,18 +78,18 @@ impl<T: Real> SlopeEstimator<T> {
         let y = y - r;
         if self.n == self.window {
             let oldest = self.buf[self.head];
-            self.sum_iy = self.sum_iy - (self.sum_y - oldest);
-            self.sum_y = self.sum_y - oldest;
+            self.sum_iy -= self.sum_y - oldest;
+            self.sum_y -= oldest;
             self.n -= 1;
             self.head = (self.head + 1) % self.window;
         }
         let tail = (self.head + self.n) % self.window;
         self.buf[tail] = y;
-        self.sum_iy = self.sum_iy + from_usize::<T>(self.n) * y;
-        self.sum_y = self.sum_y + y;
+        self.sum_iy += from_usize::<T>(self.n) * y;
+        self.sum_y += y;
         self.n += 1;
         self.pushes += 1;
-        if self.pushes % SLOPE_CAPACITY == 0 {
+        if self.pushes.is_multiple_of(SLOPE_CAPACITY) {
             self.recompute();
         }
         if self.n >= 2 {
@@ -106,8 +106,8 @@ impl<T: Real> SlopeEstimator<T> {
         let (mut sy, mut siy) = (T::zero(), T::zero());
         for i in 0..self.n {
             let y = self.buf[(self.head + i) % self.window];
-            sy = sy + y;
-            siy = siy + from_usize::<T>(i) * y;
+            sy += y;
+            siy += from_usize::<T>(i) * y;
         }
         self.sum_y = sy;
         self.sum_iy = siy;

@@ -85,7 +85,11 @@ def build(w: SectionWriter) -> None:
         ax.legend(fontsize=8, loc="upper left")
         ax.grid(True, alpha=0.3)
         filt = "standard ZUPT" if fig_no == 38 else "TCZUPT"
-        w.figure(fig, f"fig{fig_no}_input_{name}", f"Figure {fig_no}: input data of the {filt} filter ({name} gyro, 1 Hz low-pass for display).")
+        w.figure(
+            fig,
+            f"fig{fig_no}_input_{name}",
+            f"Figure {fig_no}: input data of the {filt} filter ({name} gyro, 1 Hz low-pass for display).",
+        )
 
     runs: dict[str, Any] = {}
     w.progress("running ZUPT and TCZUPT")
@@ -126,12 +130,25 @@ def build(w: SectionWriter) -> None:
             for mode, label in (("zupt", "ZUPT (calibrated data)"), ("tczupt", "TCZUPT (raw data)")):
                 r = runs[scen][mode]
                 r.plot_bias(j, ax=ax, label=label)
-                ax.plot(r.t, refs[mode][0][::dec, j], lw=0.6, alpha=0.6, label=f"moving average ({mode.upper()} input)")
+                ax.plot(
+                    r.t,
+                    refs[mode][0][::dec, j],
+                    lw=0.6,
+                    alpha=0.6,
+                    label=f"moving average ({mode.upper()} input)",
+                )
                 ax.plot(r.t, refs[mode][1][::dec, j], "k--", lw=0.8)
-            ax.set_title(("nominal" if scen == "nominal" else "residual 15 deg/h") + f", {AXES[j]} axis (dashed: true bias)")
+            ax.set_title(
+                ("nominal" if scen == "nominal" else "residual 15 deg/h")
+                + f", {AXES[j]} axis (dashed: true bias)"
+            )
             ax.legend(fontsize=7)
             title = "nominal condition" if scen == "nominal" else "residual error of 15 degrees/h"
-            w.figure(fig, f"fig{first + j}_{scen}_{AXES[j]}", f"Figure {first + j}: gyro bias ({title}, {AXES[j]}-axis).")
+            w.figure(
+                fig,
+                f"fig{first + j}_{scen}_{AXES[j]}",
+                f"Figure {first + j}: gyro bias ({title}, {AXES[j]}-axis).",
+            )
 
     # Table 10.
     data: dict[str, Any] = {"table10": {}, "table11": {}, "table12": {}, "table13": {}}
@@ -144,10 +161,22 @@ def build(w: SectionWriter) -> None:
                 rms_ma = zupt.rms_error(r.gyro_bias, refs[mode][0][::dec])[j]
                 rms_tr = zupt.rms_error(r.gyro_bias, refs[mode][1][::dec])[j]
                 row += [TABLE10[scen][a][0 if mode == "zupt" else 1], rms_ma, rms_tr]
-                data["table10"].setdefault(scen, {}).setdefault(mode, {})[a] = {"vs_moving_average": rms_ma, "vs_truth": rms_tr}
+                data["table10"].setdefault(scen, {}).setdefault(mode, {})[a] = {
+                    "vs_moving_average": rms_ma,
+                    "vs_truth": rms_tr,
+                }
             rows.append(tuple(row))
     w.table(
-        ["scenario", "axis", "ZUPT thesis", "ZUPT vs MA", "ZUPT vs truth", "TCZUPT thesis", "TCZUPT vs MA", "TCZUPT vs truth"],
+        [
+            "scenario",
+            "axis",
+            "ZUPT thesis",
+            "ZUPT vs MA",
+            "ZUPT vs truth",
+            "TCZUPT thesis",
+            "TCZUPT vs MA",
+            "TCZUPT vs truth",
+        ],
         rows,
         caption="Table 10: RMS error (rad/s) over the whole run; MA = 30 s moving-average reference.",
         fmt="{:.2e}",
@@ -167,7 +196,17 @@ def build(w: SectionWriter) -> None:
             data["table11"].setdefault(mode, {})[a] = {"vs_truth": ct, "vs_moving_average": ct_ma}
         rows.append(tuple(row))
     w.table(
-        ["axis", "ZUPT thesis (s)", "ZUPT truth", "ZUPT MA", "TCZUPT thesis (s)", "TCZUPT truth", "TCZUPT MA", "TCZUPT σ_GBI truth", "TCZUPT σ_GBI MA"],
+        [
+            "axis",
+            "ZUPT thesis (s)",
+            "ZUPT truth",
+            "ZUPT MA",
+            "TCZUPT thesis (s)",
+            "TCZUPT truth",
+            "TCZUPT MA",
+            "TCZUPT σ_GBI truth",
+            "TCZUPT σ_GBI MA",
+        ],
         rows,
         caption="Table 11: convergence time (first |error| < 1e-5 rad/s), residual 15 deg/h. "
         "'TCZUPT σ_GBI' is the ablation with the standard-ZUPT σ_GBI.",
@@ -182,14 +221,17 @@ def build(w: SectionWriter) -> None:
         for mode in ("zupt", "tczupt"):
             truth = truth_cal if mode == "zupt" else truth_raw
             piece_log = log.slice(int(60 * log.sample_rate), log.n)
-            _, mean, std = zupt.segment_rms(piece_log, mode, truth[int(60 * log.sample_rate) :], model=model, config=cfg, segment_s=seg_s)
+            _, mean, std = zupt.segment_rms(
+                piece_log, mode, truth[int(60 * log.sample_rate) :], model=model, config=cfg, segment_s=seg_s
+            )
             for j, a in enumerate(AXES):
                 rows.append((mode.upper(), a, thesis[mode][a][0], mean[j], thesis[mode][a][1], std[j]))
                 data[f"table{tab_no}"].setdefault(mode, {})[a] = {"mean": mean[j], "std": std[j]}
         w.table(
             ["filter", "axis", "mean thesis", "mean ours", "std thesis", "std ours"],
             rows,
-            caption=f"Table {tab_no}: mean and standard deviation of the RMS error vs truth over 5 × {seg_s:g} s segments "
+            caption=f"Table {tab_no}: mean and standard deviation of the RMS error vs truth over "
+            f"5 × {seg_s:g} s segments "
             f"({'nominal' if scen == 'nominal' else 'residual 15 deg/h'}), rad/s.",
             fmt="{:.2e}",
         )
@@ -212,11 +254,17 @@ def build(w: SectionWriter) -> None:
         lo, hi = chi2.ppf([0.005, 0.995], 3 * n_mc) / n_mc
         inside = float(np.mean((nees >= lo) & (nees <= hi)))
         nees_rows.append((mode.upper(), n_mc, float(np.mean(nees)), lo, hi, inside * 100))
-        data.setdefault("nees", {})[mode] = {"mean": float(np.mean(nees)), "lo": lo, "hi": hi, "inside_pct": inside * 100}
+        data.setdefault("nees", {})[mode] = {
+            "mean": float(np.mean(nees)),
+            "lo": lo,
+            "hi": hi,
+            "inside_pct": inside * 100,
+        }
     w.table(
         ["filter", "runs", "mean NEES (3 dof)", "99 % lower", "99 % upper", "% of time inside"],
         nees_rows,
-        caption="Gyro-bias NEES averaged over Monte-Carlo runs against its χ² bounds (consistent: mean ≈ 3, ~99 % inside).",
+        caption="Gyro-bias NEES averaged over Monte-Carlo runs against its χ² bounds "
+        "(consistent: mean ≈ 3, ~99 % inside).",
         fmt="{:.3g}",
     )
 
@@ -224,7 +272,9 @@ def build(w: SectionWriter) -> None:
     rz = data["table11"]["zupt"]
     rt = data["table11"]["tczupt"]
     faster = [
-        (rt[a]["vs_truth"] is not None) and (rz[a]["vs_truth"] is None or rt[a]["vs_truth"] < rz[a]["vs_truth"]) for a in AXES
+        (rt[a]["vs_truth"] is not None)
+        and (rz[a]["vs_truth"] is None or rt[a]["vs_truth"] < rz[a]["vs_truth"])
+        for a in AXES
     ]
     rms_z = [data["table10"]["residual"]["zupt"][a]["vs_truth"] for a in AXES]
     rms_t = [data["table10"]["residual"]["tczupt"][a]["vs_truth"] for a in AXES]
@@ -264,13 +314,19 @@ def build(w: SectionWriter) -> None:
     w.table(
         ["branch", "ZUPT x", "ZUPT y", "ZUPT z", "TCZUPT x", "TCZUPT y", "TCZUPT z", "|calibration offset|"],
         hrows,
-        caption=f"Hysteresis (bias +{h:.0e} rad/s heating, −{h:.0e} cooling; calibration on the heating branch): RMS error vs truth (rad/s) per branch.",
+        caption=f"Hysteresis (bias +{h:.0e} rad/s heating, −{h:.0e} cooling; calibration on the "
+        "heating branch): RMS error vs truth (rad/s) per branch.",
         fmt="{:.2e}",
     )
     fig, ax = new_figure(7.0, 4.0)
     hz.plot_bias(0, ax=ax, reference=tz, reference_label="true residual (ZUPT)", label="ZUPT", sigma=False)
     ht.plot_bias(0, ax=ax, reference=tt, reference_label="true bias (TCZUPT)", label="TCZUPT", sigma=False)
-    w.figure(fig, "hysteresis_x", "Hysteresis study, x axis: the fixed-reference calibration leaves a −2h offset on the cooling branch for ZUPT to absorb.")
+    w.figure(
+        fig,
+        "hysteresis_x",
+        "Hysteresis study, x axis: the fixed-reference calibration leaves a −2h offset on the "
+        "cooling branch for ZUPT to absorb.",
+    )
     w.p(
         "With hysteresis the fixed calibration curve is right on one branch only: the ZUPT "
         "filter on calibrated data must absorb a 2h step every time the temperature turns. "
