@@ -40,6 +40,40 @@ fn finite3<T: Real>(what: &'static str, index: usize, v: &[T; 3]) -> Result<(), 
     }
 }
 
+/// The non-identity block rows of `Φ = I + F·Ts` (δv and ψ rows; δr rows are `I, Ts·I`),
+/// stored column-major as nalgebra converts them (`[column][row]`).
+struct PhiBlocks<T> {
+    dt: T,
+    /// `(2g/r)·Ts` on the δv_D ← δr_D entry.
+    dd: T,
+    vv: [[T; 3]; 3],
+    vp: [[T; 3]; 3],
+    vb: [[T; 3]; 3],
+    pp: [[T; 3]; 3],
+}
+
+impl<T: Real> PhiBlocks<T> {
+    /// `(Φ·x)[0..9]` for a 15-vector `x` (the bias rows of `Φ·x` equal those of `x`).
+    #[inline(always)]
+    fn apply(&self, x: &[T; N_STATES]) -> [T; 9] {
+        let mut y = [T::zero(); 9];
+        for i in 0..3 {
+            y[i] = x[i] + self.dt * x[3 + i];
+            let mut v = x[3 + i];
+            let mut p = x[6 + i];
+            for k in 0..3 {
+                // [k][i] is row i, column k of the block (column-major storage).
+                v += self.vv[k][i] * x[3 + k] + self.vp[k][i] * x[6 + k] + self.vb[k][i] * x[9 + k];
+                p += self.pp[k][i] * x[6 + k] + self.vb[k][i] * x[12 + k];
+            }
+            y[3 + i] = v;
+            y[6 + i] = p;
+        }
+        y[5] += self.dd * x[2];
+        y
+    }
+}
+
 /// The ZUPT / TCZUPT filter (see the module docs for the model). Allocation-free and
 /// `Copy`-free by design (it holds a 15×15 covariance and the temperature window).
 #[derive(Debug, Clone)]
@@ -260,39 +294,37 @@ impl<T: Real> ZuptFilter<T> {
         let a_dd = self.grav_grad * dt;
         match self.cfg.discretisation {
             Discretisation::FirstOrder => {
-                // B = Φ·P by block rows (only δr, δv and ψ rows differ from P) …
-                let p = &self.p;
-                let mut b = *p;
-                let r_v = p.fixed_rows::<3>(3);
-                let r_p = p.fixed_rows::<3>(6);
-                let top = p.fixed_rows::<3>(0) + r_v * dt;
-                let mut vel = r_v + a_vv * r_v + a_vp * r_p + a_vb * p.fixed_rows::<3>(9);
-                // Vertical gravity gradient: only the δv_D row gets (2g/r)·Ts·δr_D.
+                // Only the δr, δv and ψ block rows of Φ differ from I, so P⁻ = Φ·P·Φᵀ needs
+                // only (Φ·x)[0..9] of 15-vectors x: first for the 15 columns of P (giving
+                // M = (Φ·P)[0..9, :]), then for the 9 rows of M (giving P⁻[0..9, 0..9]); the
+                // bias blocks are P⁻[0..9, 9..] = M[:, 9..] and P⁻[9.., 9..] = P[9.., 9..].
+                // Plain scalar loops over fixed arrays: the compiler unrolls them fully.
+                let blocks = PhiBlocks {
+                    dt,
+                    dd: a_dd,
+                    vv: a_vv.into(),
+                    vp: a_vp.into(),
+                    vb: a_vb.into(),
+                    pp: a_pp.into(),
+                };
+                let mut m = [[T::zero(); N_STATES]; 9];
                 for j in 0..N_STATES {
-                    vel[(2, j)] += p[(2, j)] * a_dd;
+                    let col: [T; N_STATES] = core::array::from_fn(|i| self.p[(i, j)]);
+                    let y = blocks.apply(&col);
+                    for (i, v) in y.iter().enumerate() {
+                        m[i][j] = *v;
+                    }
                 }
-                let att = r_p + a_pp * r_p + a_vb * p.fixed_rows::<3>(12);
-                b.fixed_rows_mut::<3>(0).copy_from(&top);
-                b.fixed_rows_mut::<3>(3).copy_from(&vel);
-                b.fixed_rows_mut::<3>(6).copy_from(&att);
-                // … then P⁻ = B·Φᵀ by block columns, with the transposed 3×3 blocks.
-                let mut out = b;
-                let c_v = b.fixed_columns::<3>(3);
-                let c_p = b.fixed_columns::<3>(6);
-                let left = b.fixed_columns::<3>(0) + c_v * dt;
-                let mut vcol = c_v
-                    + c_v * a_vv.transpose()
-                    + c_p * a_vp.transpose()
-                    + b.fixed_columns::<3>(9) * a_vb.transpose();
-                for i in 0..N_STATES {
-                    vcol[(i, 2)] += b[(i, 2)] * a_dd;
+                for (i, row) in m.iter().enumerate() {
+                    let y = blocks.apply(row);
+                    for (j, v) in y.iter().enumerate() {
+                        self.p[(i, j)] = *v;
+                    }
+                    for j in 9..N_STATES {
+                        self.p[(i, j)] = row[j];
+                        self.p[(j, i)] = row[j];
+                    }
                 }
-                let pcol =
-                    c_p + c_p * a_pp.transpose() + b.fixed_columns::<3>(12) * a_vb.transpose();
-                out.fixed_columns_mut::<3>(0).copy_from(&left);
-                out.fixed_columns_mut::<3>(3).copy_from(&vcol);
-                out.fixed_columns_mut::<3>(6).copy_from(&pcol);
-                self.p = out;
             }
             Discretisation::SecondOrder => {
                 let mut f = Mat15::<T>::zeros();
