@@ -1,6 +1,6 @@
 //! The filter kernel: strapdown mechanisation, block-structured covariance propagation, the
 //! nine-measurement ZUPT update in Joseph form, feedback and reset; and the batch runner.
-use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, SMatrix, SVector, UnitQuaternion, Vector3};
 
 use super::slope::SlopeEstimator;
 use super::{
@@ -53,24 +53,33 @@ struct PhiBlocks<T> {
 }
 
 impl<T: Real> PhiBlocks<T> {
-    /// `(Φ·x)[0..9]` for a 15-vector `x` (the bias rows of `Φ·x` equal those of `x`).
+    /// `(Φ·S)[0..9, :]` for a 15×L matrix `S` given by its rows `src[k]` (the bias rows of
+    /// `Φ·S` equal those of `S`). Each output row is a few AXPYs over contiguous length-L
+    /// rows, which the compiler vectorises.
     #[inline(always)]
-    fn apply(&self, x: &[T; N_STATES]) -> [T; 9] {
-        let mut y = [T::zero(); 9];
+    fn rows<const L: usize>(&self, src: &[[T; L]; N_STATES]) -> [[T; L]; 9] {
+        let mut out = [[T::zero(); L]; 9];
         for i in 0..3 {
-            y[i] = x[i] + self.dt * x[3 + i];
-            let mut v = x[3 + i];
-            let mut p = x[6 + i];
+            for l in 0..L {
+                out[i][l] = src[i][l] + self.dt * src[3 + i][l];
+            }
+            let mut v = src[3 + i];
+            let mut p = src[6 + i];
             for k in 0..3 {
                 // [k][i] is row i, column k of the block (column-major storage).
-                v += self.vv[k][i] * x[3 + k] + self.vp[k][i] * x[6 + k] + self.vb[k][i] * x[9 + k];
-                p += self.pp[k][i] * x[6 + k] + self.vb[k][i] * x[12 + k];
+                let (a, b, c, d) = (self.vv[k][i], self.vp[k][i], self.vb[k][i], self.pp[k][i]);
+                for l in 0..L {
+                    v[l] += a * src[3 + k][l] + b * src[6 + k][l] + c * src[9 + k][l];
+                    p[l] += d * src[6 + k][l] + c * src[12 + k][l];
+                }
             }
-            y[3 + i] = v;
-            y[6 + i] = p;
+            out[3 + i] = v;
+            out[6 + i] = p;
         }
-        y[5] += self.dd * x[2];
-        y
+        for l in 0..L {
+            out[5][l] += self.dd * src[2][l];
+        }
+        out
     }
 }
 
@@ -264,10 +273,25 @@ impl<T: Real> ZuptFilter<T> {
         let f_hat = Vector3::from(*accel_m_s2) - self.ba;
         let c = quat_to_dcm(&self.q);
         // Attitude: body rotation on the right, Earth rotation of the NED frame on the left.
-        let q_body = quat_from_rotation_vector(&(w_hat * dt));
-        self.q = UnitQuaternion::new_normalize(
-            self.q_earth.into_inner() * self.q.into_inner() * q_body.into_inner(),
-        );
+        let phi = w_hat * dt;
+        let n2 = phi.norm_squared();
+        let q_body = if n2 < lit(1e-8) {
+            // exp(φ/2) to 4th order: the truncation (|φ|⁶/46080 < 3e-29) is below f64
+            // resolution, and the product is renormalised below.
+            let k = lit::<T>(0.5) - n2 / lit(48.0);
+            Quaternion::new(
+                T::one() - n2 / lit(8.0) + n2 * n2 / lit(384.0),
+                phi.x * k,
+                phi.y * k,
+                phi.z * k,
+            )
+        } else {
+            quat_from_rotation_vector(&phi).into_inner()
+        };
+        let q = self.q_earth.into_inner() * self.q.into_inner() * q_body;
+        // One Newton step towards |q| = 1 (|q|² − 1 is O(1e-16) here): no sqrt, no division.
+        let s = (lit::<T>(3.0) - q.norm_squared()) * lit::<T>(0.5);
+        self.q = UnitQuaternion::new_unchecked(q * s);
         let f_n = c * f_hat;
         let g = self.g0 + self.grav_grad * self.pos.z;
         let acc = f_n + Vector3::new(T::zero(), T::zero(), g)
@@ -284,6 +308,8 @@ impl<T: Real> ZuptFilter<T> {
     }
 
     /// `P ← Φ·P·Φᵀ + Γ`.
+    // Index loops mirror the block algebra (row i, column j) and unroll fully.
+    #[allow(clippy::needless_range_loop)]
     fn propagate_covariance(&mut self, c: &Matrix3<T>, f_n: &Vector3<T>) {
         let dt = self.dt;
         let w = skew(&self.w_ie);
@@ -307,22 +333,24 @@ impl<T: Real> ZuptFilter<T> {
                     vb: a_vb.into(),
                     pp: a_pp.into(),
                 };
-                let mut m = [[T::zero(); N_STATES]; 9];
-                for j in 0..N_STATES {
-                    let col: [T; N_STATES] = core::array::from_fn(|i| self.p[(i, j)]);
-                    let y = blocks.apply(&col);
-                    for (i, v) in y.iter().enumerate() {
-                        m[i][j] = *v;
+                // P is symmetric, so its column-major columns are also its rows.
+                let m = blocks.rows(&self.p.data.0); // M = (Φ·P)[0..9, :], row-major
+                let mut mt = [[T::zero(); 9]; N_STATES]; // Mᵀ
+                for (i, row) in m.iter().enumerate() {
+                    for (j, v) in row.iter().enumerate() {
+                        mt[j][i] = *v;
                     }
                 }
-                for (i, row) in m.iter().enumerate() {
-                    let y = blocks.apply(row);
-                    for (j, v) in y.iter().enumerate() {
-                        self.p[(i, j)] = *v;
-                    }
-                    for j in 9..N_STATES {
-                        self.p[(i, j)] = row[j];
-                        self.p[(j, i)] = row[j];
+                // (Φ·Mᵀ)[0..9, :] = (M·Φᵀ)ᵀ[0..9, 0..9] = P⁻[0..9, 0..9] (symmetric).
+                let n = blocks.rows(&mt);
+                let cols = &mut self.p.data.0;
+                for (a, row) in n.iter().enumerate() {
+                    cols[a][..9].copy_from_slice(row);
+                }
+                for j in 9..N_STATES {
+                    cols[j][..9].copy_from_slice(&mt[j]);
+                    for i in 0..9 {
+                        cols[i][j] = mt[j][i];
                     }
                 }
             }
