@@ -26,6 +26,7 @@ __all__ = [
     "attitude_rotation_angle",
     "noise_fit_ieee952",
     "noise_read_points",
+    "zupt_detect_static",
     "zupt_run",
 ]
 
@@ -113,3 +114,16 @@ def zupt_run(
     gyro_bias (m, 3), accel_bias (m, 3), attitude (m, 4), cov_diag (m, 15), temp_rate (m,),
     initial_attitude [4], updates, mean_nis; m = ceil(n / decimation).
     """
+
+def zupt_detect_static(
+    accel: NDArray[np.float64],
+    gyro: NDArray[np.float64],
+    *,
+    sigma_accel_m_s2: float = 0.05,
+    sigma_gyro_rad_s: float = 0.01,
+    window_samples: int = 25,
+    threshold: float = 10.0,
+    gravity_m_s2: float = 9.80665,
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """GLRT (SHOE) stationarity statistic T (n,) and mask T < threshold (n,) of accel (n, 3)
+    m/s² and gyro (n, 3) rad/s over a centred window of window_samples samples."""

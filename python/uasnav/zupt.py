@@ -309,7 +309,7 @@ def run(
     model: ThermalModel | None = None,
     config: ZuptConfig | None = None,
     *,
-    stationary: ArrayLike | None = None,
+    stationary: ArrayLike | Literal["auto"] | None = None,
 ) -> ZuptResult:
     """Run the ZUPT or TCZUPT filter over a whole log (one call into Rust, GIL released).
 
@@ -323,9 +323,10 @@ def run(
         Thermal bias model. ZUPT: subtracted before filtering (None → data already calibrated).
         TCZUPT: required; its derivative drives eq. (31).
     config : ZuptConfig, optional
-    stationary : array_like of bool, shape (n,), optional
-        Per-sample stationarity (e.g. ``uasnav.stationary.detect_static(log).mask``); ZUPT
-        updates are applied only where true. Default: stationary throughout.
+    stationary : array_like of bool, shape (n,), or "auto", optional
+        Per-sample stationarity; ZUPT updates are applied only where true. ``"auto"`` runs
+        :func:`detect_stationary` with its default thresholds. Default: stationary
+        throughout.
 
     Returns
     -------
@@ -358,7 +359,11 @@ def run(
             raise InputError("log.temp: calibrating with a model needs the die temperature")
         gyro = gyro - _model_rows("model.predict(temp)", model.predict(log.temp), log.n)
     mask = None
-    if stationary is not None:
+    if isinstance(stationary, str):
+        if stationary != "auto":
+            raise InputError(f"stationary: expected a bool array or 'auto', got {stationary!r}")
+        mask = detect_stationary(log).mask
+    elif stationary is not None:
         mask = np.ascontiguousarray(np.asarray(stationary, dtype=bool))
         if mask.shape != (log.n,):
             raise InputError(f"stationary: expected shape ({log.n},), got {mask.shape}")
@@ -402,6 +407,60 @@ def run(
         mean_nis=float(out["mean_nis"]),
         meta={"rate_hz": rate, "n": log.n},
     )
+
+
+@dataclass(frozen=True)
+class StationarityResult:
+    """Output of :func:`detect_stationary`.
+
+    Attributes
+    ----------
+    mask : ndarray of bool, shape (n,)
+        True where the unit is declared stationary (``statistic < threshold``).
+    statistic : ndarray, shape (n,)
+        GLRT statistic T (dimensionless) over the centred window.
+    intervals : list of (float, float)
+        ``(t_start, t_end)`` (s) of each stationary run.
+    """
+
+    mask: NDArray[np.bool_]
+    statistic: FloatArray
+    intervals: list[tuple[float, float]]
+
+
+def detect_stationary(
+    log: ImuLog,
+    *,
+    window_s: float = 0.25,
+    sigma_accel_m_s2: float = 0.05,
+    sigma_gyro_rad_s: float = 0.01,
+    threshold: float = 10.0,
+    gravity_m_s2: float = 9.80665,
+) -> StationarityResult:
+    """Per-sample stationarity by the generalised likelihood ratio test ("SHOE", Skog et al.
+    2010) computed in Rust (``nav_core::zupt::StationarityDetector``, the same test the
+    filter can run per sample on a microcontroller).
+
+    ``T = (1/W)·Σ [‖a − g·ā/‖ā‖‖²/σ_a² + ‖ω‖²/σ_ω²]`` over a centred window of ``window_s``;
+    stationary where ``T < threshold``. The defaults (σ_a = 0.05 m/s², σ_ω = 0.01 rad/s,
+    0.25 s, γ = 10) give T ≈ 2–3 for a consumer MEMS IMU at rest and 10²–10⁴ in motion; raise
+    the σ for noisier sensors.
+    """
+    rate = log.sample_rate
+    w = max(1, min(256, round(window_s * rate)))
+    stat, mask = _core.zupt_detect_static(
+        np.ascontiguousarray(log.accel),
+        np.ascontiguousarray(log.gyro),
+        sigma_accel_m_s2=sigma_accel_m_s2,
+        sigma_gyro_rad_s=sigma_gyro_rad_s,
+        window_samples=w,
+        threshold=threshold,
+        gravity_m_s2=gravity_m_s2,
+    )
+    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    intervals = [(float(log.t[a]), float(log.t[b])) for a, b in zip(starts, ends, strict=True)]
+    return StationarityResult(mask=mask, statistic=stat, intervals=intervals)
 
 
 def _model_rows(name: str, a: ArrayLike, n: int) -> FloatArray:
@@ -525,10 +584,12 @@ __all__ = [
     "STATE_NAMES",
     "THESIS_TCZUPT_NOISE",
     "THESIS_ZUPT_NOISE",
+    "StationarityResult",
     "ThermalModel",
     "ZuptConfig",
     "ZuptResult",
     "convergence_time",
+    "detect_stationary",
     "moving_average",
     "moving_average_reference",
     "reference_residual",

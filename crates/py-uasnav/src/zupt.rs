@@ -1,10 +1,10 @@
 //! Binding of `nav_core::zupt`: one call runs a whole log (GIL released).
 use nav_core::zupt::{
-    BatchInput, BatchOutput, DerivativeTable, Discretisation, HeadingSource, Mode, NoDerivative,
-    ZuptConfig, ZuptFilter, N_STATES,
+    detect_static, BatchInput, BatchOutput, DerivativeTable, Discretisation, HeadingSource, Mode,
+    NoDerivative, StationarityConfig, ZuptConfig, ZuptFilter, N_STATES,
 };
 use numpy::ndarray::{Array1, Array2};
-use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -217,7 +217,44 @@ fn config_or_default(
     config(py, mode, discretisation, values)
 }
 
+type StaticArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// GLRT (SHOE) stationarity statistic and mask (n,) of a log with a centred window.
+#[pyfunction]
+#[pyo3(signature = (accel, gyro, *, sigma_accel_m_s2=0.05, sigma_gyro_rad_s=0.01,
+    window_samples=25, threshold=10.0, gravity_m_s2=9.80665))]
+#[allow(clippy::too_many_arguments)]
+fn zupt_detect_static<'py>(
+    py: Python<'py>,
+    accel: PyReadonlyArray2<'py, f64>,
+    gyro: PyReadonlyArray2<'py, f64>,
+    sigma_accel_m_s2: f64,
+    sigma_gyro_rad_s: f64,
+    window_samples: usize,
+    threshold: f64,
+    gravity_m_s2: f64,
+) -> PyResult<StaticArrays<'py>> {
+    let a = rows::<3>(py, "accel", &accel)?;
+    let g = rows::<3>(py, "gyro", &gyro)?;
+    let cfg = StationarityConfig {
+        sigma_accel_m_s2,
+        sigma_gyro_rad_s,
+        window_samples,
+        threshold,
+        gravity_m_s2,
+    };
+    let (stat, mask) = py
+        .detach(|| {
+            let mut stat = vec![0.0; a.len()];
+            let mut mask = vec![false; a.len()];
+            detect_static(a, g, cfg, &mut stat, &mut mask).map(|_| (stat, mask))
+        })
+        .py_err(py)?;
+    Ok((stat.into_pyarray(py), mask.into_pyarray(py)))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(zupt_run, m)?)?;
+    m.add_function(wrap_pyfunction!(zupt_detect_static, m)?)?;
     Ok(())
 }

@@ -97,6 +97,10 @@ pub struct ZuptFilter<T: Real> {
     bg: Vector3<T>,
     // Frozen references of the ZUPT measurement.
     q0: UnitQuaternion<T>,
+    /// Frozen position (m, NED displacement from the start).
+    pos0: Vector3<T>,
+    /// Whether the previous sample was flagged stationary (re-freeze on a new rest period).
+    was_stationary: bool,
     // Error covariance P (15×15).
     p: Mat15<T>,
     // Earth model at the frozen position.
@@ -179,6 +183,8 @@ impl<T: Real> ZuptFilter<T> {
             ba: accel_bias_m_s2,
             bg: gyro_bias_rad_s,
             q0,
+            pos0: Vector3::zeros(),
+            was_stationary: true,
             p,
             w_ie: earth::earth_rate_ned(config.latitude_rad),
             q_earth: quat_from_rotation_vector(
@@ -390,7 +396,7 @@ impl<T: Real> ZuptFilter<T> {
         };
         let psi = Vector3::new(dq.i, dq.j, dq.k) * (lit::<T>(2.0) * s);
         let mut z = Vec9::<T>::zeros();
-        z.fixed_rows_mut::<3>(0).copy_from(&self.pos);
+        z.fixed_rows_mut::<3>(0).copy_from(&(self.pos - self.pos0));
         z.fixed_rows_mut::<3>(3).copy_from(&self.vel);
         z.fixed_rows_mut::<3>(6).copy_from(&psi);
 
@@ -466,6 +472,14 @@ impl<T: Real> ZuptFilter<T> {
             rate = deriv.dbias_dtemp(self.index, temp) * dtdt;
         }
         self.predict(gyro_rad_s, accel_m_s2, &rate)?;
+        if stationary && !self.was_stationary {
+            // A new rest period after motion: the unit may have moved and turned, so the
+            // position and attitude references are re-frozen at the current solution (only
+            // the zero-velocity measurement stays absolute).
+            self.q0 = self.q;
+            self.pos0 = self.pos;
+        }
+        self.was_stationary = stationary;
         self.since_update += 1;
         if self.since_update >= self.steps_per_update {
             self.since_update = 0;

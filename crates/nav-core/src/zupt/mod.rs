@@ -46,10 +46,18 @@
 //! `∂b/∂T` from a [`BiasTemperatureDerivative`] (e.g. the MLP engine's analytic derivative)
 //! and `dT/dt` from the sliding-window least-squares slope of the die temperature
 //! ([`SlopeEstimator`]); σ'_GBI is configured smaller than the raw bias instability (Table 5).
+//!
+//! # Stationarity
+//! Updates are applied only on samples flagged stationary; [`StationarityDetector`] is the
+//! generalised likelihood ratio test (SHOE) with documented default thresholds. When a new
+//! rest period starts after motion, the position and attitude references are re-frozen at
+//! the current solution (the unit may have been moved); zero velocity stays absolute.
+mod detect;
 mod filter;
 mod init;
 mod slope;
 
+pub use detect::{detect_static, StationarityConfig, StationarityDetector, DETECT_CAPACITY};
 #[cfg(test)]
 use filter::skew as filter_test_skew;
 pub use filter::{BatchInput, BatchOutput, BatchSummary, ZuptFilter};
