@@ -67,10 +67,18 @@ impl<T: Real> PhiBlocks<T> {
             let mut p = src[6 + i];
             for k in 0..3 {
                 // [k][i] is row i, column k of the block (column-major storage).
-                let (a, b, c, d) = (self.vv[k][i], self.vp[k][i], self.vb[k][i], self.pp[k][i]);
+                let c = self.vb[k][i];
                 for l in 0..L {
-                    v[l] += a * src[3 + k][l] + b * src[6 + k][l] + c * src[9 + k][l];
-                    p[l] += d * src[6 + k][l] + c * src[12 + k][l];
+                    v[l] += c * src[9 + k][l];
+                    p[l] += c * src[12 + k][l];
+                }
+                // vv, vp and pp are skew-symmetric: their diagonal is zero.
+                if k != i {
+                    let (a, b, d) = (self.vv[k][i], self.vp[k][i], self.pp[k][i]);
+                    for l in 0..L {
+                        v[l] += a * src[3 + k][l] + b * src[6 + k][l];
+                        p[l] += d * src[6 + k][l];
+                    }
                 }
             }
             out[3 + i] = v;
