@@ -24,9 +24,10 @@
 //! discretised as `Φ ≈ I + F·Ts` (eq. 16, or with the second-order term `(F·Ts)²/2`,
 //! [`Discretisation`]) and `Γ = G·Q·Gᵀ·Ts` (eq. 18) with `Q = diag(σ_VRW², σ_ARW², σ_ABI²,
 //! σ_GBI²)` (eqs. 22–25). Because `Q` is isotropic within each group, `Ĉ·σ²I·Ĉᵀ = σ²I` and
-//! `Γ` is diagonal. `Φ·P·Φᵀ` is evaluated block-wise: only the velocity and attitude block
-//! rows of `Φ` differ from the identity, so one left product costs 5·135 multiply-adds
-//! instead of 3375.
+//! `Γ` is diagonal. `Φ·P·Φᵀ` is evaluated block-wise: only the δr, δv and ψ block rows of
+//! `Φ` differ from the identity, so `P⁻` needs `(Φ·x)[0..9]` of the 15 columns of `P` and of
+//! the 9 rows of `(Φ·P)[0..9, :]` (≈ 960 multiply-adds, skipping the zero diagonals of the
+//! skew blocks) instead of two dense 15×15 products (6750).
 //!
 //! Note on σ_GBI: the thesis (eq. 25) puts the bias instability (rad/s) straight on the
 //! diagonal of Q, so the bias random walk has the numerical PSD σ_GBI² (read as
