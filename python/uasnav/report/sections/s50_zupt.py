@@ -182,34 +182,50 @@ def build(w: SectionWriter) -> None:
         fmt="{:.2e}",
     )
 
-    # Table 11.
+    # Table 11. Two starts: after the 60 s zeroing (as in the thesis; its own error is
+    # σ_ARW/√60 s ≈ 1.2e-4 rad/s per axis, larger than 15 deg/h), and from the exact initial
+    # bias + 15 deg/h (zeroing off), which isolates the scenario.
+    exact = {}
+    for mode in ("zupt", "tczupt", "tczupt_sgbi"):
+        tru0 = (truth_cal if mode == "zupt" else truth_raw)[0]
+        cfg = base.replace(
+            zeroing=False,
+            gyro_bias0_rad_s=tuple(float(v) for v in tru0),
+            residual_gyro_bias_rad_s=zupt.RESIDUAL_BIAS_15DEG_H,
+        )
+        if mode == "tczupt_sgbi":
+            cfg = cfg.replace(noise=zupt.THESIS_ZUPT_NOISE)
+        exact[mode] = zupt.run(log, "zupt" if mode == "zupt" else "tczupt", model, cfg)
     rows = []
     for j, a in enumerate(AXES):
-        row = [a]
+        row: list[Any] = [a]
         for mode in ("zupt", "tczupt", "tczupt_sgbi"):
+            tru = refs[mode][1][::dec]
             r = runs["residual"][mode]
-            ct = zupt.convergence_time(r.t, r.gyro_bias, refs[mode][1][::dec])[j]
-            ct_ma = zupt.convergence_time(r.t, r.gyro_bias, refs[mode][0][::dec])[j]
+            ct = zupt.convergence_time(r.t, r.gyro_bias, tru)[j]
+            ce = zupt.convergence_time(exact[mode].t, exact[mode].gyro_bias, tru)[j]
             if mode != "tczupt_sgbi":
                 row.append(TABLE11[a][0 if mode == "zupt" else 1])
-            row += [_fmt_t(ct), _fmt_t(ct_ma)]
-            data["table11"].setdefault(mode, {})[a] = {"vs_truth": ct, "vs_moving_average": ct_ma}
+            row += [_fmt_t(ct), _fmt_t(ce)]
+            data["table11"].setdefault(mode, {})[a] = {"after_zeroing": ct, "exact_start": ce}
         rows.append(tuple(row))
     w.table(
         [
             "axis",
             "ZUPT thesis (s)",
-            "ZUPT truth",
-            "ZUPT MA",
+            "ZUPT zeroed",
+            "ZUPT exact+15°/h",
             "TCZUPT thesis (s)",
-            "TCZUPT truth",
-            "TCZUPT MA",
-            "TCZUPT σ_GBI truth",
-            "TCZUPT σ_GBI MA",
+            "TCZUPT zeroed",
+            "TCZUPT exact+15°/h",
+            "TCZUPT σ_GBI zeroed",
+            "TCZUPT σ_GBI exact+15°/h",
         ],
         rows,
-        caption="Table 11: convergence time (first |error| < 1e-5 rad/s), residual 15 deg/h. "
-        "'TCZUPT σ_GBI' is the ablation with the standard-ZUPT σ_GBI.",
+        caption="Table 11: convergence time (first |error vs true bias| < 1e-5 rad/s), residual "
+        "15 deg/h. 'zeroed': start after the 60 s zeroing + 15 deg/h; 'exact+15°/h': start at the "
+        "true bias + 15 deg/h. 'TCZUPT σ_GBI': ablation with the standard-ZUPT σ_GBI. Against "
+        "the moving average (noise 1.7e-4 rad/s) a 1e-5 threshold is met only by chance.",
     )
 
     # Tables 12–13: five consecutive segments.
@@ -268,29 +284,45 @@ def build(w: SectionWriter) -> None:
         fmt="{:.3g}",
     )
 
-    # Claim check.
-    rz = data["table11"]["zupt"]
-    rt = data["table11"]["tczupt"]
-    faster = [
-        (rt[a]["vs_truth"] is not None)
-        and (rz[a]["vs_truth"] is None or rt[a]["vs_truth"] < rz[a]["vs_truth"])
-        for a in AXES
-    ]
-    rms_z = [data["table10"]["residual"]["zupt"][a]["vs_truth"] for a in AXES]
-    rms_t = [data["table10"]["residual"]["tczupt"][a]["vs_truth"] for a in AXES]
-    not_worse = [t <= 1.1 * z for t, z in zip(rms_t, rms_z, strict=True)]
-    data["claim"] = {"tczupt_faster_axes": sum(faster), "tczupt_not_worse_rms_axes": sum(not_worse)}
+    # Claim check, from the numbers above.
+    faster = 0
+    for a in AXES:
+        tz_, tt_ = data["table11"]["zupt"][a]["exact_start"], data["table11"]["tczupt"][a]["exact_start"]
+        faster += int(tt_ is not None and (tz_ is None or tt_ < tz_))
+    rms = {
+        m: np.array([zupt.rms_error(runs["residual"][m].gyro_bias, refs[m][1][::dec])[j] for j in range(3)])
+        for m in ("zupt", "tczupt", "tczupt_sgbi")
+    }
+    not_worse = int(np.sum(rms["tczupt"] <= 1.1 * rms["zupt"]))
+    ratio = float(np.mean(rms["tczupt"] / rms["zupt"]))
+    ratio_abl = float(np.mean(rms["tczupt_sgbi"] / rms["zupt"]))
+    verdict = "confirmed" if faster >= 2 and not_worse >= 2 else "not confirmed"
+    data["claim"] = {
+        "tczupt_faster_axes_exact_start": faster,
+        "tczupt_not_worse_rms_axes": not_worse,
+        "mean_rms_ratio_tczupt_over_zupt": ratio,
+        "mean_rms_ratio_tczupt_standard_sgbi_over_zupt": ratio_abl,
+        "verdict": verdict,
+    }
     w.p(
-        f"Thesis claim (TCZUPT converges faster in the 15 deg/h scenario and is not worse in RMS): "
-        f"TCZUPT converged first on {sum(faster)}/3 axes and its whole-run RMS vs truth is within 10 % "
-        f"of ZUPT's or better on {sum(not_worse)}/3 axes. Our analysis: both filters start from the "
-        "same zeroing estimate and have the same bias observability (the frozen-attitude "
-        "measurement observes ψ directly, so the bias estimate is essentially a P-weighted "
-        "average of the gyro output). What speeds TCZUPT up is mostly its larger σ'_GBI "
-        "(Table 5), which keeps the gain higher — compare the ablation column with the standard "
-        "σ_GBI. Eq. 31 itself matters while the temperature changes: it moves the estimate "
-        "along the calibration slope without waiting for the measurements, which is what keeps "
-        "TCZUPT on raw data as good as ZUPT on calibrated data."
+        "Thesis claim — TCZUPT converges faster in the 15 deg/h scenario and is not worse in "
+        f"RMS over the whole run: {verdict.upper()} on our data. From the exact start + 15 deg/h, "
+        f"TCZUPT converged first on {faster}/3 axes; its whole-run RMS error vs truth is within "
+        f"10 % of ZUPT's on {not_worse}/3 axes (mean ratio TCZUPT/ZUPT {ratio:.2f}; with the "
+        f"standard σ_GBI instead of Table 5's σ'_GBI the ratio is {ratio_abl:.2f}). Analysis: both "
+        "filters have the same bias observability (the frozen-attitude measurement observes ψ "
+        "directly, so the bias estimate is a P-weighted average of the gyro output minus the "
+        "propagated drift). TCZUPT's larger σ'_GBI keeps its gain higher: faster reaction, but "
+        "more of the σ_ARW white noise passes into the estimate, which raises the RMS. Eq. 31 "
+        "moves the estimate along ∂b/∂T·dT/dt between updates, so on raw data it tracks the "
+        "thermal drift that ZUPT only sees after calibration; with an accurate calibration (as "
+        "here) ZUPT on calibrated data has no drift left to track, and the smaller σ_GBI wins. "
+        "The thesis' advantage may come from a calibration residual larger than in this "
+        "stand-in, or from a different noise/zeroing set-up; we cannot reproduce it. Note on "
+        "Table 11's metric: with σ_ARW = 3.18 deg/√h the 1σ of any bias estimate after t s of "
+        "data is ≈ σ_ARW/√t, above 1e-5 rad/s until t ≈ 8 500 s, so the first crossing of "
+        "1e-5 rad/s is a chance event of the noise (here within seconds to minutes, equal for "
+        "both filters), not a convergence time in the sense of the error staying below it."
     )
 
     # Hysteresis study.
