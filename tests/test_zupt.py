@@ -248,3 +248,24 @@ def test_xio_stationary_intervals_detected_and_used(shared_data):
     u = a.mean(axis=0) / np.linalg.norm(a.mean(axis=0))
     direct = np.mean(np.sum((a - 9.80665 * u) ** 2, axis=1) / 0.05**2 + np.sum(g**2, axis=1) / 0.01**2)
     assert s.statistic[k] == pytest.approx(direct, rel=1e-9)
+
+
+def test_rust_earth_model_matches_closed_forms():
+    """nav_core::earth (what the filter uses) against the WGS-84 closed forms written out here
+    (Somigliana, Groves eq. 2.139 free-air factor, radii of curvature)."""
+    a, e2, f = 6378137.0, 6.69437999014e-3, 1 / 298.257223563
+    b, mu, w = 6356752.31425, 3.986004418e14, 7.292115e-5
+    for lat_deg, h in ((0.0, 0.0), (45.0, 0.0), (51.08, 1100.0), (-89.0, 50.0), (90.0, 0.0)):
+        lat = np.deg2rad(lat_deg)
+        s2 = np.sin(lat) ** 2
+        g0 = 9.7803253359 * (1 + 0.00193185265241 * s2) / np.sqrt(1 - e2 * s2)
+        g = g0 * (1 - 2 * h / a * (1 + f + w * w * a * a * b / mu) + 3 * h * h / a**2)
+        assert _core.earth_normal_gravity(lat, h) == pytest.approx(g, rel=1e-14)
+        np.testing.assert_allclose(
+            _core.earth_rate_ned(lat), w * np.array([np.cos(lat), 0, -np.sin(lat)]), atol=1e-20
+        )
+        rn, re = _core.earth_radii(lat)
+        assert rn == pytest.approx(a * (1 - e2) / (1 - e2 * s2) ** 1.5, rel=1e-14)
+        assert re == pytest.approx(a / np.sqrt(1 - e2 * s2), rel=1e-14)
+    with pytest.raises(InputError, match="latitude_rad"):
+        _core.earth_normal_gravity(float("nan"), 0.0)

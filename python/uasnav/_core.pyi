@@ -24,6 +24,9 @@ __all__ = [
     "attitude_quat_to_dcm",
     "attitude_quat_to_euler",
     "attitude_rotation_angle",
+    "earth_normal_gravity",
+    "earth_radii",
+    "earth_rate_ned",
     "noise_fit_ieee952",
     "noise_read_points",
     "zupt_detect_static",
@@ -127,3 +130,13 @@ def zupt_detect_static(
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """GLRT (SHOE) stationarity statistic T (n,) and mask T < threshold (n,) of accel (n, 3)
     m/s² and gyro (n, 3) rad/s over a centred window of window_samples samples."""
+
+# --- earth -----------------------------------------------------------------------------------
+def earth_normal_gravity(latitude_rad: float, height_m: float) -> float:
+    """WGS-84 normal gravity (m/s²) at geodetic latitude (rad) and ellipsoidal height (m)."""
+
+def earth_rate_ned(latitude_rad: float) -> list[float]:
+    """Earth rotation rate resolved in NED (rad/s) at geodetic latitude (rad)."""
+
+def earth_radii(latitude_rad: float) -> tuple[float, float]:
+    """Meridian and transverse radii of curvature (m) at geodetic latitude (rad)."""

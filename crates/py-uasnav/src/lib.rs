@@ -5,6 +5,7 @@
 mod allan;
 mod attitude;
 mod convert;
+mod earth;
 mod errors;
 mod zupt;
 
@@ -16,6 +17,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     allan::register(m)?;
     attitude::register(m)?;
+    earth::register(m)?;
     zupt::register(m)?;
     Ok(())
 }
