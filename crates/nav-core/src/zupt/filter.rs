@@ -91,8 +91,8 @@ impl<T: Real> PhiBlocks<T> {
     }
 }
 
-/// The ZUPT / TCZUPT filter (see the module docs for the model). Allocation-free and
-/// `Copy`-free by design (it holds a 15×15 covariance and the temperature window).
+/// The ZUPT / TCZUPT filter (see the module docs for the model). Never allocates; `Clone`
+/// but not `Copy` (it holds a 15×15 covariance and the 512-sample temperature window).
 #[derive(Debug, Clone)]
 pub struct ZuptFilter<T: Real> {
     cfg: ZuptConfig<T>,
