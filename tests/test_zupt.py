@@ -259,7 +259,7 @@ def test_rust_earth_model_matches_closed_forms():
         lat = np.deg2rad(lat_deg)
         s2 = np.sin(lat) ** 2
         g0 = 9.7803253359 * (1 + 0.00193185265241 * s2) / np.sqrt(1 - e2 * s2)
-        g = g0 * (1 - 2 * h / a * (1 + f + w * w * a * a * b / mu) + 3 * h * h / a**2)
+        g = g0 * (1 - 2 * h / a * (1 + f * (1 - 2 * s2) + w * w * a * a * b / mu) + 3 * h * h / a**2)
         assert _core.earth_normal_gravity(lat, h) == pytest.approx(g, rel=1e-14)
         np.testing.assert_allclose(
             _core.earth_rate_ned(lat), w * np.array([np.cos(lat), 0, -np.sin(lat)]), atol=1e-20

@@ -32,7 +32,8 @@ pub const SOMIGLIANA_K: f64 = 1.931_852_652_41e-3;
 /// `height_m` (m above the ellipsoid).
 ///
 /// Somigliana on the ellipsoid, `γ₀ = γ_e (1 + k sin²φ)/√(1 − e² sin²φ)` (Groves eq. 2.134),
-/// times the free-air factor `1 − 2h/a·(1 + f + ω²a²b/μ) + 3h²/a²` (Groves eq. 2.139).
+/// times the free-air factor `1 − 2h/a·(1 + f·(1 − 2 sin²φ) + ω²a²b/μ) + 3h²/a²` (Groves
+/// eq. 2.139).
 pub fn normal_gravity<T: Real>(latitude_rad: T, height_m: T) -> T {
     let s2 = num_traits::Float::powi(num_traits::Float::sin(latitude_rad), 2);
     let g0 = lit::<T>(GAMMA_EQUATOR) * (T::one() + lit::<T>(SOMIGLIANA_K) * s2)
@@ -40,8 +41,9 @@ pub fn normal_gravity<T: Real>(latitude_rad: T, height_m: T) -> T {
     let m = OMEGA_IE * OMEGA_IE * WGS84_A * WGS84_A * WGS84_B / WGS84_MU;
     let a = lit::<T>(WGS84_A);
     let h = height_m;
-    g0 * (T::one() - lit::<T>(2.0) / a * (lit::<T>(1.0 + WGS84_F + m)) * h
-        + lit::<T>(3.0) * h * h / (a * a))
+    let f = lit::<T>(WGS84_F);
+    let k = T::one() + f * (T::one() - lit::<T>(2.0) * s2) + lit::<T>(m);
+    g0 * (T::one() - lit::<T>(2.0) / a * k * h + lit::<T>(3.0) * h * h / (a * a))
 }
 
 /// Gravity vector in NED (m/s²): `[0, 0, g]` (down positive), `g` from [`normal_gravity`]
