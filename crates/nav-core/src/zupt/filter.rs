@@ -318,6 +318,33 @@ impl<T: Real> ZuptFilter<T> {
 
         self.propagate_covariance(&c, &f_n);
         self.index += 1;
+        self.check_health()
+    }
+
+    /// Health check after each step: a non-finite solution (e.g. from absurd but finite input)
+    /// or a covariance diagonal that is not finite and non-negative is reported, never carried.
+    fn check_health(&self) -> Result<(), NavError> {
+        // Sums propagate NaN and inf, so one finiteness test per group suffices (a sum can
+        // only overflow when some value is already beyond 1e307: absurd either way).
+        let sol =
+            self.pos.sum() + self.vel.sum() + self.q.coords.sum() + self.bg.sum() + self.ba.sum();
+        if !num_traits::Float::is_finite(sol) {
+            return Err(NavError::NonFinite {
+                what: "navigation solution",
+                index: self.index,
+            });
+        }
+        let (mut trace, mut negative) = (T::zero(), false);
+        for i in 0..N_STATES {
+            let d = self.p[(i, i)];
+            trace += d;
+            negative |= d < T::zero();
+        }
+        if negative || !num_traits::Float::is_finite(trace) {
+            return Err(NavError::NotPositiveDefinite {
+                what: "state covariance P",
+            });
+        }
         Ok(())
     }
 
@@ -449,7 +476,7 @@ impl<T: Real> ZuptFilter<T> {
         self.ba -= dx.fixed_rows::<3>(9);
         self.bg -= dx.fixed_rows::<3>(12);
         self.n_updates += 1;
-        Ok(())
+        self.check_health()
     }
 
     /// One sample: predict, and update when `stationary` and an update is due (cadence

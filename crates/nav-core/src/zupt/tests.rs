@@ -432,3 +432,37 @@ proptest! {
         prop_assert!(f.gyro_bias_rad_s().iter().all(|x| x.is_finite()));
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    #[test]
+    fn any_finite_input_gives_ok_or_err_never_a_panic_or_silent_nan(
+        seed in 0u64..1_000_000,
+        mag in -300.0f64..300.0,
+        tc in any::<bool>(),
+    ) {
+        // Finite input of any magnitude (up to 1e300): every step returns Ok with a finite
+        // state or an Err; nothing panics and no NaN is carried forward silently.
+        let cfg = ZuptConfig {
+            mode: if tc { Mode::Tczupt } else { Mode::Zupt },
+            ..ZuptConfig::default()
+        };
+        let mut f = ZuptFilter::new(cfg, UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros(), 0.01)
+            .unwrap();
+        let mut rng = Gauss::new(seed);
+        let scale = 10f64.powf(mag);
+        let mut deriv = |_i: usize, t: f64| Vector3::new(t, -t, 1e-5);
+        for _ in 0..250 {
+            let g = rng.vec3(scale);
+            let a = rng.vec3(scale);
+            let temp = rng.next() * scale;
+            match f.step(&g.into(), &a.into(), Some(temp), true, &mut deriv) {
+                Ok(_) => {
+                    prop_assert!(f.gyro_bias_rad_s().iter().all(|x| x.is_finite()));
+                    prop_assert!(f.covariance().iter().all(|x| x.is_finite()));
+                }
+                Err(_) => break,
+            }
+        }
+    }
+}
