@@ -4,6 +4,9 @@ Private API: import :mod:`uasnav.allan`, :mod:`uasnav.attitude`, … instead. Un
 quaternions scalar first, body → NED.
 """
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -22,8 +25,13 @@ __all__ = [
     "attitude_quat_to_euler",
     "attitude_rotation_angle",
     "mlp_evaluate_model",
+    "earth_normal_gravity",
+    "earth_radii",
+    "earth_rate_ned",
     "noise_fit_ieee952",
     "noise_read_points",
+    "zupt_detect_static",
+    "zupt_run",
 ]
 
 # --- allan / noise -------------------------------------------------------------------------
@@ -89,3 +97,56 @@ def mlp_evaluate_model(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
     """Networks of a neural thermal-model file (JSON text) at temperatures (n,) degC:
     (value (n, k) rad/s, d/dT (n, k) rad/s/degC, clipped (n,))."""
+def zupt_run(
+    gyro: NDArray[np.float64],
+    accel: NDArray[np.float64],
+    dt_s: float,
+    *,
+    mode: str = "zupt",
+    discretisation: str = "first_order",
+    config: dict[str, float] | None = None,
+    temp: NDArray[np.float64] | None = None,
+    dbias_dtemp: NDArray[np.float64] | None = None,
+    mag: NDArray[np.float64] | None = None,
+    stationary: NDArray[np.bool_] | None = None,
+    levelling_samples: int = 6000,
+    heading_rad: float | None = None,
+    declination_rad: float | None = None,
+    accel_bias0: Sequence[float] = ...,
+    gyro_bias0: Sequence[float] = ...,
+    zero_gyro_bias: bool = True,
+    decimation: int = 1,
+) -> dict[str, Any]:
+    """Run the ZUPT ('zupt') or TCZUPT ('tczupt') filter over a whole log (GIL released).
+
+    gyro, accel (n, 3) rad/s and m/s² (body); dt_s sample period (s); config: SI floats named
+    as nav_core::zupt::ZuptConfig (unknown keys raise); temp (n,) °C; dbias_dtemp (n, 3)
+    rad/s/°C (TCZUPT); mag (n, 3) for a magnetic heading with declination_rad; stationary
+    (n,) bool (updates only where true); zero_gyro_bias starts the bias from the mean
+    gyro over the levelling window minus the Earth rate (plus gyro_bias0). Returns a dict:
+    gyro_bias (m, 3), accel_bias (m, 3), attitude (m, 4), cov_diag (m, 15), temp_rate (m,),
+    initial_attitude [4], updates, mean_nis; m = ceil(n / decimation).
+    """
+
+def zupt_detect_static(
+    accel: NDArray[np.float64],
+    gyro: NDArray[np.float64],
+    *,
+    sigma_accel_m_s2: float = 0.05,
+    sigma_gyro_rad_s: float = 0.01,
+    window_samples: int = 25,
+    threshold: float = 10.0,
+    gravity_m_s2: float = 9.80665,
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """GLRT (SHOE) stationarity statistic T (n,) and mask T < threshold (n,) of accel (n, 3)
+    m/s² and gyro (n, 3) rad/s over a centred window of window_samples samples."""
+
+# --- earth -----------------------------------------------------------------------------------
+def earth_normal_gravity(latitude_rad: float, height_m: float) -> float:
+    """WGS-84 normal gravity (m/s²) at geodetic latitude (rad) and ellipsoidal height (m)."""
+
+def earth_rate_ned(latitude_rad: float) -> list[float]:
+    """Earth rotation rate resolved in NED (rad/s) at geodetic latitude (rad)."""
+
+def earth_radii(latitude_rad: float) -> tuple[float, float]:
+    """Meridian and transverse radii of curvature (m) at geodetic latitude (rad)."""

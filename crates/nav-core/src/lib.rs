@@ -22,10 +22,12 @@ extern crate std;
 
 pub mod allan;
 pub mod attitude;
+pub mod earth;
 pub mod error;
 pub mod mlp;
 pub mod noise;
 pub(crate) mod scalar;
+pub mod zupt;
 
 pub use error::NavError;
 pub use scalar::Real;

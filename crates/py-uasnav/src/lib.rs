@@ -5,8 +5,10 @@
 mod allan;
 mod attitude;
 mod convert;
+mod earth;
 mod errors;
 mod mlp;
+mod zupt;
 
 use pyo3::prelude::*;
 
@@ -17,5 +19,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     allan::register(m)?;
     attitude::register(m)?;
     mlp::register(m)?;
+    earth::register(m)?;
+    zupt::register(m)?;
     Ok(())
 }

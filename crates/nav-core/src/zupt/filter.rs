@@ -1,0 +1,727 @@
+//! The filter kernel: strapdown mechanisation, block-structured covariance propagation, the
+//! nine-measurement ZUPT update in Joseph form, feedback and reset; and the batch runner.
+use nalgebra::{Matrix3, Quaternion, SMatrix, SVector, UnitQuaternion, Vector3};
+
+use super::slope::SlopeEstimator;
+use super::{
+    BiasTemperatureDerivative, Discretisation, HeadingSource, Levelling, Mode, ZuptConfig, N_MEAS,
+    N_STATES,
+};
+use crate::attitude::{quat_from_rotation_vector, quat_to_array, quat_to_dcm};
+use crate::earth;
+use crate::scalar::lit;
+use crate::{NavError, Real};
+
+type Mat15<T> = SMatrix<T, N_STATES, N_STATES>;
+type Vec9<T> = SVector<T, N_MEAS>;
+
+/// `[v×]`, the cross-product matrix.
+#[inline(always)]
+pub(super) fn skew<T: Real>(v: &Vector3<T>) -> Matrix3<T> {
+    Matrix3::new(
+        T::zero(),
+        -v.z,
+        v.y,
+        v.z,
+        T::zero(),
+        -v.x,
+        -v.y,
+        v.x,
+        T::zero(),
+    )
+}
+
+#[inline(always)]
+fn finite3<T: Real>(what: &'static str, index: usize, v: &[T; 3]) -> Result<(), NavError> {
+    if v.iter().all(|x| num_traits::Float::is_finite(*x)) {
+        Ok(())
+    } else {
+        Err(NavError::NonFinite { what, index })
+    }
+}
+
+/// The non-identity block rows of `Φ = I + F·Ts` (δv and ψ rows; δr rows are `I, Ts·I`),
+/// stored column-major as nalgebra converts them (`[column][row]`).
+struct PhiBlocks<T> {
+    dt: T,
+    /// `(2g/r)·Ts` on the δv_D ← δr_D entry.
+    dd: T,
+    vv: [[T; 3]; 3],
+    vp: [[T; 3]; 3],
+    vb: [[T; 3]; 3],
+    pp: [[T; 3]; 3],
+}
+
+impl<T: Real> PhiBlocks<T> {
+    /// `(Φ·S)[0..9, :]` for a 15×L matrix `S` given by its rows `src[k]` (the bias rows of
+    /// `Φ·S` equal those of `S`). Each output row is a few AXPYs over contiguous length-L
+    /// rows, which the compiler vectorises.
+    #[inline(always)]
+    fn rows<const L: usize>(&self, src: &[[T; L]; N_STATES]) -> [[T; L]; 9] {
+        let mut out = [[T::zero(); L]; 9];
+        for i in 0..3 {
+            for l in 0..L {
+                out[i][l] = src[i][l] + self.dt * src[3 + i][l];
+            }
+            let mut v = src[3 + i];
+            let mut p = src[6 + i];
+            for k in 0..3 {
+                // [k][i] is row i, column k of the block (column-major storage).
+                let c = self.vb[k][i];
+                for l in 0..L {
+                    v[l] += c * src[9 + k][l];
+                    p[l] += c * src[12 + k][l];
+                }
+                // vv, vp and pp are skew-symmetric: their diagonal is zero.
+                if k != i {
+                    let (a, b, d) = (self.vv[k][i], self.vp[k][i], self.pp[k][i]);
+                    for l in 0..L {
+                        v[l] += a * src[3 + k][l] + b * src[6 + k][l];
+                        p[l] += d * src[6 + k][l];
+                    }
+                }
+            }
+            out[3 + i] = v;
+            out[6 + i] = p;
+        }
+        for l in 0..L {
+            out[5][l] += self.dd * src[2][l];
+        }
+        out
+    }
+}
+
+/// The ZUPT / TCZUPT filter (see the module docs for the model). Never allocates; `Clone`
+/// but not `Copy` (it holds a 15×15 covariance and the 512-sample temperature window).
+#[derive(Debug, Clone)]
+pub struct ZuptFilter<T: Real> {
+    cfg: ZuptConfig<T>,
+    dt: T,
+    // Navigation solution.
+    pos: Vector3<T>,
+    vel: Vector3<T>,
+    q: UnitQuaternion<T>,
+    ba: Vector3<T>,
+    bg: Vector3<T>,
+    // Frozen references of the ZUPT measurement.
+    q0: UnitQuaternion<T>,
+    /// Frozen position (m, NED displacement from the start).
+    pos0: Vector3<T>,
+    /// Whether the previous sample was flagged stationary (re-freeze on a new rest period).
+    was_stationary: bool,
+    // Error covariance P (15×15).
+    p: Mat15<T>,
+    // Earth model at the frozen position.
+    w_ie: Vector3<T>,
+    /// Rotation of the NED frame over one sample, `exp(−ω_ie·Ts/2)`.
+    q_earth: UnitQuaternion<T>,
+    g0: T,
+    grav_grad: T,
+    // Γ diagonal per group (variance added per step).
+    gamma: [T; 4],
+    r_diag: Vec9<T>,
+    // Scheduling.
+    steps_per_update: usize,
+    since_update: usize,
+    slope: SlopeEstimator<T>,
+    index: usize,
+    n_updates: usize,
+    last_dtemp_dt: T,
+    last_nis: T,
+}
+
+impl<T: Real> ZuptFilter<T> {
+    /// A filter at rest at the frozen attitude `q0` (body → NED), with initial bias estimates
+    /// `accel_bias_m_s2` (m/s², body) and `gyro_bias_rad_s` (rad/s, body), for samples every
+    /// `dt_s` seconds.
+    pub fn new(
+        config: ZuptConfig<T>,
+        q0: UnitQuaternion<T>,
+        accel_bias_m_s2: Vector3<T>,
+        gyro_bias_rad_s: Vector3<T>,
+        dt_s: T,
+    ) -> Result<Self, NavError> {
+        config.validate()?;
+        if !(num_traits::Float::is_finite(dt_s) && dt_s > T::zero()) {
+            return Err(NavError::InvalidParameter {
+                what: "dt_s",
+                reason: "must be finite and > 0",
+            });
+        }
+        crate::error::check_finite("q0", q0.coords.as_slice())?;
+        crate::error::check_finite("accel_bias_m_s2", accel_bias_m_s2.as_slice())?;
+        crate::error::check_finite("gyro_bias_rad_s", gyro_bias_rad_s.as_slice())?;
+        let per = num_traits::Float::round(config.update_interval_s / dt_s);
+        let steps_per_update = num_traits::ToPrimitive::to_usize(&per)
+            .unwrap_or(usize::MAX)
+            .max(1);
+        let sq = |x: T| x * x;
+        let mut p = Mat15::zeros();
+        let init = [
+            config.init_std_position_m,
+            config.init_std_velocity_m_s,
+            config.init_std_attitude_rad,
+            config.init_std_accel_bias_m_s2,
+            config.init_std_gyro_bias_rad_s,
+        ];
+        for (b, s) in init.iter().enumerate() {
+            for i in 0..3 {
+                p[(3 * b + i, 3 * b + i)] = sq(*s);
+            }
+        }
+        let n = config.noise;
+        let gamma = [
+            sq(n.sigma_vrw_m_s_sqrt_s) * dt_s,
+            sq(n.sigma_arw_rad_sqrt_s) * dt_s,
+            sq(n.sigma_abi_m_s2) * dt_s,
+            sq(n.sigma_gbi_rad_s) * dt_s,
+        ];
+        let r = [
+            sq(config.meas_std_position_m),
+            sq(config.meas_std_velocity_m_s),
+            sq(config.meas_std_attitude_rad),
+        ];
+        let r_diag = Vec9::from_fn(|i, _| r[i / 3]);
+        let g0 = earth::normal_gravity(config.latitude_rad, config.height_m);
+        Ok(Self {
+            dt: dt_s,
+            pos: Vector3::zeros(),
+            vel: Vector3::zeros(),
+            q: q0,
+            ba: accel_bias_m_s2,
+            bg: gyro_bias_rad_s,
+            q0,
+            pos0: Vector3::zeros(),
+            was_stationary: true,
+            p,
+            w_ie: earth::earth_rate_ned(config.latitude_rad),
+            q_earth: quat_from_rotation_vector(
+                &(-earth::earth_rate_ned(config.latitude_rad) * dt_s),
+            ),
+            g0,
+            grav_grad: lit::<T>(2.0) * g0 / earth::geocentric_radius(config.latitude_rad),
+            gamma,
+            r_diag,
+            steps_per_update,
+            since_update: 0,
+            slope: SlopeEstimator::new(config.temp_slope_window_s, dt_s),
+            index: 0,
+            n_updates: 0,
+            last_dtemp_dt: T::zero(),
+            last_nis: T::zero(),
+            cfg: config,
+        })
+    }
+
+    /// Estimated gyro bias (rad/s, body).
+    #[inline]
+    pub fn gyro_bias_rad_s(&self) -> Vector3<T> {
+        self.bg
+    }
+
+    /// Estimated accelerometer bias (m/s², body).
+    #[inline]
+    pub fn accel_bias_m_s2(&self) -> Vector3<T> {
+        self.ba
+    }
+
+    /// Current attitude estimate (body → NED).
+    #[inline]
+    pub fn attitude(&self) -> &UnitQuaternion<T> {
+        &self.q
+    }
+
+    /// Velocity estimate (m/s, NED).
+    #[inline]
+    pub fn velocity_m_s(&self) -> Vector3<T> {
+        self.vel
+    }
+
+    /// Position estimate: NED displacement from the frozen initial point (m).
+    #[inline]
+    pub fn position_m(&self) -> Vector3<T> {
+        self.pos
+    }
+
+    /// Error covariance P (15×15; order δr, δv, ψ, δb_a, δb_g; SI units).
+    #[inline]
+    pub fn covariance(&self) -> &SMatrix<T, N_STATES, N_STATES> {
+        &self.p
+    }
+
+    /// Number of ZUPT updates applied so far.
+    #[inline]
+    pub fn updates(&self) -> usize {
+        self.n_updates
+    }
+
+    /// Latest dT/dt estimate (°C/s) used by TCZUPT.
+    #[inline]
+    pub fn temp_rate_c_s(&self) -> T {
+        self.last_dtemp_dt
+    }
+
+    /// Normalised innovation squared `zᵀS⁻¹z` of the latest update (χ² with 9 degrees of
+    /// freedom for a consistent filter).
+    #[inline]
+    pub fn last_nis(&self) -> T {
+        self.last_nis
+    }
+
+    /// One time-propagation step (eqs. 15–18) with gyro `gyro_rad_s` (rad/s, body; calibrated
+    /// for ZUPT, raw for TCZUPT) and specific force `accel_m_s2` (m/s², body) held over the
+    /// sample period; `dbias_dt_rad_s2` is the deterministic gyro-bias rate (rad/s²) of eq. 31
+    /// (zero for standard ZUPT). Errors on non-finite input (state unchanged) and when the
+    /// covariance stops being finite and non-negative on the diagonal.
+    pub fn predict(
+        &mut self,
+        gyro_rad_s: &[T; 3],
+        accel_m_s2: &[T; 3],
+        dbias_dt_rad_s2: &Vector3<T>,
+    ) -> Result<(), NavError> {
+        finite3("gyro_rad_s", self.index, gyro_rad_s)?;
+        finite3("accel_m_s2", self.index, accel_m_s2)?;
+        finite3("dbias_dt_rad_s2", self.index, &(*dbias_dt_rad_s2).into())?;
+        let dt = self.dt;
+        let w_hat = Vector3::from(*gyro_rad_s) - self.bg;
+        let f_hat = Vector3::from(*accel_m_s2) - self.ba;
+        let c = quat_to_dcm(&self.q);
+        // Attitude: body rotation on the right, Earth rotation of the NED frame on the left.
+        let phi = w_hat * dt;
+        let n2 = phi.norm_squared();
+        let q_body = if n2 < lit(1e-8) {
+            // exp(φ/2) to 4th order: the truncation (|φ|⁶/46080 < 3e-29) is below f64
+            // resolution, and the product is renormalised below.
+            let k = lit::<T>(0.5) - n2 / lit(48.0);
+            Quaternion::new(
+                T::one() - n2 / lit(8.0) + n2 * n2 / lit(384.0),
+                phi.x * k,
+                phi.y * k,
+                phi.z * k,
+            )
+        } else {
+            quat_from_rotation_vector(&phi).into_inner()
+        };
+        let q = self.q_earth.into_inner() * self.q.into_inner() * q_body;
+        // One Newton step towards |q| = 1 (|q|² − 1 is O(1e-16) here): no sqrt, no division.
+        let s = (lit::<T>(3.0) - q.norm_squared()) * lit::<T>(0.5);
+        self.q = UnitQuaternion::new_unchecked(q * s);
+        let f_n = c * f_hat;
+        let g = self.g0 + self.grav_grad * self.pos.z;
+        let acc = f_n + Vector3::new(T::zero(), T::zero(), g)
+            - self.w_ie.cross(&self.vel) * lit::<T>(2.0);
+        let v_old = self.vel;
+        self.vel += acc * dt;
+        self.pos += (v_old + self.vel) * (dt * lit::<T>(0.5));
+        // Eq. 31 (F_g = 0): deterministic thermal drift of the bias.
+        self.bg += dbias_dt_rad_s2 * dt;
+
+        self.propagate_covariance(&c, &f_n);
+        self.index += 1;
+        self.check_health()
+    }
+
+    /// Health check after each step: a non-finite solution (e.g. from absurd but finite input)
+    /// or a covariance diagonal that is not finite and non-negative is reported, never carried.
+    fn check_health(&self) -> Result<(), NavError> {
+        // Sums propagate NaN and inf, so one finiteness test per group suffices (a sum can
+        // only overflow when some value is already beyond 1e307: absurd either way).
+        let sol =
+            self.pos.sum() + self.vel.sum() + self.q.coords.sum() + self.bg.sum() + self.ba.sum();
+        if !num_traits::Float::is_finite(sol) {
+            return Err(NavError::NonFinite {
+                what: "navigation solution",
+                index: self.index,
+            });
+        }
+        let (mut trace, mut negative) = (T::zero(), false);
+        for i in 0..N_STATES {
+            let d = self.p[(i, i)];
+            trace += d;
+            negative |= d < T::zero();
+        }
+        if negative || !num_traits::Float::is_finite(trace) {
+            return Err(NavError::NotPositiveDefinite {
+                what: "state covariance P",
+            });
+        }
+        Ok(())
+    }
+
+    /// `P ← Φ·P·Φᵀ + Γ`.
+    // Index loops mirror the block algebra (row i, column j) and unroll fully.
+    #[allow(clippy::needless_range_loop)]
+    fn propagate_covariance(&mut self, c: &Matrix3<T>, f_n: &Vector3<T>) {
+        let dt = self.dt;
+        let w = skew(&self.w_ie);
+        let a_vv = w * (lit::<T>(-2.0) * dt);
+        let a_vp = skew(f_n) * (-dt);
+        let a_vb = c * (-dt);
+        let a_pp = w * (-dt);
+        let a_dd = self.grav_grad * dt;
+        match self.cfg.discretisation {
+            Discretisation::FirstOrder => {
+                // Only the δr, δv and ψ block rows of Φ differ from I, so P⁻ = Φ·P·Φᵀ needs
+                // only (Φ·x)[0..9] of 15-vectors x: first for the 15 columns of P (giving
+                // M = (Φ·P)[0..9, :]), then for the 9 rows of M (giving P⁻[0..9, 0..9]); the
+                // bias blocks are P⁻[0..9, 9..] = M[:, 9..] and P⁻[9.., 9..] = P[9.., 9..].
+                // Plain scalar loops over fixed arrays: the compiler unrolls them fully.
+                let blocks = PhiBlocks {
+                    dt,
+                    dd: a_dd,
+                    vv: a_vv.into(),
+                    vp: a_vp.into(),
+                    vb: a_vb.into(),
+                    pp: a_pp.into(),
+                };
+                // P is symmetric, so its column-major columns are also its rows.
+                let m = blocks.rows(&self.p.data.0); // M = (Φ·P)[0..9, :], row-major
+                let mut mt = [[T::zero(); 9]; N_STATES]; // Mᵀ
+                for (i, row) in m.iter().enumerate() {
+                    for (j, v) in row.iter().enumerate() {
+                        mt[j][i] = *v;
+                    }
+                }
+                // (Φ·Mᵀ)[0..9, :] = (M·Φᵀ)ᵀ[0..9, 0..9] = P⁻[0..9, 0..9] (symmetric).
+                let n = blocks.rows(&mt);
+                let cols = &mut self.p.data.0;
+                for (a, row) in n.iter().enumerate() {
+                    cols[a][..9].copy_from_slice(row);
+                }
+                for j in 9..N_STATES {
+                    cols[j][..9].copy_from_slice(&mt[j]);
+                    for i in 0..9 {
+                        cols[i][j] = mt[j][i];
+                    }
+                }
+            }
+            Discretisation::SecondOrder => {
+                let mut f = Mat15::<T>::zeros();
+                let eye3 = Matrix3::<T>::identity();
+                f.fixed_view_mut::<3, 3>(0, 3).copy_from(&eye3);
+                f[(5, 2)] = self.grav_grad;
+                f.fixed_view_mut::<3, 3>(3, 3)
+                    .copy_from(&(w * lit::<T>(-2.0)));
+                f.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(f_n)));
+                f.fixed_view_mut::<3, 3>(3, 9).copy_from(&(-c));
+                f.fixed_view_mut::<3, 3>(6, 6).copy_from(&(-w));
+                f.fixed_view_mut::<3, 3>(6, 12).copy_from(&(-c));
+                let ft = f * dt;
+                let phi = Mat15::<T>::identity() + ft + ft * ft * lit::<T>(0.5);
+                self.p = phi * self.p * phi.transpose();
+            }
+        }
+        for (grp, var) in self.gamma.iter().enumerate() {
+            for i in 0..3 {
+                let k = 3 * (grp + 1) + i;
+                self.p[(k, k)] += *var;
+            }
+        }
+    }
+
+    /// The ZUPT measurement update (eqs. 19–21): frozen position, zero velocity, frozen
+    /// attitude; Joseph form, symmetrised; feedback into the solution and reset.
+    pub fn update(&mut self) -> Result<(), NavError> {
+        // Attitude measurement: q̂ ⊗ q₀* = exp(ψ/2) for Ĉ = (I + [ψ×])·C₀.
+        let dq = self.q.into_inner() * self.q0.conjugate().into_inner();
+        let s = if dq.w < T::zero() {
+            -T::one()
+        } else {
+            T::one()
+        };
+        let psi = Vector3::new(dq.i, dq.j, dq.k) * (lit::<T>(2.0) * s);
+        let mut z = Vec9::<T>::zeros();
+        z.fixed_rows_mut::<3>(0).copy_from(&(self.pos - self.pos0));
+        z.fixed_rows_mut::<3>(3).copy_from(&self.vel);
+        z.fixed_rows_mut::<3>(6).copy_from(&psi);
+
+        let p9 = self.p.fixed_rows::<N_MEAS>(0).into_owned(); // H·P (9×15)
+        let mut s_mat = p9.fixed_columns::<N_MEAS>(0).into_owned();
+        for i in 0..N_MEAS {
+            s_mat[(i, i)] += self.r_diag[i];
+        }
+        let chol = s_mat.cholesky().ok_or(NavError::NotPositiveDefinite {
+            what: "innovation covariance S = HPHᵀ + R",
+        })?;
+        let kt = chol.solve(&p9); // Kᵀ = S⁻¹·H·P (9×15)
+        let k = kt.transpose(); // 15×9
+        self.last_nis = z.dot(&chol.solve(&z));
+        let dx = k * z;
+        // Joseph form with H = [I₉ 0]: (I−KH)P(I−KH)ᵀ + KRKᵀ.
+        let m = self.p - k * p9;
+        let mk = m.fixed_columns::<N_MEAS>(0) * kt;
+        let mut kr = k;
+        for j in 0..N_MEAS {
+            let r = self.r_diag[j];
+            kr.column_mut(j).scale_mut(r);
+        }
+        let p_new = m - mk + kr * kt;
+        let p_sym = (p_new + p_new.transpose()) * lit::<T>(0.5);
+        for i in 0..N_STATES {
+            let d = p_sym[(i, i)];
+            if !(num_traits::Float::is_finite(d) && d > T::zero()) {
+                return Err(NavError::NotPositiveDefinite {
+                    what: "state covariance P",
+                });
+            }
+        }
+        self.p = p_sym;
+        // Feedback (δx = estimate − truth) and reset.
+        self.pos -= dx.fixed_rows::<3>(0);
+        self.vel -= dx.fixed_rows::<3>(3);
+        let dpsi: Vector3<T> = dx.fixed_rows::<3>(6).into_owned();
+        self.q = UnitQuaternion::new_normalize(
+            quat_from_rotation_vector(&(-dpsi)).into_inner() * self.q.into_inner(),
+        );
+        self.ba -= dx.fixed_rows::<3>(9);
+        self.bg -= dx.fixed_rows::<3>(12);
+        self.n_updates += 1;
+        self.check_health()
+    }
+
+    /// One sample: predict, and update when `stationary` and an update is due (cadence
+    /// `update_interval_s`). `temp_c` (°C) and `deriv` are used in TCZUPT mode only (`temp_c`
+    /// required there). Returns whether an update was applied.
+    pub fn step<D: BiasTemperatureDerivative<T>>(
+        &mut self,
+        gyro_rad_s: &[T; 3],
+        accel_m_s2: &[T; 3],
+        temp_c: Option<T>,
+        stationary: bool,
+        deriv: &mut D,
+    ) -> Result<bool, NavError> {
+        let mut rate = Vector3::zeros();
+        if self.cfg.mode == Mode::Tczupt {
+            let temp = temp_c.ok_or(NavError::InvalidParameter {
+                what: "temp_c",
+                reason: "TCZUPT needs the die temperature",
+            })?;
+            if !num_traits::Float::is_finite(temp) {
+                return Err(NavError::NonFinite {
+                    what: "temp_c",
+                    index: self.index,
+                });
+            }
+            let dtdt = self.slope.push(temp);
+            self.last_dtemp_dt = dtdt;
+            rate = deriv.dbias_dtemp(self.index, temp) * dtdt;
+        }
+        self.predict(gyro_rad_s, accel_m_s2, &rate)?;
+        if stationary && !self.was_stationary {
+            // A new rest period after motion: the unit may have moved and turned, so the
+            // position and attitude references are re-frozen at the current solution (only
+            // the zero-velocity measurement stays absolute).
+            self.q0 = self.q;
+            self.pos0 = self.pos;
+        }
+        self.was_stationary = stationary;
+        self.since_update += 1;
+        if self.since_update >= self.steps_per_update {
+            self.since_update = 0;
+            if stationary {
+                self.update()?;
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+}
+
+/// A whole log for [`ZuptFilter::run_batch`]: slices of equal length `n`, sampled every
+/// `dt_s`.
+#[derive(Debug, Clone, Copy)]
+pub struct BatchInput<'a, T> {
+    /// Sample period (s).
+    pub dt_s: T,
+    /// Gyro output (rad/s, body), one `[x, y, z]` per sample.
+    pub gyro_rad_s: &'a [[T; 3]],
+    /// Accelerometer output (m/s², body).
+    pub accel_m_s2: &'a [[T; 3]],
+    /// Die temperature (°C); required for TCZUPT.
+    pub temp_c: Option<&'a [T]>,
+    /// Magnetometer (any unit, body) for a magnetic initial heading.
+    pub mag: Option<&'a [[T; 3]]>,
+    /// Per-sample stationarity (updates only where true); `None` = stationary throughout.
+    pub stationary: Option<&'a [bool]>,
+    /// Samples averaged for coarse levelling (thesis: 60 s of data).
+    pub levelling_samples: usize,
+    /// Initial heading.
+    pub heading: HeadingSource<T>,
+    /// Initial accelerometer bias estimate (m/s², body).
+    pub accel_bias0_m_s2: [T; 3],
+    /// Initial gyro bias estimate (rad/s, body), e.g. a residual 15 deg/h scenario. With
+    /// `zero_gyro_bias` it is added to the zeroing estimate.
+    pub gyro_bias0_rad_s: [T; 3],
+    /// Initial zeroing (thesis §4.2.6.2): start the gyro-bias estimate from the mean gyro
+    /// output over the levelling window minus the Earth rate resolved in the levelled body
+    /// frame.
+    pub zero_gyro_bias: bool,
+}
+
+/// Output buffers of [`ZuptFilter::run_batch`]: row `j` holds the state after sample
+/// `j·decimation` (so each has `ceil(n / decimation)` rows).
+#[derive(Debug)]
+pub struct BatchOutput<'a, T> {
+    /// Store one row every `decimation` samples (≥ 1).
+    pub decimation: usize,
+    /// Gyro bias estimate (rad/s, body).
+    pub gyro_bias_rad_s: &'a mut [[T; 3]],
+    /// Accelerometer bias estimate (m/s², body).
+    pub accel_bias_m_s2: &'a mut [[T; 3]],
+    /// Attitude (body → NED), scalar first.
+    pub attitude: &'a mut [[T; 4]],
+    /// Diagonal of P (SI units; δr, δv, ψ, δb_a, δb_g).
+    pub cov_diag: &'a mut [[T; N_STATES]],
+    /// dT/dt (°C/s) used by TCZUPT (0 for ZUPT).
+    pub temp_rate_c_s: &'a mut [T],
+}
+
+/// What [`ZuptFilter::run_batch`] returns besides the histories.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BatchSummary<T> {
+    /// Levelled initial attitude (body → NED), scalar first.
+    pub initial_attitude: [T; 4],
+    /// Number of ZUPT updates applied.
+    pub updates: usize,
+    /// Mean normalised innovation squared over the updates (≈ 9 when consistent).
+    pub mean_nis: T,
+}
+
+impl<T: Real> ZuptFilter<T> {
+    /// Runs a whole log: coarse levelling over the first `levelling_samples`, then the filter
+    /// over every sample, writing decimated histories into `out`. No allocation.
+    pub fn run_batch<D: BiasTemperatureDerivative<T>>(
+        config: ZuptConfig<T>,
+        input: &BatchInput<'_, T>,
+        deriv: &mut D,
+        out: &mut BatchOutput<'_, T>,
+    ) -> Result<BatchSummary<T>, NavError> {
+        let n = input.gyro_rad_s.len();
+        if n < 2 {
+            return Err(NavError::TooShort {
+                what: "gyro_rad_s",
+                len: n,
+                min: 2,
+            });
+        }
+        let check_len = |what: &'static str, got: usize| {
+            if got == n {
+                Ok(())
+            } else {
+                Err(NavError::LengthMismatch {
+                    what,
+                    expected: n,
+                    got,
+                })
+            }
+        };
+        check_len("accel_m_s2", input.accel_m_s2.len())?;
+        if let Some(t) = input.temp_c {
+            check_len("temp_c", t.len())?;
+        } else if config.mode == Mode::Tczupt {
+            return Err(NavError::InvalidParameter {
+                what: "temp_c",
+                reason: "TCZUPT needs the die temperature",
+            });
+        }
+        if let Some(m) = input.mag {
+            check_len("mag", m.len())?;
+        }
+        if let Some(s) = input.stationary {
+            check_len("stationary", s.len())?;
+        }
+        if out.decimation == 0 {
+            return Err(NavError::InvalidParameter {
+                what: "decimation",
+                reason: "must be ≥ 1",
+            });
+        }
+        let rows = n.div_ceil(out.decimation);
+        check_len_rows(rows, out)?;
+
+        let mut lev = Levelling::new();
+        let m = input.levelling_samples.clamp(1, n);
+        let mut sum_w = Vector3::zeros();
+        for k in 0..m {
+            let mag = input.mag.map(|v| &v[k]);
+            lev.push(&input.accel_m_s2[k], mag)
+                .map_err(|e| reindex(e, k))?;
+            finite3("gyro_rad_s", k, &input.gyro_rad_s[k])?;
+            sum_w += Vector3::from(input.gyro_rad_s[k]);
+        }
+        let q0 = lev.attitude(input.heading)?;
+        let mut bg0 = Vector3::from(input.gyro_bias0_rad_s);
+        if input.zero_gyro_bias {
+            let w_b = quat_to_dcm(&q0).transpose() * earth::earth_rate_ned(config.latitude_rad);
+            bg0 += sum_w / crate::scalar::from_usize::<T>(m) - w_b;
+        }
+        let mut f = Self::new(
+            config,
+            q0,
+            Vector3::from(input.accel_bias0_m_s2),
+            bg0,
+            input.dt_s,
+        )?;
+        let mut nis_sum = T::zero();
+        for k in 0..n {
+            let temp = input.temp_c.map(|t| t[k]);
+            let stat = input.stationary.is_none_or(|s| s[k]);
+            if f.step(
+                &input.gyro_rad_s[k],
+                &input.accel_m_s2[k],
+                temp,
+                stat,
+                deriv,
+            )? {
+                nis_sum += f.last_nis;
+            }
+            if k % out.decimation == 0 {
+                let j = k / out.decimation;
+                out.gyro_bias_rad_s[j] = f.bg.into();
+                out.accel_bias_m_s2[j] = f.ba.into();
+                out.attitude[j] = quat_to_array(&f.q);
+                for i in 0..N_STATES {
+                    out.cov_diag[j][i] = f.p[(i, i)];
+                }
+                out.temp_rate_c_s[j] = f.last_dtemp_dt;
+            }
+        }
+        let mean_nis = if f.n_updates > 0 {
+            nis_sum / crate::scalar::from_usize(f.n_updates)
+        } else {
+            T::zero()
+        };
+        Ok(BatchSummary {
+            initial_attitude: quat_to_array(&q0),
+            updates: f.n_updates,
+            mean_nis,
+        })
+    }
+}
+
+fn reindex(e: NavError, k: usize) -> NavError {
+    match e {
+        NavError::NonFinite { what, .. } => NavError::NonFinite { what, index: k },
+        other => other,
+    }
+}
+
+fn check_len_rows<T>(rows: usize, out: &BatchOutput<'_, T>) -> Result<(), NavError> {
+    let lens: [(&'static str, usize); 5] = [
+        ("out.gyro_bias_rad_s", out.gyro_bias_rad_s.len()),
+        ("out.accel_bias_m_s2", out.accel_bias_m_s2.len()),
+        ("out.attitude", out.attitude.len()),
+        ("out.cov_diag", out.cov_diag.len()),
+        ("out.temp_rate_c_s", out.temp_rate_c_s.len()),
+    ];
+    for (what, got) in lens {
+        if got != rows {
+            return Err(NavError::LengthMismatch {
+                what,
+                expected: rows,
+                got,
+            });
+        }
+    }
+    Ok(())
+}

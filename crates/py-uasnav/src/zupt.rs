@@ -1,0 +1,260 @@
+//! Binding of `nav_core::zupt`: one call runs a whole log (GIL released).
+use nav_core::zupt::{
+    detect_static, BatchInput, BatchOutput, DerivativeTable, Discretisation, HeadingSource, Mode,
+    NoDerivative, StationarityConfig, ZuptConfig, ZuptFilter, N_STATES,
+};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{rows, slice1};
+use crate::errors::{input_error, IntoPy};
+
+/// Builds a `ZuptConfig` from `mode`, `discretisation` and a dict of SI floats named exactly
+/// as the nav-core fields; an unknown key is an error (a typo must not pass silently).
+fn config(
+    py: Python<'_>,
+    mode: &str,
+    discretisation: &str,
+    values: Option<&Bound<'_, PyDict>>,
+) -> PyResult<ZuptConfig<f64>> {
+    let mut c = ZuptConfig::<f64> {
+        mode: match mode {
+            "zupt" => Mode::Zupt,
+            "tczupt" => Mode::Tczupt,
+            _ => {
+                return Err(input_error(
+                    py,
+                    format!("mode: expected 'zupt' or 'tczupt', got {mode:?}"),
+                ))
+            }
+        },
+        discretisation: match discretisation {
+            "first_order" => Discretisation::FirstOrder,
+            "second_order" => Discretisation::SecondOrder,
+            _ => {
+                return Err(input_error(
+                    py,
+                    format!(
+                        "discretisation: expected 'first_order' or 'second_order', got {discretisation:?}"
+                    ),
+                ))
+            }
+        },
+        ..ZuptConfig::default()
+    };
+    if let Some(d) = values {
+        for (k, v) in d.iter() {
+            let key: String = k.extract()?;
+            let x: f64 = v
+                .extract()
+                .map_err(|_| input_error(py, format!("config[{key:?}]: expected a float")))?;
+            let slot = match key.as_str() {
+                "sigma_vrw_m_s_sqrt_s" => &mut c.noise.sigma_vrw_m_s_sqrt_s,
+                "sigma_arw_rad_sqrt_s" => &mut c.noise.sigma_arw_rad_sqrt_s,
+                "sigma_abi_m_s2" => &mut c.noise.sigma_abi_m_s2,
+                "sigma_gbi_rad_s" => &mut c.noise.sigma_gbi_rad_s,
+                "meas_std_position_m" => &mut c.meas_std_position_m,
+                "meas_std_velocity_m_s" => &mut c.meas_std_velocity_m_s,
+                "meas_std_attitude_rad" => &mut c.meas_std_attitude_rad,
+                "update_interval_s" => &mut c.update_interval_s,
+                "init_std_position_m" => &mut c.init_std_position_m,
+                "init_std_velocity_m_s" => &mut c.init_std_velocity_m_s,
+                "init_std_attitude_rad" => &mut c.init_std_attitude_rad,
+                "init_std_accel_bias_m_s2" => &mut c.init_std_accel_bias_m_s2,
+                "init_std_gyro_bias_rad_s" => &mut c.init_std_gyro_bias_rad_s,
+                "latitude_rad" => &mut c.latitude_rad,
+                "height_m" => &mut c.height_m,
+                "temp_slope_window_s" => &mut c.temp_slope_window_s,
+                _ => return Err(input_error(py, format!("config: unknown key {key:?}"))),
+            };
+            *slot = x;
+        }
+    }
+    c.validate().py_err(py)?;
+    Ok(c)
+}
+
+/// Runs the ZUPT/TCZUPT filter over a whole log; returns a dict of decimated histories and
+/// a summary (see `_core.pyi`).
+#[pyfunction]
+#[pyo3(signature = (gyro, accel, dt_s, *, mode="zupt", discretisation="first_order",
+    config=None, temp=None, dbias_dtemp=None, mag=None, stationary=None,
+    levelling_samples=6000, heading_rad=None, declination_rad=None,
+    accel_bias0=[0.0; 3], gyro_bias0=[0.0; 3], zero_gyro_bias=true, decimation=1))]
+#[allow(clippy::too_many_arguments)]
+fn zupt_run<'py>(
+    py: Python<'py>,
+    gyro: PyReadonlyArray2<'py, f64>,
+    accel: PyReadonlyArray2<'py, f64>,
+    dt_s: f64,
+    mode: &str,
+    discretisation: &str,
+    config: Option<Bound<'py, PyDict>>,
+    temp: Option<PyReadonlyArray1<'py, f64>>,
+    dbias_dtemp: Option<PyReadonlyArray2<'py, f64>>,
+    mag: Option<PyReadonlyArray2<'py, f64>>,
+    stationary: Option<PyReadonlyArray1<'py, bool>>,
+    levelling_samples: usize,
+    heading_rad: Option<f64>,
+    declination_rad: Option<f64>,
+    accel_bias0: [f64; 3],
+    gyro_bias0: [f64; 3],
+    zero_gyro_bias: bool,
+    decimation: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let cfg = config_or_default(py, mode, discretisation, config.as_ref())?;
+    let g = rows::<3>(py, "gyro", &gyro)?;
+    let a = rows::<3>(py, "accel", &accel)?;
+    let t = temp.as_ref().map(|x| slice1(py, "temp", x)).transpose()?;
+    let d = dbias_dtemp
+        .as_ref()
+        .map(|x| rows::<3>(py, "dbias_dtemp", x))
+        .transpose()?;
+    let m = mag.as_ref().map(|x| rows::<3>(py, "mag", x)).transpose()?;
+    let s = stationary
+        .as_ref()
+        .map(|x| {
+            x.as_slice()
+                .map_err(|_| input_error(py, "stationary: expected a contiguous bool array".into()))
+        })
+        .transpose()?;
+    if let Some(d) = d {
+        if d.len() != g.len() {
+            return Err(input_error(
+                py,
+                format!("dbias_dtemp: expected {} rows, got {}", g.len(), d.len()),
+            ));
+        }
+    }
+    let heading = match (heading_rad, declination_rad) {
+        (Some(h), None) => HeadingSource::Given(h),
+        (None, Some(dec)) => HeadingSource::Magnetic {
+            declination_rad: dec,
+        },
+        (None, None) => HeadingSource::Given(0.0),
+        (Some(_), Some(_)) => {
+            return Err(input_error(
+                py,
+                "heading_rad and declination_rad: give one (heading input or magnetic heading)"
+                    .into(),
+            ))
+        }
+    };
+    if decimation == 0 {
+        return Err(input_error(py, "decimation: must be >= 1".into()));
+    }
+    let n = g.len();
+    let nrows = n.div_ceil(decimation);
+    let input = BatchInput {
+        dt_s,
+        gyro_rad_s: g,
+        accel_m_s2: a,
+        temp_c: t,
+        mag: m,
+        stationary: s,
+        levelling_samples,
+        heading,
+        accel_bias0_m_s2: accel_bias0,
+        gyro_bias0_rad_s: gyro_bias0,
+        zero_gyro_bias,
+    };
+    type Hist = (
+        Vec<[f64; 3]>,
+        Vec<[f64; 3]>,
+        Vec<[f64; 4]>,
+        Vec<[f64; N_STATES]>,
+        Vec<f64>,
+    );
+    let result = py.detach(|| {
+        let mut h: Hist = (
+            vec![[0.0; 3]; nrows],
+            vec![[0.0; 3]; nrows],
+            vec![[0.0; 4]; nrows],
+            vec![[0.0; N_STATES]; nrows],
+            vec![0.0; nrows],
+        );
+        let mut out = BatchOutput {
+            decimation,
+            gyro_bias_rad_s: &mut h.0,
+            accel_bias_m_s2: &mut h.1,
+            attitude: &mut h.2,
+            cov_diag: &mut h.3,
+            temp_rate_c_s: &mut h.4,
+        };
+        let summary = match d {
+            Some(table) => {
+                ZuptFilter::run_batch(cfg, &input, &mut DerivativeTable(table), &mut out)
+            }
+            None => ZuptFilter::run_batch(cfg, &input, &mut NoDerivative, &mut out),
+        }?;
+        Ok::<_, nav_core::NavError>((h, summary))
+    });
+    let ((gb, ab, att, cov, tr), summary) = result.py_err(py)?;
+    let dict = PyDict::new(py);
+    dict.set_item("gyro_bias", to2(&gb).into_pyarray(py))?;
+    dict.set_item("accel_bias", to2(&ab).into_pyarray(py))?;
+    dict.set_item("attitude", to2(&att).into_pyarray(py))?;
+    dict.set_item("cov_diag", to2(&cov).into_pyarray(py))?;
+    dict.set_item("temp_rate", Array1::from_vec(tr).into_pyarray(py))?;
+    dict.set_item("initial_attitude", summary.initial_attitude.to_vec())?;
+    dict.set_item("updates", summary.updates)?;
+    dict.set_item("mean_nis", summary.mean_nis)?;
+    Ok(dict)
+}
+
+fn to2<const K: usize>(v: &[[f64; K]]) -> Array2<f64> {
+    Array2::from_shape_fn((v.len(), K), |(i, j)| v[i][j])
+}
+
+fn config_or_default(
+    py: Python<'_>,
+    mode: &str,
+    discretisation: &str,
+    values: Option<&Bound<'_, PyDict>>,
+) -> PyResult<ZuptConfig<f64>> {
+    config(py, mode, discretisation, values)
+}
+
+type StaticArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// GLRT (SHOE) stationarity statistic and mask (n,) of a log with a centred window.
+#[pyfunction]
+#[pyo3(signature = (accel, gyro, *, sigma_accel_m_s2=0.05, sigma_gyro_rad_s=0.01,
+    window_samples=25, threshold=10.0, gravity_m_s2=9.80665))]
+#[allow(clippy::too_many_arguments)]
+fn zupt_detect_static<'py>(
+    py: Python<'py>,
+    accel: PyReadonlyArray2<'py, f64>,
+    gyro: PyReadonlyArray2<'py, f64>,
+    sigma_accel_m_s2: f64,
+    sigma_gyro_rad_s: f64,
+    window_samples: usize,
+    threshold: f64,
+    gravity_m_s2: f64,
+) -> PyResult<StaticArrays<'py>> {
+    let a = rows::<3>(py, "accel", &accel)?;
+    let g = rows::<3>(py, "gyro", &gyro)?;
+    let cfg = StationarityConfig {
+        sigma_accel_m_s2,
+        sigma_gyro_rad_s,
+        window_samples,
+        threshold,
+        gravity_m_s2,
+    };
+    let (stat, mask) = py
+        .detach(|| {
+            let mut stat = vec![0.0; a.len()];
+            let mut mask = vec![false; a.len()];
+            detect_static(a, g, cfg, &mut stat, &mut mask).map(|_| (stat, mask))
+        })
+        .py_err(py)?;
+    Ok((stat.into_pyarray(py), mask.into_pyarray(py)))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(zupt_run, m)?)?;
+    m.add_function(wrap_pyfunction!(zupt_detect_static, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,131 @@
+"""``uasnav zupt``: run the ZUPT or TCZUPT filter over a static log."""
+
+from __future__ import annotations
+
+import re
+
+import click
+
+from uasnav.cli._common import echo_json
+from uasnav.errors import InputError, UasnavError
+
+
+def parse_rate(text: str, what: str) -> float:
+    """``"15deg/h"`` / ``"15 deg/h"`` / ``"7e-5 rad/s"`` → rad/s (dimension checked)."""
+    from uasnav.units import convert
+
+    m = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S+)\s*", text)
+    if not m:
+        raise click.BadParameter(f"{what}: expected '<number><unit>', e.g. '15deg/h', got {text!r}")
+    try:
+        return float(convert(float(m.group(1)), m.group(2), "rad/s"))
+    except UasnavError as e:
+        raise click.BadParameter(f"{what}: {e}") from None
+
+
+def load_model(path: str) -> object:
+    """A thermal model from the calibration issue's JSON format (``uasnav.thermal``)."""
+    try:
+        from uasnav.thermal import load_model as _load  # type: ignore[import-not-found,attr-defined,unused-ignore]
+    except ImportError:
+        raise InputError(f"{path}: thermal models (uasnav.thermal) are not available in this build") from None
+    return _load(path)
+
+
+@click.command("zupt")
+@click.argument("log", type=click.Path(dir_okay=False))
+@click.option("--mode", type=click.Choice(["zupt", "tczupt"]), default="zupt", show_default=True)
+@click.option(
+    "--model",
+    "model_path",
+    type=click.Path(dir_okay=False),
+    help="Thermal model JSON (required for tczupt; for zupt it calibrates the gyro first).",
+)
+@click.option(
+    "--residual-bias",
+    default="0 rad/s",
+    show_default=True,
+    help="Error added to the initial gyro-bias estimate on every axis, e.g. 15deg/h.",
+)
+@click.option("--latitude-deg", type=float, default=45.0, show_default=True, help="Latitude of the unit.")
+@click.option("--heading-deg", type=float, default=0.0, show_default=True, help="True heading of the unit.")
+@click.option("--levelling-s", type=float, default=60.0, show_default=True, help="Zeroing window (s).")
+@click.option("--out", "out_path", type=click.Path(dir_okay=False), help="Write EST.csv (t,bgx,…,baz,…).")
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write a PNG of the gyro bias.")
+def command(
+    log: str,
+    mode: str,
+    model_path: str | None,
+    residual_bias: str,
+    latitude_deg: float,
+    heading_deg: float,
+    levelling_s: float,
+    out_path: str | None,
+    as_json: bool,
+    plot_path: str | None,
+) -> None:
+    """Estimate the gyro and accelerometer biases of a stationary LOG with the 15-state
+    ZUPT filter (calibrated gyro data) or the thermally compensated TCZUPT filter (raw gyro
+    data and a thermal model's derivative).
+
+    LOG is any log the data layer reads (CSV v1). Without --model, zupt takes the gyro data as
+    already calibrated.
+    """
+    import math
+
+    from uasnav import zupt
+    from uasnav.io import read_log
+
+    if mode == "tczupt" and model_path is None:
+        raise click.UsageError("--model is required for --mode tczupt")
+    resid = parse_rate(residual_bias, "--residual-bias")
+    data = read_log(log)
+    model = load_model(model_path) if model_path else None
+    cfg = zupt.ZuptConfig(
+        latitude_deg=latitude_deg,
+        heading_rad=math.radians(heading_deg),
+        levelling_s=levelling_s,
+        residual_gyro_bias_rad_s=resid,
+    )
+    res = zupt.run(data, mode, model, cfg)  # type: ignore[arg-type]
+    if out_path:
+        res.to_csv(out_path)
+    if plot_path:
+        _plot(res, plot_path)
+    summary = {
+        "log": log,
+        "mode": mode,
+        "n_samples": data.n,
+        "rate_hz": res.meta["rate_hz"],
+        "updates": res.updates,
+        "mean_nis": res.mean_nis,
+        "residual_bias_rad_s": resid,
+        "gyro_bias_rad_s": res.gyro_bias[-1],
+        "gyro_bias_std_rad_s": res.gyro_bias_std[-1],
+        "accel_bias_m_s2": res.accel_bias[-1],
+        "accel_bias_std_m_s2": res.accel_bias_std[-1],
+        "initial_attitude": res.initial_attitude,
+    }
+    if as_json:
+        echo_json(summary)
+        return
+    click.echo(
+        f"{log}: {data.n} samples at {res.meta['rate_hz']:g} Hz, {mode.upper()}, {res.updates} updates"
+    )
+    for j, ax in enumerate("xyz"):
+        click.echo(
+            f"  gyro bias {ax}: {res.gyro_bias[-1, j]: .4e} ± {res.gyro_bias_std[-1, j]:.1e} rad/s   "
+            f"accel bias {ax}: {res.accel_bias[-1, j]: .4e} ± {res.accel_bias_std[-1, j]:.1e} m/s²"
+        )
+
+
+def _plot(res: object, path: str) -> None:
+    from uasnav.plotting import new_figure, save_png
+
+    fig, _ = new_figure(7.0, 7.5)
+    fig.clear()
+    axes = fig.subplots(3, 1, sharex=True)
+    for j in range(3):
+        res.plot_bias(j, ax=axes[j])  # type: ignore[attr-defined]
+    save_png(fig, path)

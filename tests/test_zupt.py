@@ -1,0 +1,271 @@
+"""ZUPT / TCZUPT: the Rust filter against filterpy (same model, dense matrices), against the
+simulated truth of the stand-in generator, error handling, the CLI contract and the report.
+
+The stand-in generator (``uasnav._zupt_standin``) replaces the simulator and thermal models
+of the parallel issues until they land on main.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from uasnav import _core, zupt
+from uasnav import _zupt_standin as standin
+from uasnav.cli import main
+from uasnav.errors import InputError
+from uasnav.imu import ImuLog
+from uasnav.io import write_csv_v1
+
+LAT = np.deg2rad(45.0)
+W_IE = 7.292115e-5 * np.array([np.cos(LAT), 0.0, -np.sin(LAT)])
+G45 = 9.806197769373233  # Somigliana at 45°, h = 0
+
+
+def _skew(v):
+    return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+@pytest.fixture(scope="module")
+def ramp():
+    log = standin.static_log(420.0, seed=4)
+    return log, standin.soak_calibration(seed=5)
+
+
+def test_covariance_matches_filterpy_with_the_same_dense_model():
+    from filterpy.kalman import KalmanFilter
+
+    n, dt = 350, 0.01
+    gyro = np.tile(W_IE, (n, 1))  # noiseless static unit, level, heading north
+    accel = np.tile([0.0, 0.0, -G45], (n, 1))
+    cfg = zupt.ZuptConfig()
+    core = cfg.core_dict("zupt")
+    out = _core.zupt_run(gyro, accel, dt, config=core, levelling_samples=100, heading_rad=0.0)
+    # The same model in dense form (Groves ch. 14 as documented in nav_core::zupt).
+    F = np.zeros((15, 15))
+    F[0:3, 3:6] = np.eye(3)
+    F[5, 2] = 2 * G45 / 6367489.5438  # 2g/r_eS at 45°
+    F[3:6, 3:6] = -2 * _skew(W_IE)
+    F[3:6, 6:9] = -_skew(np.array([0.0, 0.0, -G45]))
+    F[3:6, 9:12] = -np.eye(3)
+    F[6:9, 6:9] = -_skew(W_IE)
+    F[6:9, 12:15] = -np.eye(3)
+    sig = [
+        core["sigma_vrw_m_s_sqrt_s"],
+        core["sigma_arw_rad_sqrt_s"],
+        core["sigma_abi_m_s2"],
+        core["sigma_gbi_rad_s"],
+    ]
+    kf = KalmanFilter(dim_x=15, dim_z=9)
+    kf.F = np.eye(15) + F * dt
+    kf.Q = np.diag(np.r_[np.zeros(3), np.repeat(np.square(sig), 3)]) * dt
+    kf.H = np.hstack([np.eye(9), np.zeros((9, 6))])
+    kf.R = np.diag(
+        np.repeat([cfg.meas_std_position_m, cfg.meas_std_velocity_m_s, cfg.meas_std_attitude_rad], 3) ** 2
+    )
+    kf.P = np.diag(
+        np.repeat(
+            [
+                cfg.init_std_position_m,
+                cfg.init_std_velocity_m_s,
+                cfg.init_std_attitude_rad,
+                cfg.init_std_accel_bias_m_s2,
+                cfg.init_std_gyro_bias_rad_s,
+            ],
+            3,
+        )
+        ** 2
+    )
+    for k in range(n):
+        kf.predict()
+        if (k + 1) % 100 == 0:
+            kf.update(np.zeros(9))
+    np.testing.assert_allclose(out["cov_diag"][-1], np.diag(kf.P), rtol=2e-5)
+    assert out["updates"] == 3
+    np.testing.assert_allclose(out["gyro_bias"][-1], 0.0, atol=1e-12)
+
+
+def test_bias_estimates_track_the_simulated_truth(ramp):
+    log, model = ramp
+    cfg = zupt.ZuptConfig(heading_rad=0.4, decimation=10)
+    truth_cal = (log.truth["gyro_bias"] - model.predict(log.temp))[::10]
+    r = zupt.run(log, "zupt", model, cfg)
+    assert r.updates == 420
+    e = np.abs(r.gyro_bias - truth_cal)[r.t > 200]
+    # σ_ARW/√200 s ≈ 6.5e-5 rad/s; the filter's own 1σ is of that size: errors within 4σ.
+    assert np.all(e < 4 * r.gyro_bias_std[r.t > 200]), e.max()
+    assert 2e-5 < r.gyro_bias_std[-1, 0] < 8e-5
+    # Accelerometer bias: z is observable through the zero-velocity measurement.
+    assert abs(r.accel_bias[-1, 2] - log.truth["accel_bias"][0, 2]) < 4 * r.accel_bias_std[-1, 2]
+    # TCZUPT on raw data estimates the total bias, and its dT/dt follows the 2 °C/min ramp.
+    rt = zupt.run(log, "tczupt", model, cfg)
+    et = np.abs(rt.gyro_bias - log.truth["gyro_bias"][::10])[rt.t > 200]
+    assert np.all(et < 4 * rt.gyro_bias_std[rt.t > 200]), et.max()
+    ramping = (rt.t > 130) & (rt.t < 250)  # inside the first heating ramp (after the lag)
+    assert np.median(rt.temp_rate[ramping]) == pytest.approx(2.0 / 60.0, rel=0.15)
+    assert np.all(r.temp_rate == 0.0)
+
+
+def test_zeroing_starts_from_mean_minus_earth_rate(ramp):
+    log, _ = ramp
+    cfg = zupt.ZuptConfig(heading_rad=0.4, update_interval_s=1e6)  # no update: pure prediction
+    r = zupt.run(log, "zupt", None, cfg)
+    w_b = zupt._earth_rate_body(r.initial_attitude, 45.0)
+    np.testing.assert_allclose(r.gyro_bias[0], log.gyro[:6000].mean(axis=0) - w_b, atol=1e-15)
+    assert r.updates == 0
+    res = zupt.run(log, "zupt", None, cfg.replace(residual_gyro_bias_rad_s=zupt.RESIDUAL_BIAS_15DEG_H))
+    np.testing.assert_allclose(res.gyro_bias[0] - r.gyro_bias[0], zupt.RESIDUAL_BIAS_15DEG_H, atol=1e-15)
+
+
+def test_stationary_mask_and_magnetic_heading(ramp):
+    log, _ = ramp
+    still = np.ones(log.n, dtype=bool)
+    still[: log.n // 2] = False
+    r = zupt.run(log, "zupt", None, zupt.ZuptConfig(), stationary=still)
+    assert r.updates == 210
+    # Magnetic heading: with 0.1 rad east declination the horizontal field points 0.1 rad east
+    # of true north; a unit at true heading 0.4 reads magnetic heading 0.3, + D → 0.4.
+    from uasnav.attitude import quat_to_dcm
+
+    c_bn = quat_to_dcm(zupt.run(log, "zupt", None, zupt.ZuptConfig(heading_rad=0.4)).initial_attitude[None])[
+        0
+    ].T
+    rot = np.array([[np.cos(0.1), -np.sin(0.1), 0], [np.sin(0.1), np.cos(0.1), 0], [0, 0, 1]])
+    mag = np.tile(c_bn @ rot @ np.array([20.0, 0.0, 40.0]), (log.n, 1))
+    log_m = ImuLog(t=log.t, gyro=log.gyro, accel=log.accel, temp=log.temp, mag=mag)
+    rm = zupt.run(log_m, "zupt", None, zupt.ZuptConfig(declination_rad=0.1))
+    from uasnav.attitude import quat_to_euler
+
+    assert quat_to_euler(rm.initial_attitude[None])[0, 2] == pytest.approx(0.4, abs=1e-9)
+
+
+def test_errors_name_what_is_wrong(ramp):
+    log, _model = ramp
+    with pytest.raises(InputError, match="model"):
+        zupt.run(log, "tczupt")
+    with pytest.raises(InputError, match="mode"):
+        zupt.run(log, "kalman")  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="stationary"):
+        zupt.run(log, stationary=np.ones(3, dtype=bool))
+    g = np.zeros((100, 3))
+    a = np.tile([0.0, 0.0, -9.8], (100, 1))
+    g[57, 1] = np.nan
+    with pytest.raises(InputError, match=r"gyro_rad_s.*57"):
+        _core.zupt_run(g, a, 0.01, levelling_samples=10)
+    with pytest.raises(InputError, match='unknown key "sigma_arw"'):
+        _core.zupt_run(np.zeros((100, 3)), a, 0.01, config={"sigma_arw": 1.0})
+    with pytest.raises(InputError, match="meas_std_velocity_m_s"):
+        _core.zupt_run(np.zeros((100, 3)), a, 0.01, config={"meas_std_velocity_m_s": -1.0})
+    with pytest.raises(InputError, match="accel"):
+        _core.zupt_run(np.zeros((100, 3)), a[:50], 0.01)
+    with pytest.raises(InputError, match="temp"):
+        _core.zupt_run(np.zeros((100, 3)), a, 0.01, mode="tczupt")
+
+
+def test_cli_writes_the_est_csv_contract(tmp_path):
+    log = standin.static_log(120.0, seed=2)
+    path = tmp_path / "static.csv"
+    write_csv_v1(log, path)
+    est, png = tmp_path / "EST.csv", tmp_path / "bias.png"
+    r = CliRunner().invoke(
+        main,
+        ["zupt", str(path), "--residual-bias", "15deg/h", "--out", str(est), "--json", "--plot", str(png)],
+    )
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["updates"] == 120 and out["mode"] == "zupt"
+    assert out["residual_bias_rad_s"] == pytest.approx(zupt.RESIDUAL_BIAS_15DEG_H)
+    header = est.read_text().splitlines()[0].split(",")
+    assert header[:7] == ["t", "bgx", "bgy", "bgz", "bax", "bay", "baz"]
+    arr = np.loadtxt(est, delimiter=",", skiprows=1)
+    assert arr.shape == (log.n, len(zupt.CSV_COLUMNS))
+    np.testing.assert_allclose(arr[-1, 1:4], out["gyro_bias_rad_s"], rtol=1e-9)
+    assert png.stat().st_size > 1000
+    r = CliRunner().invoke(main, ["zupt", str(path), "--mode", "tczupt"])
+    assert r.exit_code == 2 and "--model is required" in r.output
+    r = CliRunner().invoke(main, ["zupt", str(path), "--residual-bias", "15 m/s"])
+    assert r.exit_code == 2 and "dimension" in r.output
+
+
+def test_report_section_quick(tmp_path):
+    r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--quick", "--only", "zupt"])
+    assert r.exit_code == 0, r.output
+    data = json.loads((tmp_path / "report.json").read_text())
+    z = data["sections"]["zupt"] if "sections" in data else data["zupt"]
+    z = z.get("data", z)
+    assert set(z["table10"]["nominal"]) == {"zupt", "tczupt"}
+    assert 0 < z["table10"]["nominal"]["zupt"]["x"]["vs_truth"] < 5e-4
+
+
+def test_adis16405_turn_on_bias_matches_mean_minus_earth_rate(shared_data):
+    """Real 2.78 h static ADIS16405 log: the ZUPT bias estimate (averaged after convergence)
+    agrees with the long-term mean output minus the Earth rate."""
+    from uasnav.noise import FilterNoise
+
+    z = np.load(shared_data / "imu" / "adis16405_static_imu1.npz")
+    gyro = np.deg2rad(z["gyro_dps"])
+    n = gyro.shape[0]
+    log = ImuLog(t=np.arange(n) / float(z["rate_hz"]), gyro=gyro, accel=z["accel_g"] * 9.80665)
+    noise = FilterNoise.from_datasheet(arw="2.4 deg/√h", gbi="1.5e-4 deg/s", vrw="0.2 m/s/√h", abi="2 m/s/h")
+    cfg = zupt.ZuptConfig(noise=noise, latitude_deg=51.08, heading_rad=0.0, decimation=100)
+    r = zupt.run(log, "zupt", None, cfg)
+    expected = gyro.mean(axis=0) - zupt._earth_rate_body(r.initial_attitude, 51.08)
+    est = r.gyro_bias[r.t > 600].mean(axis=0)
+    # Turn-on biases are ≈ 7e-3 rad/s (0.4 deg/s); agreement to 1e-4 rad/s (1.5 %) or better.
+    assert np.all(np.abs(expected) > 4e-3)
+    np.testing.assert_allclose(est, expected, atol=1e-4)
+
+
+def test_xio_stationary_intervals_detected_and_used(shared_data):
+    """Real x-IMU log (handled, about half at rest): the GLRT detector finds the rest periods,
+    and ZUPT on them estimates the bias of the first rest period as the mean gyro output."""
+    d = np.genfromtxt(shared_data / "imu" / "xio_fusion_sensor_data.csv", delimiter=",", skip_header=1)
+    t = d[:, 0]
+    tu = np.arange(t[0], t[-1], 0.01)  # the recording has gaps: resample to a uniform 100 Hz
+
+    def interp(x):
+        return np.column_stack([np.interp(tu, t, x[:, j]) for j in range(x.shape[1])])
+
+    log = ImuLog(t=tu, gyro=interp(np.deg2rad(d[:, 1:4])), accel=interp(d[:, 4:7] * 9.80665))
+    s = zupt.detect_stationary(log)
+    assert 0.35 < s.mask.mean() < 0.55
+    first = s.intervals[0]
+    assert first[0] == pytest.approx(tu[0]) and first[1] - first[0] > 10.0
+    r = zupt.run(log, "zupt", None, zupt.ZuptConfig(levelling_s=10.0), stationary="auto")
+    assert 0 < r.updates <= int(s.mask.sum() / 100) + len(s.intervals)
+    end = int(np.searchsorted(tu, first[1])) - 1
+    w_b = zupt._earth_rate_body(r.initial_attitude, 45.0)
+    mean_rest = log.gyro[: end + 1].mean(axis=0) - w_b
+    assert np.all(np.abs(r.gyro_bias[end] - mean_rest) < 3 * r.gyro_bias_std[end])
+    assert np.all(np.isfinite(r.gyro_bias)) and np.all(r.cov_diag > 0)
+    # The Rust detector's statistic is the GLRT formula evaluated directly (centred window).
+    k = 3000
+    win = slice(k - 12, k + 13)  # the default 0.25 s window: 25 samples centred on k
+    a, g = log.accel[win], log.gyro[win]
+    u = a.mean(axis=0) / np.linalg.norm(a.mean(axis=0))
+    direct = np.mean(np.sum((a - 9.80665 * u) ** 2, axis=1) / 0.05**2 + np.sum(g**2, axis=1) / 0.01**2)
+    assert s.statistic[k] == pytest.approx(direct, rel=1e-9)
+
+
+def test_rust_earth_model_matches_closed_forms():
+    """nav_core::earth (what the filter uses) against the WGS-84 closed forms written out here
+    (Somigliana, Groves eq. 2.139 free-air factor, radii of curvature)."""
+    a, e2, f = 6378137.0, 6.69437999014e-3, 1 / 298.257223563
+    b, mu, w = 6356752.31425, 3.986004418e14, 7.292115e-5
+    for lat_deg, h in ((0.0, 0.0), (45.0, 0.0), (51.08, 1100.0), (-89.0, 50.0), (90.0, 0.0)):
+        lat = np.deg2rad(lat_deg)
+        s2 = np.sin(lat) ** 2
+        g0 = 9.7803253359 * (1 + 0.00193185265241 * s2) / np.sqrt(1 - e2 * s2)
+        g = g0 * (1 - 2 * h / a * (1 + f * (1 - 2 * s2) + w * w * a * a * b / mu) + 3 * h * h / a**2)
+        assert _core.earth_normal_gravity(lat, h) == pytest.approx(g, rel=1e-14)
+        np.testing.assert_allclose(
+            _core.earth_rate_ned(lat), w * np.array([np.cos(lat), 0, -np.sin(lat)]), atol=1e-20
+        )
+        rn, re = _core.earth_radii(lat)
+        assert rn == pytest.approx(a * (1 - e2) / (1 - e2 * s2) ** 1.5, rel=1e-14)
+        assert re == pytest.approx(a / np.sqrt(1 - e2 * s2), rel=1e-14)
+    with pytest.raises(InputError, match="latitude_rad"):
+        _core.earth_normal_gravity(float("nan"), 0.0)
