@@ -24,6 +24,7 @@ pub mod allan;
 pub mod attitude;
 pub mod error;
 pub mod noise;
+pub mod redundancy;
 pub(crate) mod scalar;
 
 pub use error::NavError;
