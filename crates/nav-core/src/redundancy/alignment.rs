@@ -76,9 +76,10 @@ pub fn wahba<T: Real>(
         }
     };
     let sv = svd.singular_values;
-    let mut sorted = [sv[0], sv[1], sv[2]];
-    sorted.sort_by(|a, b| b.partial_cmp(a).unwrap_or(core::cmp::Ordering::Equal));
-    if !(sorted[0] > T::zero()) || sorted[1] <= sorted[0] * lit(1e-6) {
+    let hi = num_traits::Float::max(sv[0], num_traits::Float::max(sv[1], sv[2]));
+    let lo = num_traits::Float::min(sv[0], num_traits::Float::min(sv[1], sv[2]));
+    let mid = sv[0] + sv[1] + sv[2] - hi - lo;
+    if !(hi > T::zero()) || mid <= hi * lit(1e-6) {
         return Err(NavError::InvalidParameter {
             what: "wahba pairs",
             reason: "need at least two non-parallel vector pairs",

@@ -15,6 +15,10 @@
 //! for the cube). A sensor's *mounting* `C` maps IMU-frame vectors into its own frame,
 //! `ω_s = C·ω_imu`, so the rows of `C` are the sensor's axes resolved in the IMU frame
 //! (the same convention as `log.meta["mounting"]` of `uasnav.sim.simulate_array`).
+// `!(x > 0)` is deliberate throughout: it also rejects NaN. Index loops walk several
+// parallel fixed-size arrays (axes, sigma, bias, masks) at once.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+
 pub mod alignment;
 pub mod chi2;
 pub mod fusion;
