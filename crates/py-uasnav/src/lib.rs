@@ -6,6 +6,7 @@ mod allan;
 mod attitude;
 mod convert;
 mod errors;
+mod redundancy;
 
 use pyo3::prelude::*;
 
@@ -15,5 +16,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     allan::register(m)?;
     attitude::register(m)?;
+    redundancy::register(m)?;
     Ok(())
 }

@@ -327,6 +327,44 @@ impl<T: Real, const M: usize> SensorArray<T, M> {
         Ok(a)
     }
 
+    /// Axes `axes[i]` (IMU frame, unit to `tol`) grouped into sensors by `sensor_of[i]`,
+    /// which must start at 0 and never decrease or skip (axes of one sensor are adjacent).
+    pub fn from_axes(axes: &[Vector3<T>], sensor_of: &[usize], tol: T) -> Result<Self, NavError> {
+        if axes.len() != sensor_of.len() {
+            return Err(NavError::LengthMismatch {
+                what: "sensor_of",
+                expected: axes.len(),
+                got: sensor_of.len(),
+            });
+        }
+        let mut a = Self::empty();
+        for (i, (h, &s)) in axes.iter().zip(sensor_of).enumerate() {
+            let next = if i == 0 { 0 } else { sensor_of[i - 1] + 1 };
+            if !(s == next || (i > 0 && s == sensor_of[i - 1])) {
+                return Err(NavError::InvalidParameter {
+                    what: "sensor_of",
+                    reason: "sensor indices must start at 0 and increase by at most 1 per axis",
+                });
+            }
+            if h.iter().any(|v| !num_traits::Float::is_finite(*v)) {
+                return Err(NavError::NonFinite {
+                    what: "sensor axis",
+                    index: i,
+                });
+            }
+            if num_traits::Float::abs(h.norm() - T::one()) > tol {
+                return Err(NavError::InvalidParameter {
+                    what: "sensor axis",
+                    reason: "not a unit vector",
+                });
+            }
+            a.push_axis(*h, s)?;
+            a.n_sensors = s + 1;
+        }
+        a.check_observable()?;
+        Ok(a)
+    }
+
     /// Number of sensor axes (rows of `H`).
     pub fn n_axes(&self) -> usize {
         self.n_axes
