@@ -321,7 +321,9 @@ def fuse_axes(
     return AxisFusion(value, var, chi2, valid, alarm, health, sg, b)
 
 
-def stack_logs(logs: Sequence[ImuLog], *, time_tol_s: float = 1e-6) -> tuple[FloatArray, FloatArray, FloatArray]:
+def stack_logs(
+    logs: Sequence[ImuLog], *, time_tol_s: float = 1e-6
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Time, gyro and accelerometer columns (m, 3·s) of s triaxial sensor logs.
 
     Raises
@@ -539,7 +541,11 @@ class AlignmentResult:
 
 
 def relative_alignment(
-    vectors: ArrayLike, *, reference: int = 0, nominal: Configuration | None = None
+    vectors: ArrayLike,
+    *,
+    reference: int = 0,
+    nominal: Configuration | None = None,
+    differences: bool = True,
 ) -> AlignmentResult:
     """Relative rotations of sensors from vectors they measured together (Wahba, SVD).
 
@@ -555,6 +561,10 @@ def relative_alignment(
         Nominal triaxial configuration; returns misalignments against it and the compensated
         configuration whose mountings are ``C_br^bi · C_ref`` (the reference mounting is taken
         as nominal).
+    differences : bool
+        Align the differences ``v_k − v_0`` instead of the vectors (needs k ≥ 3): a constant
+        sensor bias (accelerometer turn-on bias, tens of mg on consumer MEMS, i.e. degrees of
+        tilt) cancels, so the sensors need no prior bias calibration.
 
     Notes
     -----
@@ -565,15 +575,17 @@ def relative_alignment(
     v = np.asarray(vectors, dtype=np.float64)
     if v.ndim != 3 or v.shape[2] != 3 or v.shape[1] < 2:
         raise InputError(f"vectors: expected shape (s, k ≥ 2, 3), got {v.shape}")
+    if differences:
+        if v.shape[1] < 3:
+            raise InputError("vectors: differences need k ≥ 3 attitudes (use differences=False)")
+        v = v[:, 1:, :] - v[:, :1, :]
     s = v.shape[0]
     if not 0 <= reference < s:
         raise InputError(f"reference: must index one of the {s} sensors, got {reference}")
     w = np.ones(v.shape[1])
     rel = np.empty((s, 3, 3))
     for i in range(s):
-        rel[i] = _core.redundancy_wahba(
-            np.ascontiguousarray(v[reference]), np.ascontiguousarray(v[i]), w
-        )
+        rel[i] = _core.redundancy_wahba(np.ascontiguousarray(v[reference]), np.ascontiguousarray(v[i]), w)
     mis = np.zeros((s, 3))
     comp = None
     if nominal is not None:
