@@ -179,7 +179,7 @@ def test_relative_alignment_recovers_known_mounting_errors(cube6) -> None:
     logs0 = None
     for k, e in enumerate(attitudes):
         logs = standin_array(
-            cube6.mountings(), duration=5.0, seed=11, euler_rad=e, mounting_error_rad=1 * DEG
+            cube6.mountings(), duration=5.0, seed=11, euler_rad=e, mounting_error_rad=1 * DEG, noise_seed=k
         )
         logs0 = logs0 or logs
         vecs.append([lg.accel.mean(axis=0) for lg in logs])
@@ -200,6 +200,24 @@ def test_relative_alignment_recovers_known_mounting_errors(cube6) -> None:
     np.testing.assert_allclose(R.relative_rotation(c_b_n[3], c_b_n[0]), true[3] @ true[0].T, atol=1e-12)
     # Levelling: roll/pitch of a level IMU seen by the +z-face sensor (its frame = IMU frame).
     np.testing.assert_allclose(R.level([[0.0, 0.0, -9.8]]), [[0.0, 0.0]], atol=1e-12)
+
+
+def test_report_section_quick(tmp_path) -> None:
+    import json
+
+    r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--quick", "--only", "redundancy"])
+    assert r.exit_code == 0, r.output
+    data = json.loads((tmp_path / "report.json").read_text())["sections"]["redundancy"]
+    assert [round(row["k_r"], 2) for row in data["table14"]] == [1.0, 0.71, 0.58, 0.5, 0.41]
+    # Fused cube: every threshold reached later, by about 1/k_r = √6 for bias-dominated drift.
+    raw = data["table15"]["raw output (no calibration)"]
+    assert all(60 < row[-1] < 250 for row in raw)
+    for _shape, _pf, _n, k_r, noise_ratio, _bias in data["improvement"]:
+        assert noise_ratio == pytest.approx(k_r, rel=0.08)
+    for name, dev_fdi, dev_plain, envelope, _flag in data["fdi"]:
+        assert dev_fdi < envelope
+        assert name.startswith("dropout") or dev_plain > envelope
+    assert data["alignment_max_error_deg"] < 0.02
 
 
 def test_cli_kr_and_fuse(tmp_path, cube6) -> None:

@@ -91,6 +91,7 @@ def standin_array(
     euler_rad: tuple[float, float, float] = (0.0, 0.0, 0.0),
     mounting_error_rad: float = 0.0,
     params: dict[str, float] | None = None,
+    noise_seed: int = 0,
 ) -> list[ImuLog]:
     """Static logs of triaxial sensors with the given nominal mountings (s, 3, 3).
 
@@ -110,6 +111,10 @@ def standin_array(
         σ (rad, per axis) of a random mounting error of every sensor but the first.
     params : dict, optional
         Overrides of :data:`LSM6DSM`.
+    noise_seed : int
+        Seed of the noise and bias-instability draws only: runs with the same ``seed`` and
+        different ``noise_seed`` share the mounting errors and turn-on biases (the same
+        hardware recorded twice).
     """
     m = np.asarray(mountings, dtype=np.float64)
     if m.ndim != 3 or m.shape[1:] != (3, 3):
@@ -118,6 +123,7 @@ def standin_array(
         raise InputError("duration, rate: must be > 0")
     p = {**LSM6DSM, **(params or {})}
     rng = np.random.default_rng(seed)
+    rng_noise = np.random.default_rng([seed, noise_seed])
     n = round(duration * rate)
     dt = 1.0 / rate
     t = dt * np.arange(n)
@@ -130,15 +136,15 @@ def standin_array(
         err = rng.normal(0.0, mounting_error_rad, 3) if (mounting_error_rad > 0 and i > 0) else np.zeros(3)
         c_true = _small_rotation(err) @ c_nom
         b_g = rng.uniform(-p["gyro_turn_on"], p["gyro_turn_on"], 3) + _gauss_markov(
-            rng, n, 3, p["gyro_bi"], p["bi_tau_s"], dt
+            rng_noise, n, 3, p["gyro_bi"], p["bi_tau_s"], dt
         )
         b_a = rng.uniform(-p["accel_turn_on"], p["accel_turn_on"], 3) + _gauss_markov(
-            rng, n, 3, p["accel_bi"], p["bi_tau_s"], dt
+            rng_noise, n, 3, p["accel_bi"], p["bi_tau_s"], dt
         )
         w_s = c_true @ w_imu
         f_s = c_true @ f_imu
-        gyro = w_s + b_g + p["gyro_nd"] * math.sqrt(rate) * rng.standard_normal((n, 3))
-        accel = f_s + b_a + p["accel_nd"] * math.sqrt(rate) * rng.standard_normal((n, 3))
+        gyro = w_s + b_g + p["gyro_nd"] * math.sqrt(rate) * rng_noise.standard_normal((n, 3))
+        accel = f_s + b_a + p["accel_nd"] * math.sqrt(rate) * rng_noise.standard_normal((n, 3))
         logs.append(
             ImuLog(
                 t=t,
