@@ -138,10 +138,20 @@ impl<T: Real, const S: usize> BiasKalman<T, S> {
         }
         let k = ph / s;
         self.x += k * (z - pred);
-        // P ← P − K·S·Kᵀ, then symmetrised against round-off.
-        self.p -= k * ph.transpose();
-        self.p = (self.p + self.p.transpose()) * crate::scalar::lit::<T>(0.5);
+        // P ← P − K·(PH)ᵀ = P − K·S·Kᵀ as an in-place rank-1 update; the caller
+        // symmetrises once per batch of scalar updates.
+        self.p.ger(-T::one(), &k, &ph, T::one());
         Ok(())
+    }
+
+    fn symmetrise(&mut self) {
+        for i in 0..S {
+            for j in (i + 1)..S {
+                let v = (self.p[(i, j)] + self.p[(j, i)]) * crate::scalar::lit::<T>(0.5);
+                self.p[(i, j)] = v;
+                self.p[(j, i)] = v;
+            }
+        }
     }
 
     /// Measurement update with one sample (one value per axis); axes with `use_axis[i]`
@@ -167,6 +177,7 @@ impl<T: Real, const S: usize> BiasKalman<T, S> {
             let g = self.h[i];
             self.scalar_update(&g, Some(i), z[i], self.r[i])?;
         }
+        self.symmetrise();
         Ok(())
     }
 
@@ -183,6 +194,7 @@ impl<T: Real, const S: usize> BiasKalman<T, S> {
             let g = Vector3::ith(j, T::one());
             self.scalar_update(&g, None, rate[j], sigma * sigma)?;
         }
+        self.symmetrise();
         Ok(())
     }
 
