@@ -268,3 +268,11 @@ def test_ardupilot_three_imus(shared_data) -> None:
     # third of this log (handling and flight vibration the IMUs see differently).
     assert res.static_gates_ok
     assert 0.6 < res.gyro_gate_ok_fraction < 0.75 and 0.6 < res.accel_gate_ok_fraction < 0.75
+
+
+def test_weights_are_the_allan_deviation_at_tau0(cube_logs) -> None:
+    from uasnav.allan import oadev
+
+    g = cube_logs[2].gyro
+    ref = oadev(g, rate=100.0, taus=[0.01]).adev[0]
+    np.testing.assert_allclose(R.white_noise_sigma(g), ref, rtol=1e-9)

@@ -211,6 +211,12 @@ impl<T: Real, const M: usize, const S: usize> FdiFuser<T, M, S> {
                 reason: "must be positive (infinity disables the check)",
             });
         }
+        if config.stuck_samples == 1 {
+            return Err(NavError::InvalidParameter {
+                what: "stuck_samples",
+                reason: "must be 0 (off) or at least 2 identical samples",
+            });
+        }
         let mut threshold = [T::infinity(); M];
         for (d, t) in threshold.iter_mut().enumerate().skip(1) {
             *t = chi2_threshold(d, config.p_fa)?;
@@ -536,6 +542,11 @@ mod tests {
         assert!(out.fused.value.iter().all(|v| v.is_nan()));
         assert_eq!(out.health[0].0, SensorHealth::NON_FINITE);
         assert!(f.step(&[0.0; 5]).is_err());
+        let one = FdiConfig {
+            stuck_samples: 1,
+            ..FdiConfig::default()
+        };
+        assert!(FdiFuser::<f64, 18, 6>::new(a, &[0.01; 6], one).is_err());
     }
 
     proptest::proptest! {
