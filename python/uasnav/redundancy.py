@@ -217,6 +217,39 @@ def white_noise_sigma(z: ArrayLike) -> FloatArray:
     return out
 
 
+def parity_residuals(config: Configuration, z: ArrayLike, sigma: ArrayLike) -> FloatArray:
+    """Least-squares residuals ``z − H·x̂`` (m, n) with weights ``1/σ²``; NaN rows where a
+    sample is non-finite. Their mean over a window is the observable (parity-space) part of
+    the axis biases; their spread measures how well the sensors agree."""
+    a = np.ascontiguousarray(np.asarray(z, dtype=np.float64))
+    if a.ndim != 2 or a.shape[1] != config.n_axes:
+        raise InputError(f"z: expected shape (m, {config.n_axes}), got {a.shape}")
+    s = np.ascontiguousarray(np.broadcast_to(np.asarray(sigma, dtype=np.float64), (config.n_axes,)))
+    return _core.redundancy_parity_residuals(*config._args(), a, s)
+
+
+def robust_sigma(config: Configuration, z: ArrayLike, sigma: ArrayLike) -> FloatArray:
+    """Per-axis σ (n,) implied by the robust spread of the parity residuals of ``z``.
+
+    ``σ_i = 1.4826·MAD(r_i)/√(1 − h_ii)`` with ``h_ii = h_iᵀ(HᵀWH)⁻¹h_i/σ_i²`` the leverage of
+    axis i (weights from ``sigma``). Use it as the FDI noise when the sensors disagree by more
+    than their white noise in normal operation (vibration, flexible mounts), so that the χ²
+    test flags gross faults rather than the vehicle's normal environment.
+    """
+    sg = np.broadcast_to(np.asarray(sigma, dtype=np.float64), (config.n_axes,))
+    r = parity_residuals(config, z, sg)
+    r = r[np.all(np.isfinite(r), axis=1)]
+    if r.shape[0] < 10:
+        raise InputError("z: fewer than 10 complete samples for a robust σ")
+    mad = 1.4826 * np.median(np.abs(r - np.median(r, axis=0)), axis=0)
+    cov = config.ls_covariance(sg)
+    lev = np.einsum("ij,jk,ik->i", config.axes, cov, config.axes) / sg**2
+    out = mad / np.sqrt(np.clip(1.0 - lev, 1e-12, None))
+    if np.any(out <= 0):
+        raise InputError("z: an axis has zero residual spread (no redundancy on it?)")
+    return out
+
+
 @dataclass(frozen=True)
 class AxisFusion:
     """Fusion of one quantity (rate or specific force) over all sensor axes.
@@ -621,7 +654,9 @@ __all__ = [
     "kalman_fuse",
     "kr",
     "level",
+    "parity_residuals",
     "relative_alignment",
+    "robust_sigma",
     "relative_rotation",
     "stack_logs",
     "table14",

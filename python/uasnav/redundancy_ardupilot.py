@@ -98,6 +98,11 @@ class ArduPilotFusion:
     fdi_alarm_fraction : float
         Fraction of samples on which the parity test (p_fa = 1e-6, σ from the static window)
         fired: vibration the IMUs see differently is not white noise.
+    robust_fdi_alarm_fraction : float
+        The same with σ from the robust spread of the whole log's parity residuals
+        (:func:`uasnav.redundancy.robust_sigma`).
+    robust_alarm_gate_overlap : float
+        Fraction of gyro-gate failures on which the robust parity test also fired.
     fused : FusionResult
     """
 
@@ -118,6 +123,8 @@ class ArduPilotFusion:
     max_gyro_diff_rad_s: float
     max_accel_diff_m_s2: float
     fdi_alarm_fraction: float
+    robust_fdi_alarm_fraction: float
+    robust_alarm_gate_overlap: float
     fused: R.FusionResult
 
 
@@ -155,6 +162,8 @@ def analyse_log(path: str | os.PathLike[str], *, static_window_s: float = 10.0) 
     sa = R.white_noise_sigma(a[win])
     fused = R.fuse(logs, cfg, fdi=False, gyro_sigma=sg, accel_sigma=sa)
     fdi = R.fuse_axes(cfg, g, sigma=sg, fdi=True, parity_bias_samples=win.stop)
+    s_rob = R.robust_sigma(cfg, g, sg)
+    fdi_rob = R.fuse_axes(cfg, g, sigma=s_rob, fdi=True, parity_bias_samples=win.stop)
     dg = _max_pairwise([lg.gyro for lg in logs])
     da = _max_pairwise([lg.accel for lg in logs])
     t = logs[0].t
@@ -176,6 +185,10 @@ def analyse_log(path: str | os.PathLike[str], *, static_window_s: float = 10.0) 
         average_noise_accel=R.white_noise_sigma(np.mean([lg.accel[win] for lg in logs], axis=0)),
         static_gates_ok=bool(np.all(dg[win] <= GYRO_GATE_RAD_S) and np.all(da[win] <= ACCEL_GATE_M_S2)),
         fdi_alarm_fraction=float(np.mean(fdi.alarm)),
+        robust_fdi_alarm_fraction=float(np.mean(fdi_rob.alarm)),
+        robust_alarm_gate_overlap=float(np.mean(fdi_rob.alarm[dg > GYRO_GATE_RAD_S]))
+        if np.any(dg > GYRO_GATE_RAD_S)
+        else 1.0,
         fused=fused,
     )
 
