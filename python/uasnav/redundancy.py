@@ -462,7 +462,12 @@ def fuse(
     n0 = 0
     if parity_bias_s > 0:
         n0 = int(np.searchsorted(t, t[0] + parity_bias_s))
-    common = {"fdi": fdi, "p_fa": p_fa, "stuck_samples": stuck_samples, "parity_bias_samples": n0}
+    common: dict[str, Any] = {
+        "fdi": fdi,
+        "p_fa": p_fa,
+        "stuck_samples": stuck_samples,
+        "parity_bias_samples": n0,
+    }
     gf = fuse_axes(config, g, sigma=gyro_sigma, saturation=gyro_saturation, **common)
     af = fuse_axes(config, a, sigma=accel_sigma, saturation=accel_saturation, **common)
     return FusionResult(t=t, gyro=gf, accel=af, config=config, meta={"fused_sensors": len(logs), "fdi": fdi})

@@ -126,7 +126,7 @@ def standin_array(
     rng_noise = np.random.default_rng([seed, noise_seed])
     n = round(duration * rate)
     dt = 1.0 / rate
-    t = dt * np.arange(n)
+    t = np.linspace(0.0, (n - 1) * dt, n)
     lat = math.radians(latitude_deg)
     c_bn = _dcm_321(*euler_rad)
     w_imu = c_bn.T @ (OMEGA_IE * np.array([math.cos(lat), 0.0, -math.sin(lat)]))
