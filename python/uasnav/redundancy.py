@@ -305,8 +305,9 @@ def fuse_axes(
     z : array_like, shape (m, n)
         One column per sensor axis (``config.axes`` order); NaN marks a dropout.
     sigma : array_like, shape (n,), optional
-        White-noise σ per sample per axis (weights ``1/σ²``); default
-        :func:`white_noise_sigma` of ``z``.
+        Noise σ per sample per axis (weights ``1/σ²`` and the χ² scale); default
+        :func:`white_noise_sigma` of ``z`` (the Allan deviation at τ₀), or with ``fdi`` and a
+        learning window, :func:`robust_sigma` over that window.
     bias : array_like, shape (n,), optional
         Per-axis bias corrections (subtracted).
     fdi : bool
@@ -329,7 +330,14 @@ def fuse_axes(
     n = config.n_axes
     if a.ndim != 2 or a.shape[1] != n:
         raise InputError(f"z: expected shape (m, {n}) (one column per sensor axis), got {a.shape}")
-    sg = white_noise_sigma(a) if sigma is None else np.asarray(sigma, dtype=np.float64)
+    if sigma is None:
+        sg = white_noise_sigma(a)
+        if fdi and parity_bias_samples >= 10:
+            # The χ² test needs the per-sample σ, which the Allan deviation at τ₀
+            # underestimates when the sensor low-pass filters its output (correlated samples).
+            sg = robust_sigma(config, a[:parity_bias_samples], sg)
+    else:
+        sg = np.asarray(sigma, dtype=np.float64)
     b = np.zeros(n) if bias is None else np.array(bias, dtype=np.float64)
     if sg.shape != (n,) or b.shape != (n,):
         raise InputError(f"sigma, bias: expected shape ({n},), got {sg.shape}, {b.shape}")

@@ -208,7 +208,7 @@ def build(w: SectionWriter) -> None:
     z = z + motion @ cube.axes.T
     w_imu = motion + w_true
     k0 = len(t) // 2
-    sigma = R.white_noise_sigma(z[:n_init])
+    sigma = R.robust_sigma(cube, z[:n_init], R.white_noise_sigma(z[:n_init]))
     opts: dict[str, Any] = {
         "sigma": sigma,
         "saturation": 4.3,
