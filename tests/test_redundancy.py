@@ -209,9 +209,10 @@ def test_report_section_quick(tmp_path) -> None:
     assert r.exit_code == 0, r.output
     data = json.loads((tmp_path / "report.json").read_text())["sections"]["redundancy"]
     assert [round(row["k_r"], 2) for row in data["table14"]] == [1.0, 0.71, 0.58, 0.5, 0.41]
-    # Fused cube: every threshold reached later, by about 1/k_r = √6 for bias-dominated drift.
+    # Fused cube vs a typical face: every threshold reached later, by about 1/k_r = √6
+    # (Δt% ≈ +145 %) for bias-dominated drift; the median is over faces and runs.
     raw = data["table15"]["raw output (no calibration)"]
-    assert all(60 < row[-1] < 250 for row in raw)
+    assert all(60 < row[-1] < 300 for row in raw)
     for _shape, _pf, _n, k_r, noise_ratio, _bias in data["improvement"]:
         assert noise_ratio == pytest.approx(k_r, rel=0.08)
     for name, dev_fdi, dev_plain, envelope, _flag in data["fdi"]:
