@@ -250,6 +250,13 @@ def test_cli_kr_and_fuse(tmp_path, cube6) -> None:
     assert fused.n == 2000
     r = CliRunner().invoke(main, ["redundancy", "fuse", *paths[:5], "--shape", "cube", "--out", str(out)])
     assert r.exit_code == 1 and "do not fill" in r.output
+    # Three IMUs sharing the IMU frame (an autopilot's), no FDI: the fused rate is the
+    # noise-weighted mean of the three.
+    r = CliRunner().invoke(main, ["redundancy", "fuse", *paths[:3], "--shape", "aligned", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    fused = read_csv_v1(out)
+    three = np.mean([read_csv_v1(p).gyro for p in paths[:3]], axis=0)
+    assert np.abs(fused.gyro - three).max() < 0.02 * np.abs(three).max()
 
 
 def test_ardupilot_three_imus(shared_data) -> None:
