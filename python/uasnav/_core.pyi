@@ -32,6 +32,18 @@ __all__ = [
     "noise_read_points",
     "zupt_detect_static",
     "zupt_run",
+    "redundancy_chi2_threshold",
+    "redundancy_face_config",
+    "redundancy_face_normals",
+    "redundancy_fuse",
+    "redundancy_kalman",
+    "redundancy_kr",
+    "redundancy_level",
+    "redundancy_ls_covariance",
+    "redundancy_mountings_config",
+    "redundancy_parity_residuals",
+    "redundancy_relative_rotation",
+    "redundancy_wahba",
 ]
 
 # --- allan / noise -------------------------------------------------------------------------
@@ -150,3 +162,84 @@ def earth_rate_ned(latitude_rad: float) -> list[float]:
 
 def earth_radii(latitude_rad: float) -> tuple[float, float]:
     """Meridian and transverse radii of curvature (m) at geodetic latitude (rad)."""
+# --- redundancy ----------------------------------------------------------------------------
+def redundancy_face_config(
+    shape: str, counts: list[int], triaxial: bool
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Axes (n, 3) and sensor index (n,) of counts[f] sensors on face f of a Platonic solid."""
+
+def redundancy_mountings_config(
+    mountings: NDArray[np.float64], tol: float = 1e-6
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Axes and sensor index of triaxial sensors with mountings (s, 3, 3) (IMU → sensor)."""
+
+def redundancy_face_normals(shape: str) -> NDArray[np.float64]:
+    """Face normals (F, 3) of a Platonic solid."""
+
+def redundancy_kr(axes: NDArray[np.float64], sensor_of: list[int]) -> list[float]:
+    """Improvement factor k_r per IMU axis (eq. 40) of a configuration."""
+
+def redundancy_ls_covariance(
+    axes: NDArray[np.float64], sensor_of: list[int], sigma: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Least-squares covariance (HᵀWH)⁻¹ (3, 3) for per-axis noise sigma (n,)."""
+
+def redundancy_chi2_threshold(dof: int, p_fa: float) -> float:
+    """Upper χ² quantile for dof and false-alarm probability p_fa."""
+
+def redundancy_fuse(
+    axes: NDArray[np.float64],
+    sensor_of: list[int],
+    z: NDArray[np.float64],
+    sigma: NDArray[np.float64],
+    bias: NDArray[np.float64],
+    fdi: bool,
+    p_fa: float = 1e-6,
+    saturation: float = ...,
+    stuck_samples: int = 0,
+    max_isolations: int = 2,
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.bool_],
+    NDArray[np.bool_],
+    NDArray[np.uint8],
+]:
+    """Batch fusion of z (m, n): (fused (m, 3), variance (m, 3), chi2 (m,), valid (m,),
+    alarm (m,), health (m, n_sensors))."""
+
+def redundancy_parity_residuals(
+    axes: NDArray[np.float64],
+    sensor_of: list[int],
+    z: NDArray[np.float64],
+    sigma: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """LS residuals z − H·x̂ (m, n); NaN rows where a sample is non-finite."""
+
+def redundancy_kalman(
+    axes: NDArray[np.float64],
+    sensor_of: list[int],
+    z: NDArray[np.float64],
+    sigma: NDArray[np.float64],
+    rate_psd: float,
+    bias_psd: float,
+    bias_sigma0: float,
+    rate_sigma0: float,
+    zero_rate: list[bool] | None = None,
+    zero_rate_sigma: float = 1e-3,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Kalman fusion with per-axis bias states: (rate, rate σ, biases, bias σ)."""
+
+def redundancy_level(f: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Roll and pitch (k, 2) rad from mean specific forces (k, 3) m/s²."""
+
+def redundancy_relative_rotation(
+    c_bi_n: NDArray[np.float64], c_br_n: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Eq. (45): C_br^bi = (C_bi^n)ᵀ · C_br^n."""
+
+def redundancy_wahba(
+    v_ref: NDArray[np.float64], v_sensor: NDArray[np.float64], weights: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Rotation C (3, 3), reference → sensor, with v_sensor ≈ C·v_ref."""

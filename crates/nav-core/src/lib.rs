@@ -26,6 +26,7 @@ pub mod earth;
 pub mod error;
 pub mod mlp;
 pub mod noise;
+pub mod redundancy;
 pub(crate) mod scalar;
 pub mod zupt;
 

@@ -9,6 +9,7 @@ mod earth;
 mod errors;
 mod mlp;
 mod zupt;
+mod redundancy;
 
 use pyo3::prelude::*;
 
@@ -21,5 +22,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     mlp::register(m)?;
     earth::register(m)?;
     zupt::register(m)?;
+    redundancy::register(m)?;
     Ok(())
 }

@@ -1,0 +1,507 @@
+//! Binding of `nav_core::redundancy`: configurations, k_r, and batch fusion / FDI / Kalman
+//! over whole multi-sensor logs (one row per sample, one column per sensor axis).
+use nalgebra::{Matrix3, Vector3};
+use nav_core::redundancy::alignment;
+use nav_core::redundancy::chi2;
+use nav_core::redundancy::fusion::{wls, FdiConfig, FdiFuser, SensorHealth};
+use nav_core::redundancy::geometry::{AxisKind, Polyhedron, SensorArray};
+use nav_core::redundancy::kalman::{BiasKalman, BiasKalmanConfig};
+use nav_core::NavError;
+use numpy::ndarray::{Array1, Array2};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    PyUntypedArrayMethods,
+};
+use pyo3::prelude::*;
+
+use crate::convert::{rows, slice1};
+use crate::errors::{input_error, IntoPy};
+
+/// Axes capacity of the binding (3 triaxial sensors on each of the icosahedron's 20 faces).
+const M: usize = 180;
+/// Sensor capacity.
+const S: usize = 60;
+
+type Arr = SensorArray<f64, M>;
+type Axes<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>);
+
+fn export<'py>(py: Python<'py>, a: &Arr) -> Axes<'py> {
+    let n = a.n_axes();
+    let axes = Array2::from_shape_fn((n, 3), |(i, j)| a.axis(i)[j]);
+    let sens = Array1::from_iter((0..n).map(|i| a.sensor_of(i) as i64));
+    (axes.into_pyarray(py), sens.into_pyarray(py))
+}
+
+fn build(py: Python<'_>, axes: &PyReadonlyArray2<'_, f64>, sensor_of: &[usize]) -> PyResult<Arr> {
+    let r = rows::<3>(py, "axes", axes)?;
+    let v: Vec<Vector3<f64>> = r.iter().map(|a| Vector3::from(*a)).collect();
+    Arr::from_axes(&v, sensor_of, 1e-6).py_err(py)
+}
+
+fn matrix<'py>(
+    py: Python<'py>,
+    a: &PyReadonlyArray2<'py, f64>,
+    name: &str,
+) -> PyResult<Matrix3<f64>> {
+    let r = rows::<3>(py, name, a)?;
+    if r.len() != 3 {
+        return Err(input_error(
+            py,
+            format!("{name}: expected shape (3, 3), got ({}, 3)", r.len()),
+        ));
+    }
+    Ok(Matrix3::from_fn(|i, j| r[i][j]))
+}
+
+/// Borrows an (m, n) float64 sample matrix with n == n_axes.
+fn samples<'a>(
+    py: Python<'_>,
+    z: &'a PyReadonlyArray2<'_, f64>,
+    n: usize,
+) -> PyResult<(&'a [f64], usize)> {
+    let shape = z.shape();
+    if shape[1] != n {
+        return Err(input_error(
+            py,
+            format!("z: expected shape (m, {n}) (one column per sensor axis), got {shape:?}"),
+        ));
+    }
+    let flat = z
+        .as_slice()
+        .map_err(|_| input_error(py, "z: expected a C-contiguous float64 array".into()))?;
+    Ok((flat, shape[0]))
+}
+
+fn check_len(py: Python<'_>, name: &str, got: usize, n: usize) -> PyResult<()> {
+    if got != n {
+        return Err(input_error(
+            py,
+            format!("{name}: expected length {n} (one per sensor axis), got {got}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Axes (n, 3) and sensor index (n,) of counts[f] sensors on face f of a Platonic solid.
+#[pyfunction]
+fn redundancy_face_config<'py>(
+    py: Python<'py>,
+    shape: &str,
+    counts: Vec<usize>,
+    triaxial: bool,
+) -> PyResult<Axes<'py>> {
+    let p = Polyhedron::from_name(shape).py_err(py)?;
+    let kind = if triaxial {
+        AxisKind::Triaxial
+    } else {
+        AxisKind::Single
+    };
+    let a = Arr::from_face_counts(p, &counts, kind).py_err(py)?;
+    Ok(export(py, &a))
+}
+
+/// Axes and sensor index of triaxial sensors with mountings (s, 3, 3) (IMU → sensor).
+#[pyfunction]
+#[pyo3(signature = (mountings, tol=1e-6))]
+fn redundancy_mountings_config<'py>(
+    py: Python<'py>,
+    mountings: PyReadonlyArray3<'py, f64>,
+    tol: f64,
+) -> PyResult<Axes<'py>> {
+    let shape = mountings.shape();
+    if shape[1] != 3 || shape[2] != 3 {
+        return Err(input_error(
+            py,
+            format!("mountings: expected shape (s, 3, 3), got {shape:?}"),
+        ));
+    }
+    let v = mountings.as_array();
+    let ms: Vec<Matrix3<f64>> = (0..shape[0])
+        .map(|s| Matrix3::from_fn(|i, j| v[(s, i, j)]))
+        .collect();
+    let mut a = Arr::empty();
+    for (s, c) in ms.iter().enumerate() {
+        a.push_triaxial(c, tol)
+            .map_err(|e| input_error(py, format!("mountings[{s}]: {e}")))?;
+    }
+    a.check_observable().py_err(py)?;
+    Ok(export(py, &a))
+}
+
+/// Face normals (F, 3) of a Platonic solid.
+#[pyfunction]
+fn redundancy_face_normals<'py>(
+    py: Python<'py>,
+    shape: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let p = Polyhedron::from_name(shape).py_err(py)?;
+    let mut out = Array2::zeros((p.faces(), 3));
+    for f in 0..p.faces() {
+        let n: Vector3<f64> = p.face_normal(f).py_err(py)?;
+        for j in 0..3 {
+            out[(f, j)] = n[j];
+        }
+    }
+    Ok(out.into_pyarray(py))
+}
+
+/// Improvement factor k_r per IMU axis (eq. 40) of a configuration.
+#[pyfunction]
+fn redundancy_kr(
+    py: Python<'_>,
+    axes: PyReadonlyArray2<'_, f64>,
+    sensor_of: Vec<usize>,
+) -> PyResult<[f64; 3]> {
+    let a = build(py, &axes, &sensor_of)?;
+    let k = a.k_r().py_err(py)?;
+    Ok([k[0], k[1], k[2]])
+}
+
+/// Least-squares covariance (HᵀWH)⁻¹ (3, 3) for per-axis noise sigma (n,).
+#[pyfunction]
+fn redundancy_ls_covariance<'py>(
+    py: Python<'py>,
+    axes: PyReadonlyArray2<'py, f64>,
+    sensor_of: Vec<usize>,
+    sigma: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let a = build(py, &axes, &sensor_of)?;
+    let s = slice1(py, "sigma", &sigma)?;
+    check_len(py, "sigma", s.len(), a.n_axes())?;
+    let c = a.ls_covariance(s).py_err(py)?;
+    Ok(Array2::from_shape_fn((3, 3), |(i, j)| c[(i, j)]).into_pyarray(py))
+}
+
+/// Upper χ² quantile for dof and false-alarm probability p_fa.
+#[pyfunction]
+fn redundancy_chi2_threshold(py: Python<'_>, dof: usize, p_fa: f64) -> PyResult<f64> {
+    chi2::chi2_threshold(dof, p_fa).py_err(py)
+}
+
+type FuseOut<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray2<u8>>,
+);
+
+/// Batch fusion of z (m, n): (fused (m, 3), variance (m, 3), chi2 (m,), valid (m,),
+/// alarm (m,), health (m, n_sensors) bit flags). Without fdi, only non-finite samples are
+/// screened out and the parity statistic is reported but not acted on.
+#[pyfunction]
+#[pyo3(signature = (axes, sensor_of, z, sigma, bias, fdi, p_fa=1e-6, saturation=f64::INFINITY, stuck_samples=0, max_isolations=2))]
+#[allow(clippy::too_many_arguments)]
+fn redundancy_fuse<'py>(
+    py: Python<'py>,
+    axes: PyReadonlyArray2<'py, f64>,
+    sensor_of: Vec<usize>,
+    z: PyReadonlyArray2<'py, f64>,
+    sigma: PyReadonlyArray1<'py, f64>,
+    bias: PyReadonlyArray1<'py, f64>,
+    fdi: bool,
+    p_fa: f64,
+    saturation: f64,
+    stuck_samples: u32,
+    max_isolations: usize,
+) -> PyResult<FuseOut<'py>> {
+    let a = build(py, &axes, &sensor_of)?;
+    let n = a.n_axes();
+    let ns = a.n_sensors();
+    if ns > S {
+        return Err(input_error(
+            py,
+            format!("sensor_of: at most {S} sensors, got {ns}"),
+        ));
+    }
+    let (flat, m) = samples(py, &z, n)?;
+    let sg = slice1(py, "sigma", &sigma)?;
+    let bs = slice1(py, "bias", &bias)?;
+    check_len(py, "sigma", sg.len(), n)?;
+    check_len(py, "bias", bs.len(), n)?;
+    let cfg = FdiConfig {
+        p_fa,
+        saturation,
+        stuck_samples,
+        max_isolations,
+    };
+    let mut fuser = FdiFuser::<f64, M, S>::new(a, sg, cfg).py_err(py)?;
+    fuser.set_axis_bias(bs).py_err(py)?;
+    let res = py.detach(|| -> Result<_, NavError> {
+        let mut fused = Array2::from_elem((m, 3), f64::NAN);
+        let mut var = Array2::from_elem((m, 3), f64::NAN);
+        let mut chi = Array1::from_elem(m, f64::NAN);
+        let mut valid = Array1::from_elem(m, false);
+        let mut alarm = Array1::from_elem(m, false);
+        let mut health = Array2::<u8>::zeros((m, ns));
+        let mut use_axis = [false; M];
+        for k in 0..m {
+            let zk = &flat[k * n..(k + 1) * n];
+            if fdi {
+                let out = fuser.step(zk)?;
+                valid[k] = out.valid;
+                alarm[k] = out.alarm;
+                for s in 0..ns {
+                    health[(k, s)] = out.health[s].0;
+                }
+                if out.valid {
+                    for j in 0..3 {
+                        fused[(k, j)] = out.fused.value[j];
+                        var[(k, j)] = out.fused.covariance[(j, j)];
+                    }
+                    chi[k] = out.fused.chi2;
+                }
+            } else {
+                for i in 0..n {
+                    use_axis[i] = zk[i].is_finite();
+                    if !use_axis[i] {
+                        health[(k, a.sensor_of(i))] |= SensorHealth::NON_FINITE;
+                    }
+                }
+                for i in 0..n {
+                    // A sensor with one bad axis is dropped as a whole, as with FDI.
+                    use_axis[i] = health[(k, a.sensor_of(i))] == 0;
+                }
+                match wls(&a, zk, sg, bs, &use_axis[..n]) {
+                    Ok(f) => {
+                        valid[k] = true;
+                        chi[k] = f.chi2;
+                        for j in 0..3 {
+                            fused[(k, j)] = f.value[j];
+                            var[(k, j)] = f.covariance[(j, j)];
+                        }
+                    }
+                    Err(NavError::InvalidParameter { .. }) => {}
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+        Ok((fused, var, chi, valid, alarm, health))
+    });
+    let (fused, var, chi, valid, alarm, health) = res.py_err(py)?;
+    Ok((
+        fused.into_pyarray(py),
+        var.into_pyarray(py),
+        chi.into_pyarray(py),
+        valid.into_pyarray(py),
+        alarm.into_pyarray(py),
+        health.into_pyarray(py),
+    ))
+}
+
+/// Least-squares residuals r = z − H·x̂ (m, n) with weights 1/sigma²; rows with a non-finite
+/// sample are NaN (and excluded from learning by the caller).
+#[pyfunction]
+fn redundancy_parity_residuals<'py>(
+    py: Python<'py>,
+    axes: PyReadonlyArray2<'py, f64>,
+    sensor_of: Vec<usize>,
+    z: PyReadonlyArray2<'py, f64>,
+    sigma: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let a = build(py, &axes, &sensor_of)?;
+    let n = a.n_axes();
+    let (flat, m) = samples(py, &z, n)?;
+    let sg = slice1(py, "sigma", &sigma)?;
+    check_len(py, "sigma", sg.len(), n)?;
+    let res = py.detach(|| -> Result<_, NavError> {
+        let mut out = Array2::from_elem((m, n), f64::NAN);
+        let zero = [0.0; M];
+        let all = [true; M];
+        for k in 0..m {
+            let zk = &flat[k * n..(k + 1) * n];
+            if zk.iter().any(|v| !v.is_finite()) {
+                continue;
+            }
+            let f = wls(&a, zk, sg, &zero[..n], &all[..n])?;
+            for i in 0..n {
+                out[(k, i)] = zk[i] - a.axis(i).dot(&f.value);
+            }
+        }
+        Ok(out)
+    });
+    Ok(res.py_err(py)?.into_pyarray(py))
+}
+
+type KfOut<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+);
+
+/// Rate, rate σ, axis biases, bias σ.
+type KfArrays = (Array2<f64>, Array2<f64>, Array2<f64>, Array2<f64>);
+
+#[allow(clippy::too_many_arguments)]
+fn kalman_run<const K: usize>(
+    a: &Arr,
+    flat: &[f64],
+    m: usize,
+    sigma: &[f64],
+    dt_s: f64,
+    cfg: BiasKalmanConfig<f64>,
+    zero_rate: Option<&[bool]>,
+    zero_rate_sigma: f64,
+) -> Result<KfArrays, NavError> {
+    let n = a.n_axes();
+    let mut kf = BiasKalman::<f64, K>::new(a, sigma, cfg)?;
+    let mut rate = Array2::zeros((m, 3));
+    let mut rate_sd = Array2::zeros((m, 3));
+    let mut bias = Array2::zeros((m, n));
+    let mut bias_sd = Array2::zeros((m, n));
+    let mut use_axis = vec![true; n];
+    for k in 0..m {
+        let zk = &flat[k * n..(k + 1) * n];
+        for i in 0..n {
+            use_axis[i] = zk[i].is_finite();
+        }
+        if k > 0 {
+            kf.predict(dt_s)?;
+        }
+        kf.update(zk, &use_axis)?;
+        if zero_rate.is_some_and(|z| z[k]) {
+            kf.update_rate(&Vector3::zeros(), zero_rate_sigma)?;
+        }
+        let r = kf.rate();
+        let rs = kf.rate_sigma();
+        for j in 0..3 {
+            rate[(k, j)] = r[j];
+            rate_sd[(k, j)] = rs[j];
+        }
+        for i in 0..n {
+            bias[(k, i)] = kf.axis_bias(i);
+            bias_sd[(k, i)] = kf.axis_bias_sigma(i);
+        }
+    }
+    Ok((rate, rate_sd, bias, bias_sd))
+}
+
+/// Kalman fusion with per-axis bias states over z (m, n) sampled every dt_s: (rate (m, 3),
+/// rate σ (m, 3), axis biases (m, n), bias σ (m, n)). zero_rate (m,) marks samples where the
+/// true rate is known to be zero (static), applied with zero_rate_sigma.
+#[pyfunction]
+#[pyo3(signature = (axes, sensor_of, z, sigma, dt_s, rate_psd, bias_psd, bias_sigma0, rate_sigma0, zero_rate=None, zero_rate_sigma=1e-3))]
+#[allow(clippy::too_many_arguments)]
+fn redundancy_kalman<'py>(
+    py: Python<'py>,
+    axes: PyReadonlyArray2<'py, f64>,
+    sensor_of: Vec<usize>,
+    z: PyReadonlyArray2<'py, f64>,
+    sigma: PyReadonlyArray1<'py, f64>,
+    dt_s: f64,
+    rate_psd: f64,
+    bias_psd: f64,
+    bias_sigma0: f64,
+    rate_sigma0: f64,
+    zero_rate: Option<Vec<bool>>,
+    zero_rate_sigma: f64,
+) -> PyResult<KfOut<'py>> {
+    let a = build(py, &axes, &sensor_of)?;
+    let n = a.n_axes();
+    let (flat, m) = samples(py, &z, n)?;
+    let sg = slice1(py, "sigma", &sigma)?;
+    check_len(py, "sigma", sg.len(), n)?;
+    if let Some(zr) = &zero_rate {
+        if zr.len() != m {
+            return Err(input_error(
+                py,
+                format!("zero_rate: expected length {m}, got {}", zr.len()),
+            ));
+        }
+    }
+    let cfg = BiasKalmanConfig {
+        rate_psd,
+        bias_psd,
+        bias_sigma0,
+        rate_sigma0,
+    };
+    let zr = zero_rate.as_deref();
+    let res = py.detach(|| {
+        if n + 3 <= 21 {
+            kalman_run::<21>(&a, flat, m, sg, dt_s, cfg, zr, zero_rate_sigma)
+        } else if n + 3 <= 63 {
+            kalman_run::<63>(&a, flat, m, sg, dt_s, cfg, zr, zero_rate_sigma)
+        } else {
+            Err(NavError::InvalidParameter {
+                what: "sensor axes",
+                reason: "the Kalman binding supports at most 60 axes",
+            })
+        }
+    });
+    let (r, rs, b, bsd) = res.py_err(py)?;
+    Ok((
+        r.into_pyarray(py),
+        rs.into_pyarray(py),
+        b.into_pyarray(py),
+        bsd.into_pyarray(py),
+    ))
+}
+
+/// Roll and pitch (k, 2) rad from mean specific forces (k, 3) m/s².
+#[pyfunction]
+fn redundancy_level<'py>(
+    py: Python<'py>,
+    f: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r = rows::<3>(py, "f", &f)?;
+    let mut out = Array2::zeros((r.len(), 2));
+    for (k, v) in r.iter().enumerate() {
+        let (roll, pitch) = alignment::level(&Vector3::from(*v))
+            .map_err(|e| input_error(py, format!("f[{k}]: {e}")))?;
+        out[(k, 0)] = roll;
+        out[(k, 1)] = pitch;
+    }
+    Ok(out.into_pyarray(py))
+}
+
+/// Eq. (45): C_br^bi (3, 3) = (C_bi^n)ᵀ · C_br^n.
+#[pyfunction]
+fn redundancy_relative_rotation<'py>(
+    py: Python<'py>,
+    c_bi_n: PyReadonlyArray2<'py, f64>,
+    c_br_n: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let a = matrix(py, &c_bi_n, "c_bi_n")?;
+    let b = matrix(py, &c_br_n, "c_br_n")?;
+    let c = alignment::relative_rotation(&a, &b);
+    Ok(Array2::from_shape_fn((3, 3), |(i, j)| c[(i, j)]).into_pyarray(py))
+}
+
+/// Rotation C (3, 3), reference → sensor, with v_sensor ≈ C·v_ref (Wahba, SVD).
+#[pyfunction]
+fn redundancy_wahba<'py>(
+    py: Python<'py>,
+    v_ref: PyReadonlyArray2<'py, f64>,
+    v_sensor: PyReadonlyArray2<'py, f64>,
+    weights: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r: Vec<Vector3<f64>> = rows::<3>(py, "v_ref", &v_ref)?
+        .iter()
+        .map(|a| Vector3::from(*a))
+        .collect();
+    let s: Vec<Vector3<f64>> = rows::<3>(py, "v_sensor", &v_sensor)?
+        .iter()
+        .map(|a| Vector3::from(*a))
+        .collect();
+    let w = slice1(py, "weights", &weights)?;
+    let c = alignment::wahba(&r, &s, w).py_err(py)?;
+    Ok(Array2::from_shape_fn((3, 3), |(i, j)| c[(i, j)]).into_pyarray(py))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(redundancy_face_config, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_mountings_config, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_face_normals, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_kr, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_ls_covariance, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_chi2_threshold, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_fuse, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_parity_residuals, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_kalman, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_level, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_relative_rotation, m)?)?;
+    m.add_function(wrap_pyfunction!(redundancy_wahba, m)?)?;
+    Ok(())
+}
