@@ -61,82 +61,16 @@ def bench_sim(n: int, repeat: int) -> None:
     print(
         f"flicker n={n:.0e}: uasnav GM sum (3 axes) {t_gm * 1e3:8.1f} ms | allantools.noise.pink (1 axis)"
         f" {t_pink * 1e3:8.1f} ms | ratio per axis {t_pink / (t_gm / 3):5.1f}x"
-def bench_mission(n_uas: int, n_cam: int, repeat: int) -> None:
-    from uasnav.mission import Targets, Weights, rank, score_matrix
-
-    ur, um, uc = rng.uniform(500, 8000, n_uas), rng.uniform(250, 9000, n_uas), rng.uniform(300, 20000, n_uas)
-    cm, cc, ci = rng.uniform(40, 700, n_cam), rng.uniform(300, 16000, n_cam), rng.uniform(0.005, 0.08, n_cam)
-    feasible = (um[:, None] * 0.3 >= cm[None, :]) & (ur[:, None] > 1500)
-    t, w = Targets(), Weights()
-
-    def ours() -> object:
-        s = score_matrix(ur, um, uc, cm, cc, ci, t, w, feasible)
-        return rank(s.total, 10)
-
-    def loop(rows: int) -> None:
-        # The same eq. 61 as a plain Python double loop (the thesis tool's per-pair approach).
-        for i in range(rows):
-            for j in range(n_cam):
-                if feasible[i, j]:
-                    _ = (
-                        w.range * min(max((ur[i] - 5000) / -3500, 0), 1)
-                        + w.weight * min(max((um[i] + cm[j] - 800) / 800, 0), 1)
-                        + w.cost * min(max((uc[i] + cc[j] - 4000) / 3000, 0), 1)
-                        + w.resolution * min(max((ci[j] - 0.01) / 0.05, 0), 1)
-                    )
-
-    t_ours = median_time(ours, repeat)
-    rows = max(1, n_uas // 100)
-    t_loop = median_time(lambda: loop(rows), 1) * n_uas / rows
-        f"mission score+rank {n_uas}x{n_cam}: uasnav {t_ours * 1e3:8.1f} ms | python loop (extrapolated "
-        f"from {rows} rows) {t_loop * 1e3:8.0f} ms | speed-up {t_loop / t_ours:5.0f}x"
-def bench_trajectory(n_predict: int, n_train: int, repeat: int) -> None:
-    from sklearn.neighbors import KNeighborsClassifier
-
-    from uasnav.trajectory.features import Features, cell_index
-    from uasnav.trajectory.predictor import TrajectoryPredictor
-    from uasnav.trajectory.samples import ElementSamples
+    )
 
 
-    def random_features(n: int) -> Features:
-        return Features(
-            theta_deg=rng.uniform(0, 180, n),
-            theta_w_deg=rng.uniform(0, 360, n),
-            wind_ms=rng.uniform(0, 11, n),
-            kind=np.zeros(n, dtype=int),
-            mirrored=np.zeros(n, dtype=bool),
-        )
-
-    f = random_features(n_train)
-    dv = -0.5 * np.sin(np.radians(f.theta_deg) / 2) + 0.05 * f.wind_ms * np.cos(np.radians(f.theta_w_deg))
-    samples = ElementSamples(
-        features=f,
-        length_m=np.full(n_train, 20.0),
-        t_real_s=20.0 / (3.33 + dv),
-        v_init_ms=np.full(n_train, 3.33),
-        v_ref_ms=np.full(n_train, 3.33),
-        dv_ms=dv,
-        flight=np.zeros(n_train, dtype=int),
-        element=np.arange(n_train),
-    t_fit = median_time(lambda: TrajectoryPredictor(random_state=0).fit(samples), repeat)
-    model = TrajectoryPredictor(random_state=0).fit(samples)
-    g = random_features(n_predict)
-    length = np.full(n_predict, 20.0)
-    t_pred = median_time(lambda: model.element_times(g, length, 3.33), repeat)
-    acc = float(np.mean(model.lvq_.predict(g.matrix()) == cell_index(g)))
-    # Peer: a 1-nearest-neighbour classifier on the same prototypes (what LVQ prediction is).
-    knn = KNeighborsClassifier(n_neighbors=1).fit(model.lvq_.prototypes_, model.lvq_.prototype_labels_)
-    X = g.matrix()
-    t_knn = median_time(lambda: knn.predict(X), repeat)
-        f"trajectory LVQ fit n={n_train:.0e} (256 prototypes, 1 epoch LVQ1): {t_fit:6.2f} s | "
-        f"predict n={n_predict:.0e} elements: uasnav {t_pred * 1e3:7.1f} ms, sklearn 1-NN on the same "
-        f"prototypes {t_knn * 1e3:7.1f} ms (ratio {t_knn / t_pred:4.1f}x) | cell accuracy {acc:.3f}"
 def bench_thermal(n: int, repeat: int) -> None:
     """LM training of one 1-2-2-1 network (one restart) on n samples, and batch inference
     through the Rust engine vs the NumPy reference."""
     from uasnav.thermal import NeuralBiasModel, train_lm
     from uasnav.thermal.neural import forward
 
+    rng = np.random.default_rng(0)
     t = np.linspace(-20.0, 37.0, n)
     b = 1e-3 * np.tanh((t - 10) / 8) + rng.normal(0, 5e-5, n)
     epochs = []
@@ -151,10 +85,16 @@ def bench_thermal(n: int, repeat: int) -> None:
     m.predict(x)
     t_rust = median_time(lambda: m.predict(x), repeat)
     t_np = median_time(lambda: [forward(net, x) for net in m.networks_], repeat)
+    print(
         f"thermal LM 1-2-2-1 n={n:.0e}: {t_train:6.2f} s per restart ({statistics.median(epochs):.0f} epochs,"
         f" {t_train / statistics.median(epochs) * 1e3:.1f} ms/epoch)"
+    )
+    print(
         f"thermal predict 3 axes n=1e6: rust {t_rust * 1e3:7.1f} ms | numpy {t_np * 1e3:7.1f} ms"
         f" | speed-up {t_np / t_rust:4.1f}x ({t_rust / 3e6 * 1e9:.1f} ns per evaluation incl. derivative)"
+    )
+
+
 def bench_zupt(n: int, n_peer: int, repeat: int) -> None:
     """Whole-log ZUPT (100 Hz, 1 Hz updates) against a filterpy loop of the same 15-state
     model. The filterpy loop only does the Kalman algebra with a fixed dense Φ (no strapdown
@@ -165,6 +105,7 @@ def bench_zupt(n: int, n_peer: int, repeat: int) -> None:
     from uasnav.imu import ImuLog
 
     dt = 0.01
+    rng = np.random.default_rng(0)
     lat = np.deg2rad(45.0)
     w_ie = 7.292115e-5 * np.array([np.cos(lat), 0.0, -np.sin(lat)])
     gyro = w_ie + 1e-3 + rng.normal(0, 9.25e-4 / np.sqrt(dt), (n, 3))
@@ -199,15 +140,20 @@ def bench_zupt(n: int, n_peer: int, repeat: int) -> None:
 
     t_peer = median_time(peer, max(1, repeat // 2))
     ours_rate, peer_rate = n / t_ours, n_peer / t_peer
+    print(
         f"zupt whole log n={n:.0e}: uasnav {t_ours * 1e3:8.1f} ms ({ours_rate / 1e6:.2f} M samples/s)"
         f" | filterpy loop n={n_peer:.0e} {t_peer * 1e3:8.1f} ms ({peer_rate / 1e3:.1f} k samples/s)"
         f" | speed-up {ours_rate / peer_rate:5.1f}x"
+    )
+
+
 def bench_redundancy(m: int, repeat: int) -> None:
     """Fuse six triaxial sensors on a cube (m samples): uasnav WLS and WLS+FDI vs numpy's
     pseudo-inverse (the same WLS estimate, vectorised, without screening or FDI)."""
     from uasnav import redundancy as R
 
     cfg = R.configuration("cube", 1, triaxial=True)
+    rng = np.random.default_rng(0)
     w = rng.standard_normal((m, 3))
     z = np.ascontiguousarray(w @ cfg.axes.T + 1e-3 * rng.standard_normal((m, cfg.n_axes)))
     sigma = np.full(cfg.n_axes, 1e-3)
@@ -216,9 +162,91 @@ def bench_redundancy(m: int, repeat: int) -> None:
     t_wls = median_time(lambda: R.fuse_axes(cfg, z, sigma=sigma, fdi=False), repeat)
     t_fdi = median_time(lambda: R.fuse_axes(cfg, z, sigma=sigma, fdi=True), repeat)
     diff = np.abs(R.fuse_axes(cfg, z, sigma=sigma, fdi=False).value - z @ h_pinv.T).max()
+    print(
         f"redundancy m={m}: numpy pinv {t_np * 1e3:.2f} ms, uasnav WLS {t_wls * 1e3:.2f} ms "
         f"({t_wls / m * 1e9:.0f} ns/sample), WLS+FDI {t_fdi * 1e3:.2f} ms "
         f"({t_fdi / m * 1e9:.0f} ns/sample), max |diff| {diff:.2g}"
+    )
+
+
+def bench_trajectory(n_predict: int, n_train: int, repeat: int) -> None:
+    from sklearn.neighbors import KNeighborsClassifier
+
+    from uasnav.trajectory.features import Features, cell_index
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+    from uasnav.trajectory.samples import ElementSamples
+
+    rng = np.random.default_rng(0)
+
+    def random_features(n: int) -> Features:
+        return Features(
+            theta_deg=rng.uniform(0, 180, n),
+            theta_w_deg=rng.uniform(0, 360, n),
+            wind_ms=rng.uniform(0, 11, n),
+            kind=np.zeros(n, dtype=int),
+            mirrored=np.zeros(n, dtype=bool),
+        )
+
+    f = random_features(n_train)
+    dv = -0.5 * np.sin(np.radians(f.theta_deg) / 2) + 0.05 * f.wind_ms * np.cos(np.radians(f.theta_w_deg))
+    samples = ElementSamples(
+        features=f,
+        length_m=np.full(n_train, 20.0),
+        t_real_s=20.0 / (3.33 + dv),
+        v_init_ms=np.full(n_train, 3.33),
+        v_ref_ms=np.full(n_train, 3.33),
+        dv_ms=dv,
+        flight=np.zeros(n_train, dtype=int),
+        element=np.arange(n_train),
+    )
+    t_fit = median_time(lambda: TrajectoryPredictor(random_state=0).fit(samples), repeat)
+    model = TrajectoryPredictor(random_state=0).fit(samples)
+    g = random_features(n_predict)
+    length = np.full(n_predict, 20.0)
+    t_pred = median_time(lambda: model.element_times(g, length, 3.33), repeat)
+    acc = float(np.mean(model.lvq_.predict(g.matrix()) == cell_index(g)))
+    # Peer: a 1-nearest-neighbour classifier on the same prototypes (what LVQ prediction is).
+    knn = KNeighborsClassifier(n_neighbors=1).fit(model.lvq_.prototypes_, model.lvq_.prototype_labels_)
+    X = g.matrix()
+    t_knn = median_time(lambda: knn.predict(X), repeat)
+    print(
+        f"trajectory LVQ fit n={n_train:.0e} (256 prototypes, 1 epoch LVQ1): {t_fit:6.2f} s | "
+        f"predict n={n_predict:.0e} elements: uasnav {t_pred * 1e3:7.1f} ms, sklearn 1-NN on the same "
+        f"prototypes {t_knn * 1e3:7.1f} ms (ratio {t_knn / t_pred:4.1f}x) | cell accuracy {acc:.3f}"
+    )
+
+
+def bench_mission(n_uas: int, n_cam: int, repeat: int) -> None:
+    from uasnav.mission import Targets, Weights, rank, score_matrix
+
+    rng = np.random.default_rng(0)
+    ur, um, uc = rng.uniform(500, 8000, n_uas), rng.uniform(250, 9000, n_uas), rng.uniform(300, 20000, n_uas)
+    cm, cc, ci = rng.uniform(40, 700, n_cam), rng.uniform(300, 16000, n_cam), rng.uniform(0.005, 0.08, n_cam)
+    feasible = (um[:, None] * 0.3 >= cm[None, :]) & (ur[:, None] > 1500)
+    t, w = Targets(), Weights()
+
+    def ours() -> object:
+        s = score_matrix(ur, um, uc, cm, cc, ci, t, w, feasible)
+        return rank(s.total, 10)
+
+    def loop(rows: int) -> None:
+        # The same eq. 61 as a plain Python double loop (the thesis tool's per-pair approach).
+        for i in range(rows):
+            for j in range(n_cam):
+                if feasible[i, j]:
+                    _ = (
+                        w.range * min(max((ur[i] - 5000) / -3500, 0), 1)
+                        + w.weight * min(max((um[i] + cm[j] - 800) / 800, 0), 1)
+                        + w.cost * min(max((uc[i] + cc[j] - 4000) / 3000, 0), 1)
+                        + w.resolution * min(max((ci[j] - 0.01) / 0.05, 0), 1)
+                    )
+
+    t_ours = median_time(ours, repeat)
+    rows = max(1, n_uas // 100)
+    t_loop = median_time(lambda: loop(rows), 1) * n_uas / rows
+    print(
+        f"mission score+rank {n_uas}x{n_cam}: uasnav {t_ours * 1e3:8.1f} ms | python loop (extrapolated "
+        f"from {rows} rows) {t_loop * 1e3:8.0f} ms | speed-up {t_loop / t_ours:5.0f}x"
     )
 
 
@@ -226,12 +254,12 @@ CASES: dict[str, Callable[[bool], None]] = {
     "trajectory": lambda quick: bench_trajectory(10**5 if quick else 10**6, 10**4 if quick else 10**5, 3),
     "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
     "sim": lambda quick: bench_sim(10**6 if quick else 10**7, 3),
-    "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
     "thermal": lambda quick: bench_thermal(10**4 if quick else 10**5, 1 if quick else 3),
     "zupt": lambda quick: bench_zupt(
         10**5 if quick else 10**6, 10**4 if quick else 5 * 10**4, 3 if quick else 5
     ),
     "redundancy": lambda quick: bench_redundancy(10**5 if quick else 10**6, 3 if quick else 5),
+    "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
 }
 
 

@@ -24,14 +24,12 @@ __all__ = [
     "attitude_quat_to_dcm",
     "attitude_quat_to_euler",
     "attitude_rotation_angle",
-    "mlp_evaluate_model",
     "earth_normal_gravity",
     "earth_radii",
     "earth_rate_ned",
+    "mlp_evaluate_model",
     "noise_fit_ieee952",
     "noise_read_points",
-    "zupt_detect_static",
-    "zupt_run",
     "redundancy_chi2_threshold",
     "redundancy_face_config",
     "redundancy_face_normals",
@@ -44,6 +42,8 @@ __all__ = [
     "redundancy_parity_residuals",
     "redundancy_relative_rotation",
     "redundancy_wahba",
+    "zupt_detect_static",
+    "zupt_run",
 ]
 
 # --- allan / noise -------------------------------------------------------------------------
@@ -109,6 +109,7 @@ def mlp_evaluate_model(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
     """Networks of a neural thermal-model file (JSON text) at temperatures (n,) degC:
     (value (n, k) rad/s, d/dT (n, k) rad/s/degC, clipped (n,))."""
+
 def zupt_run(
     gyro: NDArray[np.float64],
     accel: NDArray[np.float64],
@@ -162,6 +163,7 @@ def earth_rate_ned(latitude_rad: float) -> list[float]:
 
 def earth_radii(latitude_rad: float) -> tuple[float, float]:
     """Meridian and transverse radii of curvature (m) at geodetic latitude (rad)."""
+
 # --- redundancy ----------------------------------------------------------------------------
 def redundancy_face_config(
     shape: str, counts: list[int], triaxial: bool
@@ -222,6 +224,7 @@ def redundancy_kalman(
     sensor_of: list[int],
     z: NDArray[np.float64],
     sigma: NDArray[np.float64],
+    dt_s: float,
     rate_psd: float,
     bias_psd: float,
     bias_sigma0: float,

@@ -8,8 +8,8 @@ mod convert;
 mod earth;
 mod errors;
 mod mlp;
-mod zupt;
 mod redundancy;
+mod zupt;
 
 use pyo3::prelude::*;
 
