@@ -169,6 +169,39 @@ def bench_redundancy(m: int, repeat: int) -> None:
     )
 
 
+def bench_redundancy_ardupilot(repeat: int) -> None:
+    """Real data: read and fuse the three IMUs of the shared ArduPilot log (the figures that
+    tests/test_redundancy.py::test_ardupilot_three_imus asserts), and time it."""
+    import os
+    from pathlib import Path
+
+    from uasnav.redundancy_ardupilot import analyse_log
+
+    root = Path(
+        os.environ.get("UASNAV_SHARED_DATA", Path(__file__).resolve().parents[1] / ".." / "shared" / "data")
+    )
+    log = root.resolve() / "logs" / "ardupilot_log171.bin"
+    if not log.is_file():
+        print(f"redundancy_ardupilot: {log} not found (set UASNAV_SHARED_DATA)")
+        return
+    res = analyse_log(log)
+    t = median_time(lambda: analyse_log(log), repeat)
+    mdps = 180 / np.pi * 1e3
+    single = ", ".join(f"IMU{i + 1} {np.mean(g) * mdps:.1f}" for i, g in enumerate(res.single_noise_gyro))
+    print(
+        f"redundancy ardupilot_log171 ({res.n_samples} samples, {res.rate_hz:.0f} Hz, read + fuse "
+        f"{t:.2f} s): gyro white noise (mean of axes, mdeg/s) {single}, plain average "
+        f"{np.mean(res.average_noise_gyro) * mdps:.1f}, fused {np.mean(res.fused_noise_gyro) * mdps:.1f} "
+        f"(LS prediction {np.mean(res.predicted_noise_gyro) * mdps:.1f}); accel (mm/s²) single "
+        f"{', '.join(f'{np.mean(a) * 1e3:.1f}' for a in res.single_noise_accel)}, fused "
+        f"{np.mean(res.fused_noise_accel) * 1e3:.1f}; ArduPilot gates pass on "
+        f"{100 * res.gyro_gate_ok_fraction:.1f} % (gyro 5 deg/s) / {100 * res.accel_gate_ok_fraction:.1f} % "
+        f"(accel 0.75 m/s²) of samples, static window {res.static_gates_ok}; parity alarms "
+        f"{100 * res.fdi_alarm_fraction:.0f} % (static σ) / {100 * res.robust_fdi_alarm_fraction:.0f} % "
+        "(robust σ)"
+    )
+
+
 def bench_trajectory(n_predict: int, n_train: int, repeat: int) -> None:
     from sklearn.neighbors import KNeighborsClassifier
 
@@ -259,6 +292,7 @@ CASES: dict[str, Callable[[bool], None]] = {
         10**5 if quick else 10**6, 10**4 if quick else 5 * 10**4, 3 if quick else 5
     ),
     "redundancy": lambda quick: bench_redundancy(10**5 if quick else 10**6, 3 if quick else 5),
+    "redundancy_ardupilot": lambda quick: bench_redundancy_ardupilot(1 if quick else 3),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
 }
 

@@ -13,7 +13,10 @@ from uasnav.allan import oadev
 from uasnav.errors import DataFormatError, InputError
 from uasnav.noise import identify
 from uasnav.sim import (
+    FAULT_KINDS,
     PRESET_NAMES,
+    array_mountings,
+    inject_fault,
     load_preset,
     simulate,
     simulate_array,
@@ -205,12 +208,57 @@ def test_cube_array_has_independent_errors_and_mountings() -> None:
         np.testing.assert_allclose(c @ c.T, np.eye(3), atol=1e-15)
         assert np.linalg.det(c) == pytest.approx(1.0)
         g = log.truth["specific_force_true"][0]
-        np.testing.assert_allclose(c.T @ g, logs[4].truth["specific_force_true"][0], atol=1e-12)
-    assert logs[4].meta["mounting"] == np.eye(3).tolist()
+        np.testing.assert_allclose(c.T @ g, logs[2].truth["specific_force_true"][0], atol=1e-12)
+    # faces +x, +y, +z, −x, −y, −z: sensor z along the outward normal
+    normals = np.array([np.array(log.meta["mounting"])[2] for log in logs])
+    np.testing.assert_array_equal(normals, np.vstack([np.eye(3), -np.eye(3)]))
+    assert logs[2].meta["mounting"] == np.eye(3).tolist()
     on = [log.truth["gyro_bias"][0] for log in logs]
     assert len({tuple(np.round(b, 12)) for b in on}) == 6
     with pytest.raises(InputError, match="shape"):
         simulate_array("lsm6dsm", shape="sphere", duration=1.0)
+
+
+@pytest.mark.parametrize(("shape", "faces"), [("tetrahedron", 4), ("octahedron", 8), ("icosahedron", 20)])
+def test_polyhedron_arrays_share_the_fusion_geometry(shape: str, faces: int) -> None:
+    from uasnav import redundancy
+
+    logs = simulate_array("lsm6dsm", shape=shape, per_face=2, duration=0.5, seed=1)
+    assert len(logs) == 2 * faces
+    m = np.array([log.meta["mounting"] for log in logs])
+    np.testing.assert_array_equal(m, redundancy.configuration(shape, 2, triaxial=True).mountings())
+    # every sensor's z axis is an outward face normal, each normal carries two sensors
+    normals = redundancy.face_normals(shape)
+    hits = np.isclose(m[:, 2, :] @ normals.T, 1.0)
+    assert hits.sum(axis=1).tolist() == [1] * 2 * faces and hits.sum(axis=0).tolist() == [2] * faces
+
+
+def test_mounting_errors_and_rerecording_the_same_array() -> None:
+    mounts = np.array(array_mountings("cube"))
+    kw = dict(mountings=mounts, mounting_error_rad=0.01, duration=2.0, seed=3)
+    a = simulate_array("lsm6dsm", **kw)
+    b = simulate_array("lsm6dsm", noise_seed=1, **kw)
+    assert a[0].meta["array_shape"] == "user" and b[0].meta["noise_seed"] == 1
+    f_body = -earth.gravity_ned(math.radians(45.0), 0.0)  # level: body = NED
+    angles = []
+    for la, lb, m in zip(a, b, mounts, strict=True):
+        assert la.meta["mounting"] == m.tolist()
+        c = np.array(la.meta["mounting_true"])
+        np.testing.assert_allclose(c @ c.T, np.eye(3), atol=1e-12)
+        assert np.linalg.det(c) == pytest.approx(1.0)
+        angles.append(np.arccos(np.clip((np.trace(c @ m.T) - 1) / 2, -1, 1)))
+        # truth channels are in the sensor's actual frame
+        np.testing.assert_allclose(la.truth["specific_force_true"][0], c @ f_body, atol=1e-12)
+        # re-recorded: same hardware (mounting, turn-on bias ~1 deg/s), fresh noise
+        assert lb.meta["mounting_true"] == la.meta["mounting_true"]
+        assert np.abs(la.truth["gyro_bias"][0] - lb.truth["gyro_bias"][0]).max() < 5e-4
+        assert np.abs(la.gyro - lb.gyro).max() > 1e-3
+    # rotation angle of a 3-D normal rotation vector with σ = 0.01 rad per axis: RMS √3·σ
+    assert 0.005 < float(np.sqrt(np.mean(np.square(angles)))) < 0.03
+    with pytest.raises(InputError, match="mountings"):
+        simulate_array("lsm6dsm", mountings=np.eye(3), duration=1.0)
+    with pytest.raises(InputError, match="mounting_error_rad"):
+        simulate_array("lsm6dsm", mounting_error_rad=-1.0, duration=1.0)
 
 
 def test_bad_arguments_name_the_argument() -> None:
@@ -293,3 +341,32 @@ def test_progress_is_reported_from_0_to_1() -> None:
     seen.clear()
     simulate_array("lsm6dsm", duration=1.0, progress=seen.append)
     assert seen[-1] == 1.0 and seen == sorted(seen) and len(seen) > 6
+
+
+@pytest.mark.parametrize("kind", FAULT_KINDS)
+def test_inject_fault_touches_only_the_faulty_sensor_after_start(kind: str) -> None:
+    z = np.random.default_rng(0).standard_normal((50, 9))
+    f = inject_fault(z, kind, sensor=1, start=20, axis=2, magnitude=7.0, duration=10)
+    same = np.ones_like(z, dtype=bool)
+    same[20:, 3:6] = False
+    np.testing.assert_array_equal(f[same], z[same])  # other sensors and earlier samples
+    seg, orig = f[20:, 3:6], z[20:, 3:6]
+    if kind == "bias step":
+        np.testing.assert_allclose(seg - orig, np.tile([0.0, 0.0, 7.0], (30, 1)), atol=1e-12)
+    elif kind == "stuck":
+        np.testing.assert_array_equal(seg, np.tile(z[19, 3:6], (30, 1)))
+    elif kind == "noise burst":
+        d = seg - orig
+        assert np.all(d[:10] != 0) and np.all(d[10:] == 0)
+        assert 3.0 < np.sqrt(np.mean(d[:10] ** 2)) < 12.0
+    elif kind == "saturation":
+        np.testing.assert_array_equal(seg[:, 2], 7.0)
+        np.testing.assert_array_equal(seg[:, :2], orig[:, :2])
+    else:
+        assert np.isnan(seg).all()
+    with pytest.raises(InputError, match="sensor"):
+        inject_fault(z, kind, sensor=3, start=20)
+    with pytest.raises(InputError, match="start"):
+        inject_fault(z, kind, sensor=0, start=0)
+    with pytest.raises(InputError, match="kind"):
+        inject_fault(z, "gremlins", sensor=0, start=5)

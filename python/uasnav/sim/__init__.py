@@ -24,6 +24,7 @@ from uasnav.sim.core import (
     thermal_bias_derivative,
     thermal_model,
 )
+from uasnav.sim.faults import FAULT_KINDS, inject_fault
 from uasnav.sim.model import (
     PRESET_NAMES,
     SensorModel,
@@ -36,6 +37,7 @@ from uasnav.sim.profiles import PROFILE_NAMES, TemperatureProfile, named_profile
 
 __all__ = [
     "ARRAY_SHAPES",
+    "FAULT_KINDS",
     "PRESET_NAMES",
     "PROFILE_NAMES",
     "SensorModel",
@@ -46,6 +48,7 @@ __all__ = [
     "array_mountings",
     "die_temperature",
     "gauss_markov_sum",
+    "inject_fault",
     "load_preset",
     "named_profile",
     "random_walk",

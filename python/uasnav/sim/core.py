@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import signal
+from scipy.spatial.transform import Rotation
 
 from uasnav import earth
 from uasnav.errors import InputError
@@ -56,14 +57,22 @@ _STREAMS = {
             "accel_static",
             "temp",
             "array",
+            "mounting",
         ]
     )
 }
 GM_PER_DECADE = 3
+# Streams that a repeated recording of the same hardware draws afresh (``noise_seed``).
+_NOISE_STREAMS = frozenset(
+    {"gyro_white", "gyro_gm", "gyro_rrw", "accel_white", "accel_gm", "accel_rrw", "temp"}
+)
 
 
-def _rng(seed: int, sensor: int, stream: str) -> np.random.Generator:
-    return np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(int(sensor), _STREAMS[stream])))
+def _rng(seed: int, sensor: int, stream: str, noise_seed: int | None = None) -> np.random.Generator:
+    key: tuple[int, ...] = (int(sensor), _STREAMS[stream])
+    if noise_seed is not None and stream in _NOISE_STREAMS:
+        key += (int(noise_seed),)
+    return np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=key))
 
 
 def _euler_dcm(euler: ArrayLike) -> FloatArray:
@@ -297,6 +306,7 @@ def _triad(
     gstep: int,
     thermal_factors: FloatArray | None,
     model: SensorModel,
+    noise_seed: int | None = None,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Simulate one triad. Returns (output, total bias, thermal bias), each (n, 3); the
     thermal part is only interpolated to full rate for the gyro (a truth channel)."""
@@ -329,10 +339,9 @@ def _triad(
                 np.arange(die_grid.size) * float(gstep),
                 np.maximum(1.0 + th.noise_tc * d_t, 0.1),
             )
-    gauss_markov_sum(
-        _rng(seed, sensor, f"{k}_gm"), n, dt, tri.bias_instability, tri.bias_instability_tau_s, slow
-    )
-    random_walk(_rng(seed, sensor, f"{k}_rrw"), n, dt, tri.rate_random_walk, duration, slow)
+    gm_rng = _rng(seed, sensor, f"{k}_gm", noise_seed)
+    gauss_markov_sum(gm_rng, n, dt, tri.bias_instability, tri.bias_instability_tau_s, slow)
+    random_walk(_rng(seed, sensor, f"{k}_rrw", noise_seed), n, dt, tri.rate_random_walk, duration, slow)
     bias = slow.render()
     bias += const[:, None]
     if moving:
@@ -341,7 +350,7 @@ def _triad(
             d_full = np.interp(np.arange(n, dtype=np.float64), np.arange(die_grid.size) * float(gstep), d_t)
             bias += th.scale_factor_tc * d_full[None, :] * x_true
     if tri.white > 0.0:
-        y = _rng(seed, sensor, f"{k}_white").standard_normal((3, n))
+        y = _rng(seed, sensor, f"{k}_white", noise_seed).standard_normal((3, n))
         y *= tri.white * math.sqrt(rate)
         if noise_scale is not None:
             y *= noise_scale[None, :]
@@ -374,6 +383,7 @@ def simulate_one(
     sensor: int = 0,
     thermal_factors: FloatArray | None = None,
     table_rate_dps: float = 0.0,
+    noise_seed: int | None = None,
 ) -> ImuLog:
     """Simulate one sensor (see :func:`uasnav.sim.simulate`); ``mounting`` is C_b^s."""
     if not (math.isfinite(rate) and rate > 0):
@@ -428,7 +438,7 @@ def simulate_one(
     chamber_g, die_g = die_temperature(model, prof, grid_idx / rate)
     tick(0.05)
     common = dict(seed=seed, sensor=sensor, n=n, rate=rate, duration=dur, die_grid=die_g, gstep=gstep)
-    common.update(thermal_factors=thermal_factors, model=model)
+    common.update(thermal_factors=thermal_factors, model=model, noise_seed=noise_seed)
     gyro, gbias, gtherm = _triad(model.gyro, x_true=w_s_t, f_true=f_s, **common)  # type: ignore[arg-type]
     tick(0.5)
     accel, abias, _ = _triad(model.accel, x_true=f_s, f_true=f_s, **common)  # type: ignore[arg-type]
@@ -437,7 +447,7 @@ def simulate_one(
     tm = model.temperature
     temp = die.copy()
     if tm.noise_c > 0:
-        temp += _rng(seed, sensor, "temp").standard_normal(n) * tm.noise_c
+        temp += _rng(seed, sensor, "temp", noise_seed).standard_normal(n) * tm.noise_c
     if tm.resolution_c > 0:
         temp = np.round(temp / tm.resolution_c) * tm.resolution_c
     truth = {
@@ -468,6 +478,8 @@ def simulate_one(
         "temp_resolution_c": tm.resolution_c,
         "table_rate_dps": float(table_rate_dps),
     }
+    if noise_seed is not None:
+        meta["noise_seed"] = int(noise_seed)
     if thermal_factors is not None:
         meta["thermal_factors"] = [float(v) for v in thermal_factors]
     log = ImuLog(t=t, gyro=gyro, accel=accel, temp=temp, truth=truth, meta=meta)
@@ -491,6 +503,7 @@ def simulate(
     euler_rad: tuple[float, float, float] = (0.0, 0.0, 0.0),
     progress: Progress = None,
     table_rate_dps: float = 0.0,
+    noise_seed: int | None = None,
 ) -> ImuLog:
     """Simulate a static IMU (one sensor) with every error term and its ground truth.
 
@@ -517,6 +530,11 @@ def simulate(
         Optional slow motion: the unit sits (at ``euler_rad``) on a single-axis rate table
         turning about the local vertical at this rate (deg/s, positive clockwise seen from
         above); the true rate, attitude and sensor outputs follow (specific force unchanged).
+    noise_seed : int, optional
+        Draw the noise processes (white noise, bias instability, random walks, temperature
+        noise) afresh from ``(seed, noise_seed)`` while keeping every hardware property of
+        ``seed`` (turn-on biases, scale factors, misalignments, thermal curve): the same unit
+        recorded again, e.g. in another attitude of a multi-position test.
 
     Returns
     -------
@@ -539,51 +557,43 @@ def simulate(
         euler_rad=euler_rad,
         progress=progress,
         table_rate_dps=table_rate_dps,
+        noise_seed=noise_seed,
     )
 
 
-def _face_matrices() -> list[FloatArray]:
-    """C_b^s of the six cube faces (+x, −x, +y, −y, +z, −z): sensor z along the outward normal."""
-    faces = []
-    for normal, x_axis in (
-        ((1, 0, 0), (0, 0, -1)),
-        ((-1, 0, 0), (0, 0, 1)),
-        ((0, 1, 0), (1, 0, 0)),
-        ((0, -1, 0), (1, 0, 0)),
-        ((0, 0, 1), (1, 0, 0)),
-        ((0, 0, -1), (1, 0, 0)),
-    ):
-        z = np.array(normal, dtype=np.float64)
-        x = np.array(x_axis, dtype=np.float64)
-        y = np.cross(z, x)
-        faces.append(np.vstack([x, y, z]))
-    return faces
+ARRAY_SHAPES = ("tetrahedron", "cube", "octahedron", "dodecahedron", "icosahedron", "planar")
 
 
-ARRAY_SHAPES = ("cube", "planar")
-
-
-def array_mountings(shape: str = "cube", per_face: int = 1) -> list[FloatArray]:
+def array_mountings(shape: str = "cube", per_face: float = 1) -> list[FloatArray]:
     """Mounting matrices C_b^s (IMU body → sensor frame) of an array.
 
-    ``"cube"``: ``per_face`` sensors on each of the six faces (+x, −x, +y, −y, +z, −z), sensor
-    z axis along the outward face normal. ``"planar"``: ``per_face`` sensors all aligned with
-    the body (the thesis' six SensorTiles on one cradle board, §4.3.4).
+    A Platonic solid (``"tetrahedron"``, ``"cube"``, ``"octahedron"``, ``"dodecahedron"``,
+    ``"icosahedron"``): ``per_face`` triaxial sensors on each face, sensor z axis along the
+    outward face normal, in the face order and orientation of
+    :func:`uasnav.redundancy.configuration` (one geometry for simulation and fusion; the
+    cube's faces are +x, +y, +z, −x, −y, −z). ``"planar"``: ``per_face`` sensors all aligned
+    with the body (the thesis' six SensorTiles on one cradle board, §4.3.4).
     """
-    if per_face < 1:
-        raise InputError(f"per_face: must be >= 1, got {per_face}")
-    if shape == "cube":
-        return [m for m in _face_matrices() for _ in range(per_face)]
+    from uasnav import redundancy
+
+    if not per_face > 0:
+        raise InputError(f"per_face: must be > 0, got {per_face}")
     if shape == "planar":
-        return [np.eye(3) for _ in range(per_face)]
-    raise InputError(f"unknown array shape {shape!r}; expected one of {', '.join(ARRAY_SHAPES)}")
+        if per_face != int(per_face):
+            raise InputError(f"per_face: a planar array needs a whole number of sensors, got {per_face}")
+        return [np.eye(3) for _ in range(int(per_face))]
+    if shape not in redundancy.SHAPES:
+        raise InputError(f"unknown array shape {shape!r}; expected one of {', '.join(ARRAY_SHAPES)}")
+    return list(redundancy.configuration(shape, per_face, triaxial=True).mountings())
 
 
 def simulate_array(
     preset: str | SensorModel,
     *,
     shape: str = "cube",
-    per_face: int = 1,
+    per_face: float = 1,
+    mountings: ArrayLike | None = None,
+    mounting_error_rad: float = 0.0,
     thermal_spread: float = 0.5,
     progress: Progress = None,
     **kwargs: Any,
@@ -591,26 +601,51 @@ def simulate_array(
     """Simulate several sensors of one type in a rigid array, with independent errors.
 
     Each sensor has its own random streams, its own mounting (``log.meta["mounting"]`` =
-    C_b^s, outputs and ``rate_true``/``specific_force_true``/biases in the sensor frame;
-    ``attitude`` stays body → NED), and its own thermal curve: the preset's curve per axis
-    scaled by a factor drawn uniformly in ``[1 − thermal_spread, 1 + thermal_spread]`` with
-    a random sign (``meta["thermal_factors"]``). Other keyword arguments as :func:`simulate`.
+    nominal C_b^s, outputs and ``rate_true``/``specific_force_true``/biases in the sensor's
+    actual frame; ``attitude`` stays body → NED), and its own thermal curve: the preset's curve
+    per axis scaled by a factor drawn uniformly in ``[1 − thermal_spread, 1 + thermal_spread]``
+    with a random sign (``meta["thermal_factors"]``). Other keyword arguments as
+    :func:`simulate` (``noise_seed`` re-records the same array).
+
+    Parameters
+    ----------
+    shape, per_face
+        Layout of :func:`array_mountings`, unless ``mountings`` is given.
+    mountings : array_like, shape (s, 3, 3), optional
+        Nominal C_b^s of every sensor (e.g. ``uasnav.redundancy.configuration("icosahedron",
+        triaxial=True).mountings()``); ``meta["array_shape"]`` is then ``"user"``.
+    mounting_error_rad : float
+        σ (rad, per axis) of a random rotation of each sensor against its nominal mounting
+        (a hardware property: fixed by ``seed``). The actual C_b^s is
+        ``meta["mounting_true"] = exp([φ×])·C_nominal``.
     """
     model = _as_model(preset)
-    mounts = array_mountings(shape, per_face)
+    if mountings is None:
+        mounts = array_mountings(shape, per_face)
+    else:
+        m = np.asarray(mountings, dtype=np.float64)
+        if m.ndim != 3 or m.shape[1:] != (3, 3) or m.shape[0] < 1:
+            raise InputError(f"mountings: expected shape (s, 3, 3), got {m.shape}")
+        mounts = list(m)
+        shape = "user"
+    if not (math.isfinite(mounting_error_rad) and mounting_error_rad >= 0):
+        raise InputError(f"mounting_error_rad: must be finite and >= 0, got {mounting_error_rad!r}")
     seed = int(kwargs.get("seed", 0))
     rng = _rng(seed, 10_000, "array")
     logs = []
-    for i, m in enumerate(mounts):
+    for i, m_nom in enumerate(mounts):
         factors = rng.uniform(1.0 - thermal_spread, 1.0 + thermal_spread, 3) * rng.choice([-1.0, 1.0], 3)
+        phi = _rng(seed, i, "mounting").standard_normal(3) * mounting_error_rad
+        m_true = Rotation.from_rotvec(phi).as_matrix() @ m_nom
 
         def sub(f: float, i: int = i) -> None:
             if progress is not None:
                 progress((i + f) / len(mounts))
 
-        logs.append(
-            simulate_one(model, mounting=m, sensor=i, thermal_factors=factors, progress=sub, **kwargs)
-        )
+        log = simulate_one(model, mounting=m_true, sensor=i, thermal_factors=factors, progress=sub, **kwargs)
+        log.meta["mounting"] = np.asarray(m_nom).tolist()
+        log.meta["mounting_true"] = m_true.tolist()
+        logs.append(log)
     for log in logs:
         log.meta["array_shape"] = shape
         log.meta["array_size"] = len(mounts)
