@@ -3,7 +3,7 @@
 use nalgebra::{Matrix3, Vector3};
 use nav_core::redundancy::alignment;
 use nav_core::redundancy::chi2;
-use nav_core::redundancy::fusion::{wls, FdiConfig, FdiFuser, SensorHealth};
+use nav_core::redundancy::fusion::{parity_residuals, FdiConfig, FdiFuser};
 use nav_core::redundancy::geometry::{AxisKind, Polyhedron, SensorArray};
 use nav_core::redundancy::kalman::{BiasKalman, BiasKalmanConfig};
 use nav_core::NavError;
@@ -53,25 +53,6 @@ fn matrix<'py>(
     Ok(Matrix3::from_fn(|i, j| r[i][j]))
 }
 
-/// Borrows an (m, n) float64 sample matrix with n == n_axes.
-fn samples<'a>(
-    py: Python<'_>,
-    z: &'a PyReadonlyArray2<'_, f64>,
-    n: usize,
-) -> PyResult<(&'a [f64], usize)> {
-    let shape = z.shape();
-    if shape[1] != n {
-        return Err(input_error(
-            py,
-            format!("z: expected shape (m, {n}) (one column per sensor axis), got {shape:?}"),
-        ));
-    }
-    let flat = z
-        .as_slice()
-        .map_err(|_| input_error(py, "z: expected a C-contiguous float64 array".into()))?;
-    Ok((flat, shape[0]))
-}
-
 fn check_len(py: Python<'_>, name: &str, got: usize, n: usize) -> PyResult<()> {
     if got != n {
         return Err(input_error(
@@ -80,6 +61,52 @@ fn check_len(py: Python<'_>, name: &str, got: usize, n: usize) -> PyResult<()> {
         ));
     }
     Ok(())
+}
+
+/// A batch call's inputs: the configuration, the (m, n) samples as one C-contiguous slice
+/// with their row count m, and the per-axis sigma (n,), every shape checked against n_axes.
+struct Batch<'a> {
+    array: Arr,
+    z: &'a [f64],
+    m: usize,
+    sigma: &'a [f64],
+}
+
+impl<'a> Batch<'a> {
+    fn new(
+        py: Python<'_>,
+        axes: &PyReadonlyArray2<'_, f64>,
+        sensor_of: &[usize],
+        z: &'a PyReadonlyArray2<'_, f64>,
+        sigma: &'a PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<Self> {
+        let array = build(py, axes, sensor_of)?;
+        let n = array.n_axes();
+        let shape = z.shape();
+        if shape[1] != n {
+            return Err(input_error(
+                py,
+                format!("z: expected shape (m, {n}) (one column per sensor axis), got {shape:?}"),
+            ));
+        }
+        let flat = z
+            .as_slice()
+            .map_err(|_| input_error(py, "z: expected a C-contiguous float64 array".into()))?;
+        let sg = slice1(py, "sigma", sigma)?;
+        check_len(py, "sigma", sg.len(), n)?;
+        Ok(Self {
+            array,
+            z: flat,
+            m: shape[0],
+            sigma: sg,
+        })
+    }
+
+    /// Sample k (one value per axis).
+    fn row(&self, k: usize) -> &'a [f64] {
+        let n = self.array.n_axes();
+        &self.z[k * n..(k + 1) * n]
+    }
 }
 
 /// Axes (n, 3) and sensor index (n,) of counts[f] sensors on face f of a Platonic solid.
@@ -206,19 +233,15 @@ fn redundancy_fuse<'py>(
     stuck_samples: u32,
     max_isolations: usize,
 ) -> PyResult<FuseOut<'py>> {
-    let a = build(py, &axes, &sensor_of)?;
-    let n = a.n_axes();
-    let ns = a.n_sensors();
+    let b = Batch::new(py, &axes, &sensor_of, &z, &sigma)?;
+    let (n, ns, m) = (b.array.n_axes(), b.array.n_sensors(), b.m);
     if ns > S {
         return Err(input_error(
             py,
             format!("sensor_of: at most {S} sensors, got {ns}"),
         ));
     }
-    let (flat, m) = samples(py, &z, n)?;
-    let sg = slice1(py, "sigma", &sigma)?;
     let bs = slice1(py, "bias", &bias)?;
-    check_len(py, "sigma", sg.len(), n)?;
     check_len(py, "bias", bs.len(), n)?;
     let cfg = FdiConfig {
         p_fa,
@@ -226,7 +249,7 @@ fn redundancy_fuse<'py>(
         stuck_samples,
         max_isolations,
     };
-    let mut fuser = FdiFuser::<f64, M, S>::new(a, sg, cfg).py_err(py)?;
+    let mut fuser = FdiFuser::<f64, M, S>::new(b.array, b.sigma, cfg).py_err(py)?;
     fuser.set_axis_bias(bs).py_err(py)?;
     let res = py.detach(|| -> Result<_, NavError> {
         let mut fused = Array2::from_elem((m, 3), f64::NAN);
@@ -235,46 +258,23 @@ fn redundancy_fuse<'py>(
         let mut valid = Array1::from_elem(m, false);
         let mut alarm = Array1::from_elem(m, false);
         let mut health = Array2::<u8>::zeros((m, ns));
-        let mut use_axis = [false; M];
         for k in 0..m {
-            let zk = &flat[k * n..(k + 1) * n];
-            if fdi {
-                let out = fuser.step(zk)?;
-                valid[k] = out.valid;
-                alarm[k] = out.alarm;
-                for s in 0..ns {
-                    health[(k, s)] = out.health[s].0;
-                }
-                if out.valid {
-                    for j in 0..3 {
-                        fused[(k, j)] = out.fused.value[j];
-                        var[(k, j)] = out.fused.covariance[(j, j)];
-                    }
-                    chi[k] = out.fused.chi2;
-                }
+            let out = if fdi {
+                fuser.step(b.row(k))?
             } else {
-                for i in 0..n {
-                    use_axis[i] = zk[i].is_finite();
-                    if !use_axis[i] {
-                        health[(k, a.sensor_of(i))] |= SensorHealth::NON_FINITE;
-                    }
+                fuser.fuse_finite(b.row(k))?
+            };
+            valid[k] = out.valid;
+            alarm[k] = out.alarm;
+            for s in 0..ns {
+                health[(k, s)] = out.health[s].0;
+            }
+            if out.valid {
+                for j in 0..3 {
+                    fused[(k, j)] = out.fused.value[j];
+                    var[(k, j)] = out.fused.covariance[(j, j)];
                 }
-                for i in 0..n {
-                    // A sensor with one bad axis is dropped as a whole, as with FDI.
-                    use_axis[i] = health[(k, a.sensor_of(i))] == 0;
-                }
-                match wls(&a, zk, sg, bs, &use_axis[..n]) {
-                    Ok(f) => {
-                        valid[k] = true;
-                        chi[k] = f.chi2;
-                        for j in 0..3 {
-                            fused[(k, j)] = f.value[j];
-                            var[(k, j)] = f.covariance[(j, j)];
-                        }
-                    }
-                    Err(NavError::InvalidParameter { .. }) => {}
-                    Err(e) => return Err(e),
-                }
+                chi[k] = out.fused.chi2;
             }
         }
         Ok((fused, var, chi, valid, alarm, health))
@@ -300,23 +300,17 @@ fn redundancy_parity_residuals<'py>(
     z: PyReadonlyArray2<'py, f64>,
     sigma: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let a = build(py, &axes, &sensor_of)?;
-    let n = a.n_axes();
-    let (flat, m) = samples(py, &z, n)?;
-    let sg = slice1(py, "sigma", &sigma)?;
-    check_len(py, "sigma", sg.len(), n)?;
+    let b = Batch::new(py, &axes, &sensor_of, &z, &sigma)?;
+    let n = b.array.n_axes();
     let res = py.detach(|| -> Result<_, NavError> {
-        let mut out = Array2::from_elem((m, n), f64::NAN);
-        let zero = [0.0; M];
-        let all = [true; M];
-        for k in 0..m {
-            let zk = &flat[k * n..(k + 1) * n];
-            if zk.iter().any(|v| !v.is_finite()) {
-                continue;
-            }
-            let f = wls(&a, zk, sg, &zero[..n], &all[..n])?;
-            for i in 0..n {
-                out[(k, i)] = zk[i] - a.axis(i).dot(&f.value);
+        let mut out = Array2::from_elem((b.m, n), f64::NAN);
+        let mut r = [0.0; M];
+        for k in 0..b.m {
+            let zk = b.row(k);
+            if zk.iter().all(|v| v.is_finite()) {
+                parity_residuals(&b.array, zk, b.sigma, &mut r[..n])?;
+                out.row_mut(k)
+                    .assign(&numpy::ndarray::ArrayView1::from(&r[..n]));
             }
         }
         Ok(out)
@@ -334,26 +328,22 @@ type KfOut<'py> = (
 /// Rate, rate σ, axis biases, bias σ.
 type KfArrays = (Array2<f64>, Array2<f64>, Array2<f64>, Array2<f64>);
 
-#[allow(clippy::too_many_arguments)]
 fn kalman_run<const K: usize>(
-    a: &Arr,
-    flat: &[f64],
-    m: usize,
-    sigma: &[f64],
+    b: &Batch<'_>,
     dt_s: f64,
     cfg: BiasKalmanConfig<f64>,
     zero_rate: Option<&[bool]>,
     zero_rate_sigma: f64,
 ) -> Result<KfArrays, NavError> {
-    let n = a.n_axes();
-    let mut kf = BiasKalman::<f64, K>::new(a, sigma, cfg)?;
+    let (n, m) = (b.array.n_axes(), b.m);
+    let mut kf = BiasKalman::<f64, K>::new(&b.array, b.sigma, cfg)?;
     let mut rate = Array2::zeros((m, 3));
     let mut rate_sd = Array2::zeros((m, 3));
     let mut bias = Array2::zeros((m, n));
     let mut bias_sd = Array2::zeros((m, n));
     let mut use_axis = vec![true; n];
     for k in 0..m {
-        let zk = &flat[k * n..(k + 1) * n];
+        let zk = b.row(k);
         for i in 0..n {
             use_axis[i] = zk[i].is_finite();
         }
@@ -398,11 +388,8 @@ fn redundancy_kalman<'py>(
     zero_rate: Option<Vec<bool>>,
     zero_rate_sigma: f64,
 ) -> PyResult<KfOut<'py>> {
-    let a = build(py, &axes, &sensor_of)?;
-    let n = a.n_axes();
-    let (flat, m) = samples(py, &z, n)?;
-    let sg = slice1(py, "sigma", &sigma)?;
-    check_len(py, "sigma", sg.len(), n)?;
+    let b = Batch::new(py, &axes, &sensor_of, &z, &sigma)?;
+    let (n, m) = (b.array.n_axes(), b.m);
     if let Some(zr) = &zero_rate {
         if zr.len() != m {
             return Err(input_error(
@@ -420,9 +407,9 @@ fn redundancy_kalman<'py>(
     let zr = zero_rate.as_deref();
     let res = py.detach(|| {
         if n + 3 <= 21 {
-            kalman_run::<21>(&a, flat, m, sg, dt_s, cfg, zr, zero_rate_sigma)
+            kalman_run::<21>(&b, dt_s, cfg, zr, zero_rate_sigma)
         } else if n + 3 <= 63 {
-            kalman_run::<63>(&a, flat, m, sg, dt_s, cfg, zr, zero_rate_sigma)
+            kalman_run::<63>(&b, dt_s, cfg, zr, zero_rate_sigma)
         } else {
             Err(NavError::InvalidParameter {
                 what: "sensor axes",

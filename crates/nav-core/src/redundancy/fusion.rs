@@ -101,6 +101,32 @@ pub fn wls<T: Real, const M: usize>(
     })
 }
 
+/// Least-squares residuals `r_i = z_i − h_iᵀx̂` of one sample fused from every axis with
+/// weights `1/σ²` and no bias correction, written to `out[..n_axes]`. Their mean over a
+/// window is the observable (parity-space) part of the axis biases.
+pub fn parity_residuals<T: Real, const M: usize>(
+    array: &SensorArray<T, M>,
+    z: &[T],
+    sigma: &[T],
+    out: &mut [T],
+) -> Result<(), NavError> {
+    let n = array.n_axes();
+    if out.len() < n {
+        return Err(NavError::LengthMismatch {
+            what: "out",
+            expected: n,
+            got: out.len(),
+        });
+    }
+    let zero = [T::zero(); M];
+    let all = [true; M];
+    let f = wls(array, z, sigma, &zero[..n], &all[..n])?;
+    for (i, r) in out.iter_mut().enumerate().take(n) {
+        *r = z[i] - array.axis(i).dot(&f.value);
+    }
+    Ok(())
+}
+
 /// Per-sensor health flags of one sample (bit set; 0 = healthy).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct SensorHealth(pub u8);
@@ -258,14 +284,7 @@ impl<T: Real, const M: usize, const S: usize> FdiFuser<T, M, S> {
     /// Fuses one sample (`z`: one value per axis, array order) with screening, parity
     /// detection, isolation and re-fusion.
     pub fn step(&mut self, z: &[T]) -> Result<FdiOutput<T, S>, NavError> {
-        let n = self.array.n_axes();
-        if z.len() != n {
-            return Err(NavError::LengthMismatch {
-                what: "z",
-                expected: n,
-                got: z.len(),
-            });
-        }
+        let n = self.sample_len(z)?;
         let mut health = [SensorHealth::default(); S];
         for i in 0..n {
             let s = self.array.sensor_of(i);
@@ -285,10 +304,7 @@ impl<T: Real, const M: usize, const S: usize> FdiFuser<T, M, S> {
                 health[s].0 |= SensorHealth::STUCK;
             }
         }
-        let mut use_axis = [false; M];
-        for (i, u) in use_axis.iter_mut().enumerate().take(n) {
-            *u = health[self.array.sensor_of(i)].is_ok();
-        }
+        let mut use_axis = self.healthy_axes(&health);
         let mut alarm = false;
         let mut isolations = 0;
         loop {
@@ -357,6 +373,54 @@ impl<T: Real, const M: usize, const S: usize> FdiFuser<T, M, S> {
                 }
             }
         }
+    }
+
+    /// Fuses one sample without fault detection: only non-finite samples are screened out
+    /// (their whole sensor is dropped and flagged [`SensorHealth::NON_FINITE`]); the parity
+    /// statistic is reported but never acted on, `alarm` stays false, and the stuck-output
+    /// history is left untouched. Invalid only when the remaining axes cannot observe three
+    /// axes (never a value fused from non-finite samples).
+    pub fn fuse_finite(&self, z: &[T]) -> Result<FdiOutput<T, S>, NavError> {
+        self.sample_len(z)?;
+        let mut health = [SensorHealth::default(); S];
+        for (i, v) in z.iter().enumerate() {
+            if !num_traits::Float::is_finite(*v) {
+                health[self.array.sensor_of(i)].0 |= SensorHealth::NON_FINITE;
+            }
+        }
+        let use_axis = self.healthy_axes(&health);
+        match wls(&self.array, z, &self.sigma, &self.bias, &use_axis) {
+            Ok(fused) => Ok(FdiOutput {
+                fused,
+                valid: true,
+                alarm: false,
+                health,
+            }),
+            Err(NavError::InvalidParameter { .. }) => Ok(self.invalid(false, health)),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Number of axes, checking that `z` holds one sample per axis.
+    fn sample_len(&self, z: &[T]) -> Result<usize, NavError> {
+        let n = self.array.n_axes();
+        if z.len() != n {
+            return Err(NavError::LengthMismatch {
+                what: "z",
+                expected: n,
+                got: z.len(),
+            });
+        }
+        Ok(n)
+    }
+
+    /// Axes whose sensor is healthy (a sensor with one bad axis is dropped as a whole).
+    fn healthy_axes(&self, health: &[SensorHealth; S]) -> [bool; M] {
+        let mut use_axis = [false; M];
+        for (i, u) in use_axis.iter_mut().enumerate().take(self.array.n_axes()) {
+            *u = health[self.array.sensor_of(i)].is_ok();
+        }
+        use_axis
     }
 
     fn invalid(&self, alarm: bool, health: [SensorHealth; S]) -> FdiOutput<T, S> {
@@ -547,6 +611,60 @@ mod tests {
             ..FdiConfig::default()
         };
         assert!(FdiFuser::<f64, 18, 6>::new(a, &[0.01; 6], one).is_err());
+    }
+
+    #[test]
+    fn fuse_finite_drops_only_non_finite_sensors_and_never_isolates() {
+        let a = cube6();
+        let w = Vector3::new(0.1, -0.2, 0.3);
+        let mut z: [f64; 18] = core::array::from_fn(|i| a.axis(i).dot(&w));
+        z[7] += 1.0; // a gross bias on sensor 2: FDI would isolate it, fuse_finite must not
+        let f = FdiFuser::<f64, 18, 6>::new(a, &[0.01; 18], FdiConfig::default()).unwrap();
+        let out = f.fuse_finite(&z).unwrap();
+        let all = wls(&a, &z, &[0.01; 18], &[0.0; 18], &[true; 18]).unwrap();
+        assert!(out.valid && !out.alarm);
+        assert_eq!(out.fused, all);
+        assert!(out.health.iter().all(|h| h.is_ok()));
+        // chi² of a 1.0 residual spread over 18 axes is far beyond any threshold but ignored
+        assert!(out.fused.chi2 > f.threshold(out.fused.dof));
+        // A NaN on sensor 4 drops its three axes, exactly like excluding them by hand.
+        z[13] = f64::NAN;
+        let out = f.fuse_finite(&z).unwrap();
+        let mut use_axis = [true; 18];
+        use_axis[12..15].copy_from_slice(&[false; 3]);
+        let ref_ = wls(&a, &z, &[0.01; 18], &[0.0; 18], &use_axis).unwrap();
+        assert!(out.valid);
+        assert_eq!(out.fused, ref_);
+        assert_eq!(out.health[4].0, SensorHealth::NON_FINITE);
+        assert!(f.fuse_finite(&z[..17]).is_err());
+        // Both x gyros of a single-axis cube out: invalid, NaN, not garbage.
+        let s = Arr::from_polyhedron(Polyhedron::Cube, 1, AxisKind::Single).unwrap();
+        let fs = FdiFuser::<f64, 18, 6>::new(s, &[0.01; 6], FdiConfig::default()).unwrap();
+        let out = fs
+            .fuse_finite(&[f64::NAN, 0.0, 0.0, f64::NAN, 0.0, 0.0])
+            .unwrap();
+        assert!(!out.valid && out.fused.value.iter().all(|v| v.is_nan()));
+    }
+
+    #[test]
+    fn parity_residuals_are_orthogonal_to_the_columns_of_h() {
+        // r = (I − H(HᵀWH)⁻¹HᵀW) z: a rotation-like bias (H·x) leaves no residual, and with
+        // equal weights Hᵀr = 0 for any z.
+        let a = cube6();
+        let mut rng = Rng(7);
+        let z: [f64; 18] = core::array::from_fn(|_| rng.normal());
+        let mut r = [0.0; 18];
+        parity_residuals(&a, &z, &[0.5; 18], &mut r).unwrap();
+        let mut htr = Vector3::zeros();
+        for (i, ri) in r.iter().enumerate() {
+            htr += a.axis(i) * *ri;
+        }
+        assert!(htr.amax() < 1e-12);
+        let x = Vector3::new(1.0, 2.0, -3.0);
+        let zx: [f64; 18] = core::array::from_fn(|i| a.axis(i).dot(&x));
+        parity_residuals(&a, &zx, &[0.5; 18], &mut r).unwrap();
+        assert!(r.iter().all(|v| v.abs() < 1e-12));
+        assert!(parity_residuals(&a, &z, &[0.5; 18], &mut r[..17]).is_err());
     }
 
     proptest::proptest! {
