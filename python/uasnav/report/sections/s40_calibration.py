@@ -119,13 +119,10 @@ def build(w: SectionWriter) -> None:
     # Figure 31: polynomial order selection.
     w.progress("polynomial order selection")
     sel_p = select_polynomial_order(temp, bias, orders=tuple(range(1, 11)), seed=w.seed)
-    fig, ax = new_figure()
-    ax.semilogy(sel_p.candidates, sel_p.sr, "o-")
-    ax.axvline(sel_p.chosen, color="C1", ls="--", label=f"chosen: {sel_p.chosen}")
-    ax.set_xlabel("polynomial order m")
-    ax.set_ylabel("Sr_PF (rad/s)")
-    ax.legend()
-    w.figure(fig, "fig31-sr-pf", "Figure 31: Sr_PF (eq. 32) on held-out soak data vs order (thesis chose 2).")
+    ax = sel_p.plot(xlabel="polynomial order m", ylabel="Sr_PF (rad/s)")
+    w.figure(
+        ax.figure, "fig31-sr-pf", "Figure 31: Sr_PF (eq. 32) on held-out soak data vs order (thesis chose 2)."
+    )
     w.data["sr_pf"] = {"orders": sel_p.candidates, "sr": sel_p.sr.tolist(), "chosen": sel_p.chosen}
 
     # Figure 32: BPNN structure selection.
@@ -135,13 +132,10 @@ def build(w: SectionWriter) -> None:
     sel_n = select_hidden_neurons(
         temp, bias, candidates=cands, restarts=1 if quick else 2, max_samples=ms, seed=w.seed
     )
-    fig, ax = new_figure()
-    ax.semilogy(sel_n.candidates, sel_n.sr, "o-")
-    ax.axvline(sel_n.chosen, color="C1", ls="--", label=f"chosen: {sel_n.chosen}")
-    ax.set_xlabel("neurons per hidden layer n")
-    ax.set_ylabel("Sr_NN (rad/s)")
-    ax.legend()
-    w.figure(fig, "fig32-sr-nn", "Figure 32: Sr_NN (eq. 33) vs neurons per hidden layer (thesis chose 2-2).")
+    ax = sel_n.plot(xlabel="neurons per hidden layer n", ylabel="Sr_NN (rad/s)")
+    w.figure(
+        ax.figure, "fig32-sr-nn", "Figure 32: Sr_NN (eq. 33) vs neurons per hidden layer (thesis chose 2-2)."
+    )
     w.data["sr_nn"] = {"neurons": sel_n.candidates, "sr": sel_n.sr.tolist(), "chosen": sel_n.chosen}
 
     # Figure 33: structure.
@@ -297,11 +291,8 @@ def build(w: SectionWriter) -> None:
     sel_d = select_hidden_neurons(
         temp, bias, candidates=cands_d, restarts=1 if quick else 2, derivative=True, seed=w.seed
     )
-    fig, ax = new_figure()
-    ax.semilogy(sel_d.candidates, sel_d.sr, "o-")
-    ax.set_xlabel("neurons per hidden layer n")
-    ax.set_ylabel("Sr_TCZUPT (rad/s/°C)")
-    w.figure(fig, "fig37-sr-tczupt", "Figure 37: Sr_TCZUPT (eq. 37) of the derivative network vs n.")
+    ax = sel_d.plot(xlabel="neurons per hidden layer n", ylabel="Sr_TCZUPT (rad/s/°C)")
+    w.figure(ax.figure, "fig37-sr-tczupt", "Figure 37: Sr_TCZUPT (eq. 37) of the derivative network vs n.")
     w.data["sr_tczupt"] = {"neurons": sel_d.candidates, "sr": sel_d.sr.tolist(), "chosen": sel_d.chosen}
 
     # Hysteresis-aware fit on the ramp (both branches).
