@@ -373,3 +373,20 @@ def test_tczupt_cli_with_a_model_file_and_the_derivative_network(tmp_path):
         zupt.run(log, "tczupt", poly, cfg)
     with pytest.raises(InputError, match=r"config\.derivative"):
         zupt.run(log, "tczupt", nn, cfg.replace(derivative="numeric"))
+
+
+def test_eq31_with_the_calibration_derivative_is_equivalent_to_calibrating_first():
+    """The report's finding as an identity: with the same Q, TCZUPT on raw data (bias
+    propagated by ∂b/∂T·dT/dt) and ZUPT on data calibrated by the same model estimate the same
+    total bias, up to the lag of the 30 s dT/dt slope — over a run with a temperature
+    reversal and the preset's hysteresis step."""
+    log = sim.simulate("ax1", profile="cycles", duration=900.0, seed=5, euler_rad=EULER)
+    model = TrueCurve()
+    cfg = zupt.ZuptConfig(heading_rad=EULER[2], decimation=10, noise=zupt.THESIS_TCZUPT_NOISE)
+    rz = zupt.run(log, "zupt", model, cfg)
+    rt = zupt.run(log, "tczupt", model, cfg)
+    total_z = rz.gyro_bias + model.predict(log.temp)[::10]
+    assert np.abs(rt.gyro_bias - total_z).max() < 0.35 * rz.gyro_bias_std[-1].min()
+    truth = log.truth["gyro_bias"][::10]
+    np.testing.assert_allclose(zupt.rms_error(rt.gyro_bias, truth), zupt.rms_error(total_z, truth), rtol=0.1)
+    assert np.ptp(log.truth["temp_die"]) > 6.0  # the run really crosses the ramp range
