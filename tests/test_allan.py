@@ -128,6 +128,39 @@ def _accel_report():
     return oadev(y, 100.0, unit="m/s^2").identify()
 
 
+def test_anti_alias_flattened_points_are_left_out_of_the_fit():
+    """A 30 Hz second-order anti-alias filter at 100 Hz (the thesis' AX1) flattens σ(τ) at
+    10–40 ms; fitting those points reads the ARW ~17 % low. The automatic rule leaves them out
+    and reads the true ARW; a quantisation-dominated start (slope −1) is kept."""
+    from scipy.signal import butter, sosfilt
+
+    arw = float(convert(3.18, "deg/√h", "rad/√s"))
+    rng = np.random.default_rng(21)
+    white = rng.normal(0.0, arw * 10.0, (1_000_000, 2))
+    aa = sosfilt(butter(2, 30.0, fs=100.0, output="sos"), white, axis=0)
+    curve = oadev(aa, 100.0, "octave", unit="rad/s")
+    rep = identify(curve)
+    np.testing.assert_allclose(rep.fit.random_walk, arw, rtol=0.03)
+    assert np.all(rep.fit_min_tau_s >= 0.04) and np.all(rep.fit_min_tau_s <= 0.16)
+    everything = identify(curve, min_tau=None)
+    assert np.all(everything.fit.random_walk < 0.9 * arw)  # what the rule prevents
+    assert np.all(everything.fit_min_tau_s == curve.taus[0])
+    explicit = identify(curve, min_tau=0.1)
+    assert np.all(explicit.fit_min_tau_s == pytest.approx(0.16))
+    # Quantisation noise (the rate is the difference of a white angle error, IEEE 952's Q
+    # model) falls as τ⁻¹ at the short end: nothing is cut.
+    angle_err = rng.uniform(-0.5, 0.5, 1_000_001) * arw * 2.0
+    q = white[:, 0] + np.diff(angle_err) / 0.01
+    qcurve = oadev(q, 100.0, "octave", unit="rad/s")
+    assert np.log(qcurve.adev[1] / qcurve.adev[0]) / np.log(2.0) < -0.9  # Q-dominated start
+    qrep = identify(qcurve)
+    assert qrep.fit_min_tau_s[0] == pytest.approx(0.01)
+    with pytest.raises(InputError, match="min_tau"):
+        identify(curve, min_tau=-1.0)
+    with pytest.raises(InputError, match="min_tau"):
+        identify(curve, min_tau=1e4)
+
+
 def test_filter_noise_from_thesis_tables():
     fn = FilterNoise.from_datasheet(arw="3.18 deg/√h", gbi="1.5e-4 deg/s", vrw="0.05 m/s/√h", abi="2 m/s/h")
     assert fn.sigma_arw_rad_sqrt_s == pytest.approx(3.18 * np.pi / 180 / 60)

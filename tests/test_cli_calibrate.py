@@ -90,8 +90,6 @@ def test_usage_and_domain_errors(logs, tmp_path) -> None:
 
 
 def test_report_section_quick(tmp_path) -> None:
-    from uasnav.report.sections.s40_calibration import standin_bias, standin_derivative
-
     r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--quick", "--only", "calibration"])
     assert r.exit_code == 0, r.output
     d = json.loads((tmp_path / "report.json").read_text())["sections"]["calibration"]
@@ -106,55 +104,26 @@ def test_report_section_quick(tmp_path) -> None:
     # Table 7 rows: t_PF is the first crossing of a constant residual: θ = |r|·t.
     assert len(d["table7"]["rows"]) == 4
     assert (tmp_path / "figures" / "calibration-fig34-delta-omega.png").exists()
-    # The stand-in's derivative is the derivative of its bias.
-    t = np.linspace(-20, 37, 50)
-    fd = (standin_bias(t + 1e-4) - standin_bias(t - 1e-4)) / 2e-4
-    np.testing.assert_allclose(standin_derivative(t), fd, rtol=1e-6, atol=1e-12)
 
 
-def test_report_section_uses_simulator_contract(monkeypatch) -> None:
-    """The section's simulator path against a fake ``uasnav.sim`` that follows the issue-3
-    contract (simulate → ImuLog with truth rate_true / gyro_bias / gyro_bias_thermal,
-    thermal_bias, thermal_bias_derivative), built from the stand-in curves."""
-    import sys
-    import types
-
+def test_report_section_data_is_the_simulated_thermal_bias() -> None:
+    """The section's soak and ramp data against the simulator's truth: after removing the
+    true rate and the non-thermal bias, what is left is the thermal curve plus white noise of
+    the CRS05-02's ARW (3.18 deg/√h), averaged over each block for the soak."""
+    from uasnav import sim
     from uasnav.report.sections import s40_calibration as sec
-
-    def simulate(preset, *, profile="static", rate=100.0, seed=0, **_):
-        if profile == "soak":
-            temp, _ = sec.standin_soak(seed, hold_s=300.0, rate=rate * 10)
-            heating = np.ones(temp.size, bool)
-        else:
-            _, temp, heating, _ = sec.standin_ramp(seed, rate=rate)
-        n = temp.size
-        earth = np.tile([5e-5, 0.0, -5e-5], (n, 1))
-        thermal = sec.standin_bias(temp, heating)
-        total = thermal + 1e-4  # turn-on bias
-        gyro = earth + total + np.random.default_rng(seed).normal(0, 1e-4, (n, 3))
-        return ImuLog(
-            t=np.arange(n) / rate,
-            gyro=gyro,
-            accel=np.tile([0.0, 0.0, -9.81], (n, 1)),
-            temp=np.round(temp, 2),
-            truth={"rate_true": earth, "gyro_bias": total, "gyro_bias_thermal": thermal, "temp_die": temp},
-        )
-
-    fake = types.ModuleType("uasnav.sim")
-    fake.simulate = simulate  # type: ignore[attr-defined]
-    fake.thermal_bias = lambda preset, t, branch="heating": sec.standin_bias(t, branch == "heating")  # type: ignore[attr-defined]
-    fake.thermal_bias_derivative = lambda preset, t, branch="heating": sec.standin_derivative(t)  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "uasnav.sim", fake)
-    import uasnav
-
-    monkeypatch.setattr(uasnav, "sim", fake, raising=False)
 
     class W:
         quick, seed = True, 3
 
     d = sec._data(W())  # type: ignore[arg-type]
-    assert d["source"].startswith("uasnav.sim")
-    # Earth rate and turn-on bias are removed: what is left is the thermal bias plus noise.
-    assert np.abs(d["ramp_gyro"] - d["ramp_truth"]).mean() < 2e-4
-    np.testing.assert_allclose(d["truth_fn"](np.array([30.0]), True), sec.standin_bias(np.array([30.0])))
-    assert d["soak_temp"].size == d["soak_bias"].shape[0] > 50
+    arw = np.deg2rad(3.18 / 60.0)  # rad/√s
+    soak_err = d["soak_bias"] - sim.thermal_bias("ax1", d["soak_temp"], "heating")
+    # 10 s block means at 1 Hz: σ = ARW/√10 s; the die lags during the ramps between levels,
+    # but the curve is evaluated at the measured (die) temperature, so no lag error remains.
+    assert np.std(soak_err) == pytest.approx(arw / np.sqrt(10.0), rel=0.15)
+    assert np.abs(soak_err.mean(axis=0)).max() < 4 * arw / np.sqrt(10.0 * soak_err.shape[0])
+    ramp_err = d["ramp_gyro"] - d["ramp_truth"]
+    assert np.abs(ramp_err.mean(axis=0)).max() < 4 * arw * np.sqrt(10.0 / ramp_err.shape[0])
+    assert d["soak_temp"].min() < -20.0 and d["soak_temp"].max() > 37.0
+    assert d["hysteresis_true"] == pytest.approx(-np.deg2rad(0.03), rel=1e-9)

@@ -370,3 +370,29 @@ def test_inject_fault_touches_only_the_faulty_sensor_after_start(kind: str) -> N
         inject_fault(z, kind, sensor=0, start=0)
     with pytest.raises(InputError, match="kind"):
         inject_fault(z, "gremlins", sensor=0, start=5)
+
+
+def test_cycles_profile_repeats_the_thesis_ramp_test() -> None:
+    log = simulate("ax1", profile="cycles", duration=3000.0, rate=1.0, seed=0)
+    die = log.truth["temp_die"]
+    assert log.meta["profile"] == "cycles"
+    assert np.all(np.abs(die[:60] - 27.28) < 1e-9)  # the 60 s zeroing at the low end
+    # With 5-min dwells the die (90 s lag) comes within 0.1 °C of both ends of 27.28 … 34.08 °C.
+    assert die.max() == pytest.approx(34.08, abs=0.12) and die[600:].min() == pytest.approx(27.28, abs=0.12)
+    reversals = np.sum(np.diff(np.sign(np.round(np.diff(die), 6))[np.round(np.diff(die), 6) != 0]) != 0)
+    assert reversals >= 4  # several heating and cooling branches
+    chamber_rate = np.diff(log.truth["temp_chamber"])
+    assert chamber_rate.max() == pytest.approx(2.0 / 60.0, rel=1e-9)
+
+
+def test_lab_block_average_and_errors() -> None:
+    from uasnav.sim.lab import block_average, soak_calibration_data
+
+    x = np.arange(10.0).reshape(5, 2)
+    np.testing.assert_allclose(block_average(x, 2), [[1.0, 2.0], [5.0, 6.0]])
+    with pytest.raises(InputError, match="block length"):
+        block_average(x, 0)
+    with pytest.raises(InputError, match="exceeds"):
+        block_average(x, 6)
+    cal = soak_calibration_data("ax1", seed=1, rate=1.0, average_s=120.0)
+    assert cal.average_s == 120.0 and cal.gyro_bias.shape == (cal.temp.size, 3)

@@ -156,6 +156,9 @@ def test_order_selection_rule() -> None:
     assert res.chosen == 3  # the true order; higher orders only fit noise
     assert res.sr[2] < 0.2 * res.sr[1]
     assert res.sr[2] == pytest.approx(np.sqrt(3) * 1e-6, rel=0.1)  # the noise floor
+    ax = res.plot(xlabel="order")  # Figure 31: the curve and the chosen order
+    np.testing.assert_array_equal(ax.lines[0].get_ydata(), res.sr)
+    assert ax.lines[1].get_xdata()[0] == 3 and ax.get_yscale() == "log"
 
 
 def test_structure_selection_runs_and_prefers_enough_neurons(data: tuple[np.ndarray, np.ndarray]) -> None:

@@ -98,11 +98,16 @@ class AllanResult:
         rel = self.rel_error if self.adev.ndim == 1 else self.rel_error[:, None]
         return self.adev * rel
 
-    def identify(self, kind: Literal["gyro", "accel"] | None = None) -> NoiseReport:
+    def identify(
+        self,
+        kind: Literal["gyro", "accel"] | None = None,
+        *,
+        min_tau: float | Literal["auto"] | None = "auto",
+    ) -> NoiseReport:
         """Identify the IEEE 952 noise terms of this curve (see :func:`uasnav.noise.identify`)."""
         from uasnav.noise import identify
 
-        return identify(self, kind=kind)
+        return identify(self, kind=kind, min_tau=min_tau)
 
     def plot(
         self,

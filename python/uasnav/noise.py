@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from uasnav import _core
 from uasnav.allan import AllanResult
@@ -149,12 +149,16 @@ class NoiseReport:
         RMS relative residual of the fit in σ², per axis.
     curve : AllanResult
         The curve the terms were read from.
+    fit_min_tau_s : ndarray, shape (c,)
+        Shortest cluster time (s) used per axis (longer than the curve's first when points
+        flattened by an anti-alias filter were left out; see :func:`identify`).
     """
 
     fit: NoiseTerms
     points: NoiseTerms
     fit_rms_rel_residual: NDArray[np.float64]
     curve: AllanResult = field(repr=False)
+    fit_min_tau_s: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     @property
     def kind(self) -> Literal["gyro", "accel"]:
@@ -193,7 +197,40 @@ class NoiseReport:
         return rows
 
 
-def identify(curve: AllanResult, kind: Literal["gyro", "accel"] | None = None) -> NoiseReport:
+def band_limited_points(
+    taus: ArrayLike, adev: ArrayLike, rel_error: ArrayLike, slope_tol: float = 0.03
+) -> int:
+    """Number of leading τ whose σ(τ) is flattened by an anti-alias low-pass filter.
+
+    No IEEE 952 term is shallower than the white noise's τ^(−1/2) at the short-τ end
+    (quantisation falls as τ⁻¹; the flat and rising terms dominate only at long τ), so a
+    leading run of points whose slope to the next point is shallower than −1/2 by more than
+    ``slope_tol`` plus 3σ of the slope's statistical error is the signature of a band-limited
+    output (e.g. a 30 Hz filter at 100 Hz: σ(10 ms) is ~45 % low). Those points would pull the
+    fit's white-noise coefficient low, so :func:`identify` leaves them out. The run is only
+    cut when a white-noise slope follows within the first third of the curve (otherwise the
+    curve is not white-noise dominated at short τ and nothing is cut).
+    """
+    t = np.asarray(taus, dtype=np.float64)
+    a = np.asarray(adev, dtype=np.float64)
+    e = np.asarray(rel_error, dtype=np.float64)
+    for k in range(max(0, t.size // 3)):
+        dlog = np.log(t[k + 1] / t[k])
+        if not (a[k] > 0 and a[k + 1] > 0 and dlog > 0):
+            return 0
+        slope = np.log(a[k + 1] / a[k]) / dlog
+        margin = slope_tol + 3.0 * np.hypot(e[k], e[k + 1]) / dlog
+        if slope <= -0.5 + margin:
+            return k
+    return 0
+
+
+def identify(
+    curve: AllanResult,
+    kind: Literal["gyro", "accel"] | None = None,
+    *,
+    min_tau: float | Literal["auto"] | None = "auto",
+) -> NoiseReport:
     """Identify IEEE 952 noise terms from an Allan curve.
 
     Parameters
@@ -203,6 +240,10 @@ def identify(curve: AllanResult, kind: Literal["gyro", "accel"] | None = None) -
         curve decides the kind unless ``kind`` is given; other units are refused, so
         deg/s data cannot silently produce rad-based coefficients).
     kind : {"gyro", "accel"}, optional
+    min_tau : float, "auto" or None
+        Shortest cluster time (s) used. ``"auto"`` (default) leaves out, per axis, the
+        leading points flattened by an anti-alias filter (:func:`band_limited_points`);
+        ``None`` uses every point. The report records what was used (``fit_min_tau_s``).
 
     Returns
     -------
@@ -223,12 +264,29 @@ def identify(curve: AllanResult, kind: Literal["gyro", "accel"] | None = None) -
     pt_vals = np.zeros((5, ncol))
     rms = np.zeros(ncol)
     missing: list[tuple[int, str]] = []
+    used = np.zeros(ncol)
     for j in range(ncol):
-        col = np.ascontiguousarray(avar[:, j])
-        coeffs, _active, r = _core.noise_fit_ieee952(curve.taus, col, curve.rel_error)
+        if min_tau == "auto":
+            k = band_limited_points(curve.taus, np.sqrt(avar[:, j]), curve.rel_error)
+        elif min_tau is None:
+            k = 0
+        else:
+            if not (isinstance(min_tau, (int, float)) and np.isfinite(min_tau) and min_tau >= 0):
+                raise InputError(
+                    f"min_tau: expected a non-negative number of seconds, 'auto' or None, got {min_tau!r}"
+                )
+            k = int(np.searchsorted(curve.taus, float(min_tau) * (1 - 1e-12)))
+            if curve.taus.size - k < 5:
+                raise InputError(
+                    f"min_tau={min_tau}: leaves {curve.taus.size - k} cluster times; the fit needs 5"
+                )
+        taus, rel = curve.taus[k:], curve.rel_error[k:]
+        used[j] = taus[0]
+        col = np.ascontiguousarray(avar[k:, j])
+        coeffs, _active, r = _core.noise_fit_ieee952(taus, col, rel)
         fit_vals[:, j] = coeffs
         rms[j] = r
-        readings = _core.noise_read_points(curve.taus, col, curve.rel_error)
+        readings = _core.noise_read_points(taus, col, rel)
         for i, (name, rd) in enumerate(zip(TERMS, readings, strict=True)):
             if rd is None:
                 missing.append((j, name))
@@ -236,7 +294,7 @@ def identify(curve: AllanResult, kind: Literal["gyro", "accel"] | None = None) -
                 pt_vals[i, j] = rd[0]
     fit = NoiseTerms(kind, "ieee952-fit", *fit_vals)
     points = NoiseTerms(kind, "slope-points", *pt_vals, missing=tuple(missing))
-    return NoiseReport(fit=fit, points=points, fit_rms_rel_residual=rms, curve=curve)
+    return NoiseReport(fit=fit, points=points, fit_rms_rel_residual=rms, curve=curve, fit_min_tau_s=used)
 
 
 @dataclass(frozen=True)
@@ -317,4 +375,13 @@ class FilterNoise:
         return self.sigma_arw_rad_sqrt_s / np.sqrt(dt_s), self.sigma_vrw_m_s_sqrt_s / np.sqrt(dt_s)
 
 
-__all__ = ["FIELD_UNITS", "SI_UNITS", "TERMS", "FilterNoise", "NoiseReport", "NoiseTerms", "identify"]
+__all__ = [
+    "FIELD_UNITS",
+    "SI_UNITS",
+    "TERMS",
+    "FilterNoise",
+    "NoiseReport",
+    "NoiseTerms",
+    "band_limited_points",
+    "identify",
+]

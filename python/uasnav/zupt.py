@@ -126,6 +126,11 @@ class ZuptConfig:
         Φ = I + F·Ts (eq. 16) or with the (F·Ts)²/2 term.
     temp_slope_window_s : float
         Window of the least-squares dT/dt slope (TCZUPT).
+    derivative : {"analytic", "network"}
+        Where TCZUPT takes ∂b/∂T from: ``model.derivative(temp)`` (the analytic derivative of
+        the bias model), or ``model.derivative(temp, method="network")`` (a network trained on
+        the derivative of the calibration data, thesis eq. 37; needs a
+        :class:`~uasnav.thermal.NeuralBiasModel` fitted with ``derivative_network=True``).
     decimation : int
         Keep one history row every ``decimation`` samples.
     """
@@ -151,6 +156,7 @@ class ZuptConfig:
     residual_gyro_bias_rad_s: float = 0.0
     discretisation: Literal["first_order", "second_order"] = "first_order"
     temp_slope_window_s: float = 30.0
+    derivative: Literal["analytic", "network"] = "analytic"
     decimation: int = 1
 
     def replace(self, **changes: Any) -> ZuptConfig:
@@ -344,6 +350,8 @@ def run(
         raise InputError(f"mode: expected 'zupt' or 'tczupt', got {mode!r}")
     if not isinstance(cfg.decimation, int) or cfg.decimation < 1:
         raise InputError(f"config.decimation: expected an int >= 1, got {cfg.decimation!r}")
+    if cfg.derivative not in ("analytic", "network"):
+        raise InputError(f"config.derivative: expected 'analytic' or 'network', got {cfg.derivative!r}")
     rate = log.uniform_rate()
     dt = 1.0 / rate
     gyro = log.gyro
@@ -353,7 +361,7 @@ def run(
             raise InputError("model: TCZUPT needs a thermal model (its derivative ∂b/∂T)")
         if log.temp is None:
             raise InputError("log.temp: TCZUPT needs the die temperature")
-        dbdt = _model_rows("model.derivative(temp)", model.derivative(log.temp), log.n)
+        dbdt = _model_derivative(model, log.temp, cfg.derivative, log.n)
     elif model is not None:
         if log.temp is None:
             raise InputError("log.temp: calibrating with a model needs the die temperature")
@@ -461,6 +469,19 @@ def detect_stationary(
     starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
     intervals = [(float(log.t[a]), float(log.t[b])) for a, b in zip(starts, ends, strict=True)]
     return StationarityResult(mask=mask, statistic=stat, intervals=intervals)
+
+
+def _model_derivative(model: ThermalModel, temp: FloatArray, method: str, n: int) -> FloatArray:
+    if method == "analytic":
+        return _model_rows("model.derivative(temp)", model.derivative(temp), n)
+    try:
+        d = model.derivative(temp, method="network")  # type: ignore[call-arg]
+    except TypeError:
+        raise InputError(
+            f"config.derivative='network': {type(model).__name__} has no derivative network "
+            "(use a NeuralBiasModel fitted with derivative_network=True)"
+        ) from None
+    return _model_rows('model.derivative(temp, method="network")', d, n)
 
 
 def _model_rows(name: str, a: ArrayLike, n: int) -> FloatArray:

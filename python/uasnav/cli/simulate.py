@@ -24,10 +24,10 @@ def _outputs(out: Path, count: int) -> list[Path]:
 )
 @click.option(
     "--profile",
-    type=click.Choice(["static", "soak", "ramp", "warmup"]),
+    type=click.Choice(["static", "soak", "ramp", "cycles", "warmup"]),
     default="static",
     show_default=True,
-    help="Temperature profile (thesis §4.2.4: soak = Fig. 29, ramp = Fig. 30).",
+    help="Temperature profile (thesis §4.2.4: soak = Fig. 29, ramp = Fig. 30; cycles = repeated ramps).",
 )
 @click.option("--duration", type=float, default=None, help="Seconds; default: the profile's natural length.")
 @click.option("--rate", type=float, default=100.0, show_default=True, help="Output sample rate (Hz).")

@@ -114,12 +114,20 @@ def load_database(source: str | os.PathLike | None = None, **fetch_kw) -> Databa
     def est(e):
         return frozenset((e.get("estimated") or "").split())
 
+    def common(items):
+        """The columns every equipment table has (identity, cost, provenance)."""
+        return {
+            "ids": [e.get("id") for e in items],
+            "producers": [e.findtext("producer") for e in items],
+            "names": [e.findtext("name") for e in items],
+            "types": [e.get("type") for e in items],
+            "cost_usd": col(items, "cost_usd"),
+            "sources": [e.findtext("source") for e in items],
+            "estimated": [est(e) for e in items],
+        }
+
     uas = UasTable(
-        ids=[e.get("id") for e in us],
-        producers=[e.findtext("producer") for e in us],
-        names=[e.findtext("name") for e in us],
-        types=[e.get("type") for e in us],
-        cost_usd=col(us, "cost_usd"),
+        **common(us),
         span_m=col(us, "span_m"),
         mass_g=col(us, "mass_g"),
         max_takeoff_g=col(us, "max_takeoff_g"),
@@ -130,15 +138,9 @@ def load_database(source: str | os.PathLike | None = None, **fetch_kw) -> Databa
         max_range_m=col(us, "max_range_m"),
         eu_class=[e.findtext("eu_class") for e in us],
         rain=np.array([_rain_capable(e.findtext("ip_rating"), e.findtext("rain")) for e in us], dtype=bool),
-        sources=[e.findtext("source") for e in us],
-        estimated=[est(e) for e in us],
     )
     cams = CameraTable(
-        ids=[e.get("id") for e in cs],
-        producers=[e.findtext("producer") for e in cs],
-        names=[e.findtext("name") for e in cs],
-        types=[e.get("type") for e in cs],
-        cost_usd=col(cs, "cost_usd"),
+        **common(cs),
         mass_g=col(cs, "mass_g"),
         hfov_deg=col(cs, "hfov_deg"),
         resolution_w_px=col(cs, "resolution_w_px"),
@@ -146,7 +148,5 @@ def load_database(source: str | os.PathLike | None = None, **fetch_kw) -> Databa
         sensor_w_mm=col(cs, "sensor_w_mm"),
         focal_mm=col(cs, "focal_mm"),
         bands=[e.findtext("bands") or "" for e in cs],
-        sources=[e.findtext("source") for e in cs],
-        estimated=[est(e) for e in cs],
     )
     return Database(uas, cams, where)

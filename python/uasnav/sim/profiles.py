@@ -11,6 +11,10 @@ soak      die −20.53 → 37.30 °C in 5 °C steps, each reached with a 1 °C/m
           held 20 min (stabilised), thesis Figure 29
 ramp      die 27.28 → 34.08 °C at 2 °C/min, held 10 min, back down at 2 °C/min, held 10 min
           (heating then cooling branch: hysteresis), thesis Figure 30
+cycles    die 27.28 ↔ 34.08 °C at 2 °C/min with 5-min dwells at both ends, repeated, after 60 s at
+          27.28 °C (the thesis' zeroing window): the ramp test as a long ZUPT/TCZUPT input with
+          several heating and cooling branches (§4.2.6.2; a 90 s die lag ends each dwell within
+          0.1 °C of the target); natural length 1 h
 warmup    constant chamber (ambient); the die warms by the self-heating with time constant
           ``warmup_tau_s`` after power-on (natural length 5 time constants)
 static    constant temperature, die at the ambient temperature (chamber = ambient − self-heating,
@@ -29,7 +33,7 @@ from uasnav.errors import InputError
 from uasnav.imu import check_time
 
 FloatArray = NDArray[np.float64]
-PROFILE_NAMES = ("static", "soak", "ramp", "warmup")
+PROFILE_NAMES = ("static", "soak", "ramp", "cycles", "warmup")
 
 #: Die temperatures of the thesis' soak test (°C): −20.53 °C in steps of 5 °C up to 37.30 °C.
 SOAK_DIE_C = (*tuple(round(-20.53 + 5.0 * k, 2) for k in range(12)), 37.30)
@@ -122,6 +126,14 @@ def named_profile(
         _ramp_hold(pts, lo - self_heating_c, RAMP_RATE_C_PER_S, 600.0)
         t, c = zip(*pts, strict=True)
         return TemperatureProfile(np.array(t), np.array(c), name="ramp")
+    if name == "cycles":
+        lo, hi = RAMP_DIE_C
+        pts = [(0.0, lo - self_heating_c), (60.0, lo - self_heating_c)]
+        while pts[-1][0] < 3600.0:
+            _ramp_hold(pts, hi - self_heating_c, RAMP_RATE_C_PER_S, 300.0)
+            _ramp_hold(pts, lo - self_heating_c, RAMP_RATE_C_PER_S, 300.0)
+        t, c = zip(*pts, strict=True)
+        return TemperatureProfile(np.array(t), np.array(c), name="cycles")
     raise InputError(
         f"unknown profile {name!r}; expected one of {', '.join(PROFILE_NAMES)} or a TemperatureProfile"
     )

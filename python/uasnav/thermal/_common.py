@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -127,6 +128,20 @@ class SelectionResult:
     sr: FloatArray
     chosen: int
     rel_tol: float
+
+    def plot(self, *, xlabel: str, ylabel: str = "Sr (rad/s)", ax: Any = None) -> Any:
+        """Sr vs candidate on a log scale with the chosen one marked (thesis Figures 31, 32,
+        37); returns the matplotlib Axes."""
+        if ax is None:
+            from uasnav.plotting import new_figure
+
+            _, ax = new_figure()
+        ax.semilogy(self.candidates, self.sr, "o-")
+        ax.axvline(self.chosen, color="C1", ls="--", label=f"chosen: {self.chosen}")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.legend()
+        return ax
 
 
 def choose(candidates: tuple[int, ...], srs: FloatArray, rel_tol: float = 0.05) -> int:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -109,13 +110,40 @@ def read_csv(path: str | Path) -> FlightLog:
     )
 
 
+def _from_fixes(
+    fixes: list[tuple[float, ...]],
+    path: str | Path,
+    *,
+    waypoints: dict[int, tuple[float, float, float]],
+    reached: list[tuple[float, int]],
+    wind: list[Any],
+    cruise_ms: float | None = None,
+) -> FlightLog:
+    """A FlightLog from position fixes ``(t, lat, lon, alt, v_N, v_E, v_D)`` and mission events."""
+    if not fixes:
+        raise DataFormatError("no position fixes", path=str(path))
+    a = np.array(fixes, dtype=np.float64)
+    return FlightLog(
+        t=a[:, 0],
+        lat=a[:, 1],
+        lon=a[:, 2],
+        alt=a[:, 3],
+        vel_ned=a[:, 4:7],
+        waypoints=waypoints,
+        reached=sorted(reached),
+        wind_ne=np.mean(wind, axis=0) if wind else None,
+        cruise_ms=cruise_ms,
+        source=str(path),
+    )
+
+
 def read_tlog(path: str | Path) -> FlightLog:
     """MAVLink telemetry log: GLOBAL_POSITION_INT, MISSION_ITEM(_INT), MISSION_ITEM_REACHED,
     WIND (ArduPilot, if present), WPNAV_SPEED / DO_CHANGE_SPEED. Times are the log's wall clock."""
     from pymavlink import mavutil
 
     conn = mavutil.mavlink_connection(str(path), dialect="ardupilotmega")
-    t, lat, lon, alt, vel = [], [], [], [], []
+    fixes: list[tuple[float, ...]] = []
     items: dict[int, tuple[int, float, float, float, float]] = {}
     reached: list[tuple[float, int]] = []
     wind = []
@@ -135,11 +163,17 @@ def read_tlog(path: str | Path) -> FlightLog:
             break
         kind = m.get_type()
         if kind == "GLOBAL_POSITION_INT":
-            t.append(m._timestamp)
-            lat.append(m.lat * 1e-7)
-            lon.append(m.lon * 1e-7)
-            alt.append(m.alt * 1e-3)
-            vel.append((m.vx * 0.01, m.vy * 0.01, m.vz * 0.01))
+            fixes.append(
+                (
+                    m._timestamp,
+                    m.lat * 1e-7,
+                    m.lon * 1e-7,
+                    m.alt * 1e-3,
+                    m.vx * 0.01,
+                    m.vy * 0.01,
+                    m.vz * 0.01,
+                )
+            )
         elif kind in ("MISSION_ITEM_INT", "MISSION_ITEM"):
             scale = 1e-7 if kind == "MISSION_ITEM_INT" else 1.0
             items[m.seq] = (m.command, m.x * scale, m.y * scale, m.z, m.param2)
@@ -149,7 +183,7 @@ def read_tlog(path: str | Path) -> FlightLog:
             wind.append(wind_vector(float(m.speed), float(m.direction)))
         elif kind == "PARAM_VALUE" and m.param_id.rstrip("\x00") == "WPNAV_SPEED":
             wpnav = float(m.param_value) * 0.01
-    if not t:
+    if not fixes:
         raise DataFormatError("no GLOBAL_POSITION_INT messages", path=str(path))
     # seq 0 is the home position on ArduPilot; navigation waypoints carry a position.
     wps = {
@@ -158,18 +192,8 @@ def read_tlog(path: str | Path) -> FlightLog:
         if s > 0 and cmd == _MAV_NAV_WAYPOINT and (x != 0 or y != 0)
     }
     speeds = [p2 for s, (cmd, *_, p2) in items.items() if cmd == _MAV_DO_CHANGE_SPEED and p2 > 0]
-    return FlightLog(
-        t=np.array(t),
-        lat=np.array(lat),
-        lon=np.array(lon),
-        alt=np.array(alt),
-        vel_ned=np.array(vel),
-        waypoints=wps,
-        reached=sorted(reached),
-        wind_ne=np.mean(wind, axis=0) if wind else None,
-        cruise_ms=speeds[0] if speeds else wpnav,
-        source=str(path),
-    )
+    cruise = speeds[0] if speeds else wpnav
+    return _from_fixes(fixes, path, waypoints=wps, reached=reached, wind=wind, cruise_ms=cruise)
 
 
 def read_dataflash(path: str | Path) -> FlightLog:
@@ -180,7 +204,7 @@ def read_dataflash(path: str | Path) -> FlightLog:
     from pymavlink import mavutil
 
     conn = mavutil.mavlink_connection(str(path))
-    t, lat, lon, alt, vel = [], [], [], [], []
+    fixes: list[tuple[float, ...]] = []
     wps: dict[int, tuple[float, float, float]] = {}
     reached: list[tuple[float, int]] = []
     wind = []
@@ -199,11 +223,9 @@ def read_dataflash(path: str | Path) -> FlightLog:
             continue
         if kind == "GPS" and getattr(m, "Status", 3) >= 3:
             crs = np.radians(m.GCrs)
-            t.append(ts)
-            lat.append(m.Lat)
-            lon.append(m.Lng)
-            alt.append(m.Alt)
-            vel.append((m.Spd * np.cos(crs), m.Spd * np.sin(crs), getattr(m, "VZ", 0.0)))
+            fixes.append(
+                (ts, m.Lat, m.Lng, m.Alt, m.Spd * np.cos(crs), m.Spd * np.sin(crs), getattr(m, "VZ", 0.0))
+            )
         elif kind == "CMD" and m.CId == _MAV_NAV_WAYPOINT and m.CNum > 0 and (m.Lat != 0 or m.Lng != 0):
             wps[int(m.CNum)] = (m.Lat, m.Lng, m.Alt)
         elif kind == "MSG":
@@ -212,19 +234,9 @@ def read_dataflash(path: str | Path) -> FlightLog:
                 reached.append((ts, int(hit.group(1))))
         elif kind in ("XKF2", "NKF2", "EKF2") and hasattr(m, "VWN"):
             wind.append((m.VWN, m.VWE))
-    if not t:
+    if not fixes:
         raise DataFormatError("no GPS messages with a 3D fix", path=str(path))
-    return FlightLog(
-        t=np.array(t),
-        lat=np.array(lat),
-        lon=np.array(lon),
-        alt=np.array(alt),
-        vel_ned=np.array(vel),
-        waypoints=wps,
-        reached=sorted(reached),
-        wind_ne=np.mean(wind, axis=0) if wind else None,
-        source=str(path),
-    )
+    return _from_fixes(fixes, path, waypoints=wps, reached=reached, wind=wind)
 
 
 def read_ulog(path: str | Path) -> FlightLog:

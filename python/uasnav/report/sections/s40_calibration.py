@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import importlib
 import warnings
 from typing import Any
 
@@ -27,134 +26,32 @@ TABLE8 = {
 THESIS_DW = {"max": 1.83e-4, "t_max": 27.78, "rms": 1.07e-4, "t_rms": 32.60}
 RAMP_RANGE = (27.28, 34.08)
 
-# --- stand-in thermal data ------------------------------------------------------------------
-# STAND-IN for the simulator of issue 3 (``uasnav.sim``), used while it is not available: a
-# deterministic AX1-like (CRS05-02 gyro) thermal bias with a heating/cooling hysteresis, the
-# thesis' soak (−20.5 → 37.3 °C in ~5 °C steps, stabilised) and ramp (27.3 → 34.1 °C at
-# 2 °C/min and back) profiles, white noise of the CRS05-02's ARW (3.18 deg/√h). Only the
-# shapes are invented; nothing here is calibrated against the real AX1.
-STANDIN_HYSTERESIS = np.array([3e-4, 2e-4, 2.5e-4])  # rad/s, full width cooling − heating
-
-
-def standin_bias(temp: np.ndarray, heating: np.ndarray | bool = True) -> np.ndarray:
-    """Stand-in true thermal gyro bias (n, 3) rad/s at die temperatures (n,) °C."""
-    t = np.asarray(temp, dtype=float)
-    b = np.stack(
-        [
-            3.0e-3 * np.tanh((t - 8) / 10) + 6e-5 * (t - 8) + 1.5e-4 * np.sin(t / 3.5),
-            -2.0e-3 * np.tanh((t - 15) / 7) + 2e-4 * np.cos(t / 6),
-            1.2e-6 * (t - 10) ** 2 + 8e-4 * np.tanh((t - 25) / 4),
-        ],
-        axis=1,
-    )
-    sign = np.where(np.asarray(heating, dtype=bool), -0.5, 0.5)
-    return b + np.multiply.outer(sign, STANDIN_HYSTERESIS)
-
-
-def standin_derivative(temp: np.ndarray) -> np.ndarray:
-    """∂b/∂T (n, 3) rad/s/°C of :func:`standin_bias` (the same on both branches)."""
-    t = np.asarray(temp, dtype=float)
-    sech2 = lambda x: 1.0 / np.cosh(x) ** 2  # noqa: E731
-    return np.stack(
-        [
-            3.0e-4 * sech2((t - 8) / 10) + 6e-5 + 1.5e-4 / 3.5 * np.cos(t / 3.5),
-            -2.0e-3 / 7 * sech2((t - 15) / 7) - 2e-4 / 6 * np.sin(t / 6),
-            2.4e-6 * (t - 10) + 2e-4 * sech2((t - 25) / 4),
-        ],
-        axis=1,
-    )
-
-
-def standin_soak(seed: int, hold_s: float = 1800.0, rate: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """Soak test (stand-in): die temperature (n,) °C and gyro output (n, 3) rad/s at ``rate``."""
-    rng = np.random.default_rng(seed)
-    levels = np.linspace(-20.53, 37.30, 12)
-    n_hold = round(hold_s * rate)
-    chamber = np.repeat(levels, n_hold)
-    # First-order lag of the die behind the chamber (τ = hold/5: 6 min for 30-min holds), so
-    # the die settles at every level.
-    a = np.exp(-1.0 / (rate * hold_s / 5.0))
-    die = np.empty_like(chamber)
-    die[0] = levels[0]
-    for k in range(1, die.size):
-        die[k] = a * die[k - 1] + (1 - a) * chamber[k]
-    sigma = np.deg2rad(3.18 / 60.0) * np.sqrt(rate)  # ARW 3.18 deg/√h → σ per sample
-    return die, standin_bias(die, True) + rng.normal(0.0, sigma, (die.size, 3))
-
-
-def standin_ramp(seed: int, rate: float = 100.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Ramp test (stand-in): time (s), die temperature (°C), heating mask, gyro output (rad/s)."""
-    rng = np.random.default_rng(seed + 1)
-    span = RAMP_RANGE[1] - RAMP_RANGE[0]
-    half = span / (2.0 / 60.0)
-    t = np.arange(0.0, 2 * half, 1.0 / rate)
-    temp = RAMP_RANGE[0] + span * (1 - np.abs(1 - t / half))
-    heating = t < half
-    sigma = np.deg2rad(3.18 / 60.0) * np.sqrt(rate)
-    return t, temp, heating, standin_bias(temp, heating) + rng.normal(0.0, sigma, (t.size, 3))
-
-
 # The thesis' Sr values (~1e-5 rad/s) are far below the CRS05-02's white noise at any usable
-# rate, so its soak data must have been heavily smoothed; we average the soak over 60 s blocks.
+# rate, so its soak data must have been heavily smoothed; we average the soak over 60 s blocks
+# (quick mode: 10 s).
 AVERAGE_S = 60
 
 
-def _block_average(temp: np.ndarray, bias: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    n = temp.size // k * k
-    return temp[:n].reshape(-1, k).mean(1), bias[:n].reshape(-1, k, bias.shape[1]).mean(1)
-
-
 def _data(w: SectionWriter) -> dict[str, Any]:
-    """Soak and ramp data from the simulator if it exists, else the stand-in."""
-    try:
-        sim = importlib.import_module("uasnav.sim")  # issue 3; absent on older trees
-
-        have_sim = hasattr(sim, "simulate") and hasattr(sim, "thermal_bias")
-    except ImportError:
-        have_sim = False
-    if have_sim:
-        return _sim_data(w)
-    hold = 300.0 if w.quick else 1800.0
-    soak_t, soak_b = _block_average(*standin_soak(w.seed, hold_s=hold), AVERAGE_S // (6 if w.quick else 1))
-    rt, rtemp, rheat, rgyro = standin_ramp(w.seed, rate=10.0 if w.quick else 100.0)
-    return {
-        "source": "stand-in generator (uasnav.sim not available)",
-        "soak_temp": soak_t,
-        "soak_bias": soak_b,
-        "ramp_t": rt,
-        "ramp_temp": rtemp,
-        "ramp_heating": rheat,
-        "ramp_gyro": rgyro,
-        "ramp_truth": standin_bias(rtemp, rheat),
-        "truth_fn": lambda temp, heating=True: standin_bias(temp, heating),
-        "truth_derivative_fn": standin_derivative,
-        "hysteresis_true": STANDIN_HYSTERESIS,
-    }
-
-
-def _sim_data(w: SectionWriter) -> dict[str, Any]:
-    sim = importlib.import_module("uasnav.sim")
-
-    # The soak lasts hours: 1 Hz (quick) or 10 Hz keeps it to a few 10⁵ samples.
-    rate = 1.0 if w.quick else 10.0
-    soak = sim.simulate("ax1", profile="soak", rate=rate, seed=w.seed)
-    ramp = sim.simulate("ax1", profile="ramp", rate=10.0 if w.quick else 100.0, seed=w.seed + 1)
-    # Lab calibration: the unit's orientation is known, so the output minus the true rate
-    # (Earth rate) is the bias. The simulator's non-thermal bias (turn-on, instability, random
-    # walk: truth gyro_bias − gyro_bias_thermal) is removed too, so that models and residuals
-    # are about the thermal curve alone; then block means as for the stand-in.
-    k = max(1, round(rate * AVERAGE_S / (6 if w.quick else 1)))
-    other = soak.truth["gyro_bias"] - soak.truth["gyro_bias_thermal"]
-    temp, bias = _block_average(soak.temp, soak.gyro - soak.truth["rate_true"] - other, k)
+    """Soak (calibration) and ramp (test) data of the simulated AX1, with their truth."""
+    from uasnav import sim
+    from uasnav.sim.lab import soak_calibration_data
     from uasnav.thermal import branch_from_temperature
 
-    heating = branch_from_temperature(ramp.t, ramp.truth.get("temp_die", ramp.temp))
+    # The soak lasts hours: 1 Hz (quick) or 10 Hz keeps it to a few 10⁵ samples.
+    cal = soak_calibration_data(
+        "ax1", seed=w.seed, rate=1.0 if w.quick else 10.0, average_s=AVERAGE_S / (6 if w.quick else 1)
+    )
+    ramp = sim.simulate("ax1", profile="ramp", rate=10.0 if w.quick else 100.0, seed=w.seed + 1)
+    # The ramp output minus the true rate (Earth rate) and the non-thermal bias (turn-on,
+    # instability, random walk) is the thermal bias plus white noise: what the models predict.
+    heating = branch_from_temperature(ramp.t, ramp.truth["temp_die"])
     turn_on = ramp.truth["gyro_bias"] - ramp.truth["gyro_bias_thermal"]
     mid = 0.5 * (RAMP_RANGE[0] + RAMP_RANGE[1])
     return {
         "source": "uasnav.sim preset ax1, profiles soak and ramp",
-        "soak_temp": temp,
-        "soak_bias": bias,
+        "soak_temp": cal.temp,
+        "soak_bias": cal.gyro_bias,
         "ramp_t": ramp.t,
         "ramp_temp": ramp.temp,
         "ramp_heating": heating,
@@ -222,13 +119,10 @@ def build(w: SectionWriter) -> None:
     # Figure 31: polynomial order selection.
     w.progress("polynomial order selection")
     sel_p = select_polynomial_order(temp, bias, orders=tuple(range(1, 11)), seed=w.seed)
-    fig, ax = new_figure()
-    ax.semilogy(sel_p.candidates, sel_p.sr, "o-")
-    ax.axvline(sel_p.chosen, color="C1", ls="--", label=f"chosen: {sel_p.chosen}")
-    ax.set_xlabel("polynomial order m")
-    ax.set_ylabel("Sr_PF (rad/s)")
-    ax.legend()
-    w.figure(fig, "fig31-sr-pf", "Figure 31: Sr_PF (eq. 32) on held-out soak data vs order (thesis chose 2).")
+    ax = sel_p.plot(xlabel="polynomial order m", ylabel="Sr_PF (rad/s)")
+    w.figure(
+        ax.figure, "fig31-sr-pf", "Figure 31: Sr_PF (eq. 32) on held-out soak data vs order (thesis chose 2)."
+    )
     w.data["sr_pf"] = {"orders": sel_p.candidates, "sr": sel_p.sr.tolist(), "chosen": sel_p.chosen}
 
     # Figure 32: BPNN structure selection.
@@ -238,13 +132,10 @@ def build(w: SectionWriter) -> None:
     sel_n = select_hidden_neurons(
         temp, bias, candidates=cands, restarts=1 if quick else 2, max_samples=ms, seed=w.seed
     )
-    fig, ax = new_figure()
-    ax.semilogy(sel_n.candidates, sel_n.sr, "o-")
-    ax.axvline(sel_n.chosen, color="C1", ls="--", label=f"chosen: {sel_n.chosen}")
-    ax.set_xlabel("neurons per hidden layer n")
-    ax.set_ylabel("Sr_NN (rad/s)")
-    ax.legend()
-    w.figure(fig, "fig32-sr-nn", "Figure 32: Sr_NN (eq. 33) vs neurons per hidden layer (thesis chose 2-2).")
+    ax = sel_n.plot(xlabel="neurons per hidden layer n", ylabel="Sr_NN (rad/s)")
+    w.figure(
+        ax.figure, "fig32-sr-nn", "Figure 32: Sr_NN (eq. 33) vs neurons per hidden layer (thesis chose 2-2)."
+    )
     w.data["sr_nn"] = {"neurons": sel_n.candidates, "sr": sel_n.sr.tolist(), "chosen": sel_n.chosen}
 
     # Figure 33: structure.
@@ -400,11 +291,8 @@ def build(w: SectionWriter) -> None:
     sel_d = select_hidden_neurons(
         temp, bias, candidates=cands_d, restarts=1 if quick else 2, derivative=True, seed=w.seed
     )
-    fig, ax = new_figure()
-    ax.semilogy(sel_d.candidates, sel_d.sr, "o-")
-    ax.set_xlabel("neurons per hidden layer n")
-    ax.set_ylabel("Sr_TCZUPT (rad/s/°C)")
-    w.figure(fig, "fig37-sr-tczupt", "Figure 37: Sr_TCZUPT (eq. 37) of the derivative network vs n.")
+    ax = sel_d.plot(xlabel="neurons per hidden layer n", ylabel="Sr_TCZUPT (rad/s/°C)")
+    w.figure(ax.figure, "fig37-sr-tczupt", "Figure 37: Sr_TCZUPT (eq. 37) of the derivative network vs n.")
     w.data["sr_tczupt"] = {"neurons": sel_d.candidates, "sr": sel_d.sr.tolist(), "chosen": sel_d.chosen}
 
     # Hysteresis-aware fit on the ramp (both branches).

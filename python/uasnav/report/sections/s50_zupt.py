@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from uasnav.report import Section, SectionWriter
+
+if TYPE_CHECKING:
+    from uasnav.zupt import Mode
 
 # Thesis Table 9 (rad/s): mean residual of the moving-average reference, calibrated / raw.
 TABLE9 = {"x": (1.68e-6, 9.53e-6), "y": (2.98e-6, 6.80e-6), "z": (3.43e-6, 1.03e-5)}
@@ -27,20 +30,44 @@ TABLE13 = {
     "tczupt": {"x": (3.81e-5, 0.54e-5), "y": (4.58e-5, 0.84e-5), "z": (3.36e-5, 0.35e-5)},
 }
 AXES = "xyz"
-STANDIN_NOTE = (
-    "Data: the simulator and thermal-model issues had not landed when this section was "
-    "written, so the evaluation uses a small STAND-IN generator (`uasnav._zupt_standin`): an "
-    "AX1-like static unit with the thesis' CRS05-02 noise (σ_ARW = 3.18 deg/√h), MS8010 "
-    "accelerometer noise, a quadratic thermal gyro bias (≈ 2–3e-5 rad/s/°C), the thesis' "
-    "ramp test (27.3 ↔ 34.1 °C at 2 °C/min, die lag 20 s, 0.0625 °C sensor resolution) and "
-    "a cubic calibration fitted on a stand-in soak (−20.5 … 37.3 °C, heating branch). Its "
-    "truth is exact, so we show errors against the true bias beside the thesis' "
-    "moving-average reference."
-)
+MODES: tuple[Mode, ...] = ("zupt", "tczupt")
+PRESET = "ax1"
+#: Attitude of the static unit (roll, pitch, yaw; rad) and its true heading.
+EULER = (0.012, -0.021, 0.4)
+
+
+def _sensor(hysteresis: bool) -> Any:
+    """The simulator's AX1 (CRS05-02 gyros), optionally without its thermal hysteresis."""
+    import dataclasses
+
+    from uasnav import sim
+
+    m = sim.load_preset(PRESET)
+    if hysteresis or m.gyro.thermal is None:
+        return m
+    th = dataclasses.replace(m.gyro.thermal, hysteresis=0.0)
+    return dataclasses.replace(m, gyro=dataclasses.replace(m.gyro, thermal=th))
+
+
+def _calibration(sensor: Any, seed: int, quick: bool) -> Any:
+    """The thesis' BPNN (two hidden layers of two neurons, plus the derivative networks of
+    eq. 37) fitted on a simulated soak test of the same sensor type (another seed)."""
+    from uasnav.sim.lab import soak_calibration_data
+    from uasnav.thermal import NeuralBiasModel
+
+    cal = soak_calibration_data(sensor, seed=seed, rate=1.0 if quick else 10.0)
+    return NeuralBiasModel(2, restarts=2 if quick else 4, derivative_network=True, seed=seed).fit(
+        cal.temp, cal.gyro_bias
+    )
+
+
+def _ramp_log(sensor: Any, duration: float, seed: int) -> Any:
+    from uasnav import sim
+
+    return sim.simulate(sensor, profile="cycles", duration=duration, seed=seed, euler_rad=EULER)
 
 
 def build(w: SectionWriter) -> None:
-    from uasnav import _zupt_standin as standin
     from uasnav import zupt
     from uasnav.plotting import new_figure
 
@@ -56,11 +83,23 @@ def build(w: SectionWriter) -> None:
         "second, Joseph form; 60 s coarse levelling and zeroing. TCZUPT propagates the bias "
         "with (∂b/∂T)·(dT/dt)·Ts (eq. 31), dT/dt from a 30 s sliding least-squares slope."
     )
-    w.p(STANDIN_NOTE)
+    w.p(
+        f"Data: the simulator's `{PRESET}` preset (CRS05-02 gyros, σ_ARW = 3.18 deg/√h, 30 Hz "
+        "anti-alias filter, thermal curve with a heating/cooling hysteresis of 0.03 deg/s, 90 s "
+        "die lag), static at roll 0.012, pitch −0.021, heading 0.4 rad, 45° N, in the `cycles` "
+        "profile: 60 s at 27.28 °C for the zeroing, then the thesis' ramp test (27.28 ↔ 34.08 °C "
+        f"at 2 °C/min) repeated with 5-min dwells, {duration:g} s in all. Calibration model: the "
+        "thesis' BPNN (2 × 2 hidden neurons, Levenberg–Marquardt) fitted on a simulated soak "
+        "test (−20.5 … 37.3 °C, heating only, 60 s means) of the same sensor type with another "
+        "seed; ZUPT takes the gyro calibrated by it, TCZUPT the raw gyro and its analytic "
+        "derivative. The simulator's truth is exact, so we report errors against the true bias "
+        "beside the thesis' moving-average reference."
+    )
     w.progress("simulating the ramp test")
-    log = standin.static_log(duration, seed=w.seed)
-    model = standin.soak_calibration(seed=w.seed + 1)
-    heading = 0.4  # the stand-in's true heading (an external input in the thesis)
+    sensor = _sensor(True)
+    log = _ramp_log(sensor, duration, w.seed)
+    model = _calibration(sensor, w.seed + 1, quick)
+    heading = EULER[2]  # the unit's true heading (an external input in the thesis)
     truth_raw = log.truth["gyro_bias"]
     truth_cal = truth_raw - model.predict(log.temp)
     base = zupt.ZuptConfig(decimation=dec, heading_rad=heading)
@@ -69,12 +108,12 @@ def build(w: SectionWriter) -> None:
     from scipy.signal import butter, sosfiltfilt
 
     sos = butter(2, 1.0, fs=log.sample_rate, output="sos")
-    for name, data, fig_no in (
+    for name, series, fig_no in (
         ("calibrated", log.gyro - model.predict(log.temp), 38),
         ("raw", log.gyro, 39),
     ):
         fig, ax = new_figure(7.0, 4.0)
-        lp = sosfiltfilt(sos, data, axis=0)
+        lp = sosfiltfilt(sos, series, axis=0)
         for j in range(3):
             ax.plot(log.t[::dec], lp[::dec, j], lw=0.8, label=f"ω{AXES[j]}")
         ax2 = ax.twinx()
@@ -98,13 +137,11 @@ def build(w: SectionWriter) -> None:
         runs[scen] = {
             "zupt": zupt.run(log, "zupt", model, cfg),
             "tczupt": zupt.run(log, "tczupt", model, cfg),
-            # Ablation: TCZUPT with the standard σ_GBI, to separate eq. 31 from the larger Q.
-            "tczupt_sgbi": zupt.run(log, "tczupt", model, cfg.replace(noise=zupt.THESIS_ZUPT_NOISE)),
         }
     q0 = runs["nominal"]["zupt"].initial_attitude
     ref_cal = zupt.moving_average_reference(log, q0, model=model)
     ref_raw = zupt.moving_average_reference(log, q0)
-    refs = {"zupt": (ref_cal, truth_cal), "tczupt": (ref_raw, truth_raw), "tczupt_sgbi": (ref_raw, truth_raw)}
+    refs = {"zupt": (ref_cal, truth_cal), "tczupt": (ref_raw, truth_raw)}
 
     # Table 9.
     res_cal = zupt.reference_residual(log, ref_cal, q0, model=model)
@@ -156,7 +193,7 @@ def build(w: SectionWriter) -> None:
     for scen in ("nominal", "residual"):
         for j, a in enumerate(AXES):
             row: list[Any] = [scen, a]
-            for mode in ("zupt", "tczupt"):
+            for mode in MODES:
                 r = runs[scen][mode]
                 rms_ma = zupt.rms_error(r.gyro_bias, refs[mode][0][::dec])[j]
                 rms_tr = zupt.rms_error(r.gyro_bias, refs[mode][1][::dec])[j]
@@ -186,27 +223,23 @@ def build(w: SectionWriter) -> None:
     # σ_ARW/√60 s ≈ 1.2e-4 rad/s per axis, larger than 15 deg/h), and from the exact initial
     # bias + 15 deg/h (zeroing off), which isolates the scenario.
     exact = {}
-    for mode in ("zupt", "tczupt", "tczupt_sgbi"):
-        tru0 = (truth_cal if mode == "zupt" else truth_raw)[0]
+    for mode in MODES:
+        tru0 = refs[mode][1][0]
         cfg = base.replace(
             zeroing=False,
             gyro_bias0_rad_s=tuple(float(v) for v in tru0),
             residual_gyro_bias_rad_s=zupt.RESIDUAL_BIAS_15DEG_H,
         )
-        if mode == "tczupt_sgbi":
-            cfg = cfg.replace(noise=zupt.THESIS_ZUPT_NOISE)
-        exact[mode] = zupt.run(log, "zupt" if mode == "zupt" else "tczupt", model, cfg)
+        exact[mode] = zupt.run(log, mode, model, cfg)
     rows = []
     for j, a in enumerate(AXES):
-        row: list[Any] = [a]
-        for mode in ("zupt", "tczupt", "tczupt_sgbi"):
+        row = [a]
+        for mode in MODES:
             tru = refs[mode][1][::dec]
             r = runs["residual"][mode]
             ct = zupt.convergence_time(r.t, r.gyro_bias, tru)[j]
             ce = zupt.convergence_time(exact[mode].t, exact[mode].gyro_bias, tru)[j]
-            if mode != "tczupt_sgbi":
-                row.append(TABLE11[a][0 if mode == "zupt" else 1])
-            row += [_fmt_t(ct), _fmt_t(ce)]
+            row += [TABLE11[a][0 if mode == "zupt" else 1], _fmt_t(ct), _fmt_t(ce)]
             data["table11"].setdefault(mode, {})[a] = {"after_zeroing": ct, "exact_start": ce}
         rows.append(tuple(row))
     w.table(
@@ -218,27 +251,25 @@ def build(w: SectionWriter) -> None:
             "TCZUPT thesis (s)",
             "TCZUPT zeroed",
             "TCZUPT exact+15°/h",
-            "TCZUPT σ_GBI zeroed",
-            "TCZUPT σ_GBI exact+15°/h",
         ],
         rows,
         caption="Table 11: convergence time (first |error vs true bias| < 1e-5 rad/s), residual "
         "15 deg/h. 'zeroed': start after the 60 s zeroing + 15 deg/h; 'exact+15°/h': start at the "
-        "true bias + 15 deg/h. 'TCZUPT σ_GBI': ablation with the standard-ZUPT σ_GBI. Against "
-        "the moving average (noise 1.7e-4 rad/s) a 1e-5 threshold is met only by chance.",
+        "true bias + 15 deg/h. Against the moving average (noise 1.7e-4 rad/s) a 1e-5 threshold "
+        "is met only by chance.",
     )
 
     # Tables 12–13: five consecutive segments.
     w.progress("segment statistics")
+    skip = int(60 * log.sample_rate)
+    piece_log = log.slice(skip, log.n)
     for tab_no, scen, thesis in ((12, "nominal", TABLE12), (13, "residual", TABLE13)):
         resid = 0.0 if scen == "nominal" else zupt.RESIDUAL_BIAS_15DEG_H
         cfg = base.replace(residual_gyro_bias_rad_s=resid, decimation=10)
         rows = []
-        for mode in ("zupt", "tczupt"):
-            truth = truth_cal if mode == "zupt" else truth_raw
-            piece_log = log.slice(int(60 * log.sample_rate), log.n)
+        for mode in MODES:
             _, mean, std = zupt.segment_rms(
-                piece_log, mode, truth[int(60 * log.sample_rate) :], model=model, config=cfg, segment_s=seg_s
+                piece_log, mode, refs[mode][1][skip:], model=model, config=cfg, segment_s=seg_s
             )
             for j, a in enumerate(AXES):
                 rows.append((mode.upper(), a, thesis[mode][a][0], mean[j], thesis[mode][a][1], std[j]))
@@ -252,36 +283,88 @@ def build(w: SectionWriter) -> None:
             fmt="{:.2e}",
         )
 
-    # NEES consistency (beyond the thesis): Monte Carlo over seeds.
-    w.progress("NEES Monte Carlo")
-    n_mc = 3 if quick else 8
-    nees_rows = []
-    for mode in ("zupt", "tczupt"):
-        acc = []
+    # What makes the difference: Monte Carlo over seeds, with and without hysteresis, and
+    # ablations that separate eq. 31 from TCZUPT's larger σ'_GBI.
+    w.progress("Monte Carlo: hysteresis and ablations")
+    n_mc = 2 if quick else 6
+    variants: dict[str, tuple[Mode, dict[str, Any]]] = {
+        "ZUPT (σ_GBI, Table 3)": ("zupt", {}),
+        "ZUPT with σ'_GBI": ("zupt", {"noise": zupt.THESIS_TCZUPT_NOISE}),
+        "TCZUPT (σ'_GBI, Table 5)": ("tczupt", {}),
+        "TCZUPT, derivative network": ("tczupt", {"derivative": "network"}),
+        "TCZUPT with σ_GBI": ("tczupt", {"noise": zupt.THESIS_ZUPT_NOISE}),
+    }
+    mc: dict[str, dict[str, list[Any]]] = {}
+    mc_rows = []
+    for hyst in (True, False):
+        sens = _sensor(hyst)
+        key = "with hysteresis" if hyst else "without hysteresis"
+        acc: dict[str, list[Any]] = {v: [] for v in variants}
+        acc["nees_zupt"], acc["nees_tczupt"] = [], []
         for s in range(n_mc):
-            lg = standin.static_log(duration, seed=1000 + s)
-            md = standin.soak_calibration(seed=2000 + s)
-            r = zupt.run(lg, mode, md, base)
-            tru = (lg.truth["gyro_bias"] - (md.predict(lg.temp) if mode == "zupt" else 0.0))[::dec]
-            acc.append(r.nees(tru))
-        nees = np.mean(np.array(acc), axis=0)  # average over runs at each time
-        from scipy.stats import chi2
-
-        lo, hi = chi2.ppf([0.005, 0.995], 3 * n_mc) / n_mc
-        inside = float(np.mean((nees >= lo) & (nees <= hi)))
-        nees_rows.append((mode.upper(), n_mc, float(np.mean(nees)), lo, hi, inside * 100))
-        data.setdefault("nees", {})[mode] = {
-            "mean": float(np.mean(nees)),
-            "lo": lo,
-            "hi": hi,
-            "inside_pct": inside * 100,
-        }
+            lg = log if (hyst and s == 0) else _ramp_log(sens, duration, w.seed + 1000 + s)
+            md = model if (hyst and s == 0) else _calibration(sens, w.seed + 2000 + s, quick)
+            tr_raw = lg.truth["gyro_bias"][::dec]
+            tr_cal = (lg.truth["gyro_bias"] - md.predict(lg.temp))[::dec]
+            cfg0 = base.replace(residual_gyro_bias_rad_s=zupt.RESIDUAL_BIAS_15DEG_H)
+            for v, (mode, change) in variants.items():
+                r = zupt.run(lg, mode, md, cfg0.replace(**change))
+                tru = tr_cal if mode == "zupt" else tr_raw
+                acc[v].append(zupt.rms_error(r.gyro_bias, tru))
+                if not change:
+                    acc[f"nees_{mode}"].append(r.nees(tru))
+        mc[key] = acc
+        for v in variants:
+            m = np.mean(acc[v], axis=0)
+            mc_rows.append((key, v, *m, float(np.mean(m))))
+            data.setdefault("monte_carlo", {}).setdefault(key, {})[v] = m.tolist()
     w.table(
-        ["filter", "runs", "mean NEES (3 dof)", "99 % lower", "99 % upper", "% of time inside"],
+        ["data", "filter", "RMS x", "RMS y", "RMS z", "mean"],
+        mc_rows,
+        caption=f"Whole-run RMS error vs truth (rad/s), residual 15 deg/h, mean over {n_mc} "
+        "simulated units (own seeds and calibrations). σ_GBI = 1.5e-4 deg/s (Table 3), "
+        "σ'_GBI = 5e-4 deg/s (Table 5).",
+        fmt="{:.2e}",
+    )
+
+    # NEES consistency (beyond the thesis).
+    from scipy.stats import chi2
+
+    lo, hi = chi2.ppf([0.005, 0.995], 3 * n_mc) / n_mc
+    nees_rows = []
+    for key, acc in mc.items():
+        for mode in MODES:
+            nees = np.mean(np.array(acc[f"nees_{mode}"]), axis=0)  # average over runs per time
+            inside = float(np.mean((nees >= lo) & (nees <= hi))) * 100
+            nees_rows.append((key, mode.upper(), n_mc, float(np.mean(nees)), lo, hi, inside))
+            data.setdefault("nees", {}).setdefault(key, {})[mode] = {
+                "mean": float(np.mean(nees)),
+                "lo": float(lo),
+                "hi": float(hi),
+                "inside_pct": inside,
+            }
+    w.table(
+        ["data", "filter", "runs", "mean NEES (3 dof)", "99 % lower", "99 % upper", "% of time inside"],
         nees_rows,
-        caption="Gyro-bias NEES averaged over Monte-Carlo runs against its χ² bounds "
-        "(consistent: mean ≈ 3, ~99 % inside).",
+        caption="Gyro-bias NEES averaged over the Monte-Carlo runs against its χ² bounds "
+        "(consistent: mean ≈ 3, ~99 % inside; above: over-confident).",
         fmt="{:.3g}",
+    )
+
+    def verdict_nees(key: str, mode: str) -> str:
+        d = data["nees"][key][mode]
+        word = "consistent" if d["lo"] <= d["mean"] <= d["hi"] else "over-confident"
+        return f"{mode.upper()} {word} (mean {d['mean']:.2g})"
+
+    w.p(
+        "Consistency: a filter whose σ_GBI covers the bias changes it meets has a mean NEES "
+        f"near 3. Without hysteresis: {verdict_nees('without hysteresis', 'zupt')}, "
+        f"{verdict_nees('without hysteresis', 'tczupt')}; with hysteresis: "
+        f"{verdict_nees('with hysteresis', 'zupt')}, {verdict_nees('with hysteresis', 'tczupt')}. "
+        "Table 3's σ_GBI does not cover the drift of the BPNN calibration residual along the "
+        "temperature ramps, and the branch step after a reversal is outside both models: Q "
+        "should be set from the calibration residual and the hysteresis width, not from the "
+        "Allan bias instability alone."
     )
 
     # Claim check, from the numbers above.
@@ -289,89 +372,93 @@ def build(w: SectionWriter) -> None:
     for a in AXES:
         tz_, tt_ = data["table11"]["zupt"][a]["exact_start"], data["table11"]["tczupt"][a]["exact_start"]
         faster += int(tt_ is not None and (tz_ is None or tt_ < tz_))
-    rms = {
-        m: np.array([zupt.rms_error(runs["residual"][m].gyro_bias, refs[m][1][::dec])[j] for j in range(3)])
-        for m in ("zupt", "tczupt", "tczupt_sgbi")
-    }
-    not_worse = int(np.sum(rms["tczupt"] <= 1.1 * rms["zupt"]))
-    ratio = float(np.mean(rms["tczupt"] / rms["zupt"]))
-    ratio_abl = float(np.mean(rms["tczupt_sgbi"] / rms["zupt"]))
-    verdict = "confirmed" if faster >= 2 and not_worse >= 2 else "not confirmed"
+    mean_rms = {k: {v: float(np.mean(acc[v])) for v in variants} for k, acc in mc.items()}
+    hy, nh = mean_rms["with hysteresis"], mean_rms["without hysteresis"]
+    ratio_h = hy["TCZUPT (σ'_GBI, Table 5)"] / hy["ZUPT (σ_GBI, Table 3)"]
+    ratio_n = nh["TCZUPT (σ'_GBI, Table 5)"] / nh["ZUPT (σ_GBI, Table 3)"]
+    not_worse = ratio_h <= 1.1
+    verdict = "confirmed" if faster >= 2 and not_worse else "not confirmed"
     data["claim"] = {
         "tczupt_faster_axes_exact_start": faster,
-        "tczupt_not_worse_rms_axes": not_worse,
-        "mean_rms_ratio_tczupt_over_zupt": ratio,
-        "mean_rms_ratio_tczupt_standard_sgbi_over_zupt": ratio_abl,
+        "rms_ratio_tczupt_over_zupt_with_hysteresis": ratio_h,
+        "rms_ratio_tczupt_over_zupt_without_hysteresis": ratio_n,
+        "rms_ratio_zupt_sgbi_prime_over_tczupt_with_hysteresis": hy["ZUPT with σ'_GBI"]
+        / hy["TCZUPT (σ'_GBI, Table 5)"],
+        "rms_ratio_tczupt_sgbi_over_zupt_with_hysteresis": hy["TCZUPT with σ_GBI"]
+        / hy["ZUPT (σ_GBI, Table 3)"],
         "verdict": verdict,
     }
+    c = data["claim"]
     w.p(
         "Thesis claim — TCZUPT converges faster in the 15 deg/h scenario and is not worse in "
-        f"RMS over the whole run: {verdict.upper()} on our data. From the exact start + 15 deg/h, "
-        f"TCZUPT converged first on {faster}/3 axes; its whole-run RMS error vs truth is within "
-        f"10 % of ZUPT's on {not_worse}/3 axes (mean ratio TCZUPT/ZUPT {ratio:.2f}; with the "
-        f"standard σ_GBI instead of Table 5's σ'_GBI the ratio is {ratio_abl:.2f}). Analysis: both "
-        "filters have the same bias observability (the frozen-attitude measurement observes ψ "
-        "directly, so the bias estimate is a P-weighted average of the gyro output minus the "
-        "propagated drift). TCZUPT's larger σ'_GBI keeps its gain higher: faster reaction, but "
-        "more of the σ_ARW white noise passes into the estimate, which raises the RMS. Eq. 31 "
-        "moves the estimate along ∂b/∂T·dT/dt between updates, so on raw data it tracks the "
-        "thermal drift that ZUPT only sees after calibration; with an accurate calibration (as "
-        "here) ZUPT on calibrated data has no drift left to track, and the smaller σ_GBI wins. "
-        "The thesis' advantage may come from a calibration residual larger than in this "
-        "stand-in, or from a different noise/zeroing set-up; we cannot reproduce it. Note on "
-        "Table 11's metric: with σ_ARW = 3.18 deg/√h the 1σ of any bias estimate after t s of "
-        "data is ≈ σ_ARW/√t, above 1e-5 rad/s until t ≈ 8 500 s, so the first crossing of "
-        "1e-5 rad/s is a chance event of the noise (here within seconds to minutes, equal for "
-        "both filters), not a convergence time in the sense of the error staying below it."
+        f"RMS over the whole run: {verdict.upper()} on the simulated AX1. From the exact start + "
+        f"15 deg/h TCZUPT reached 1e-5 rad/s first on {faster}/3 axes; over the Monte Carlo its "
+        f"whole-run RMS error is {ratio_h:.2f}× ZUPT's with the preset's hysteresis and "
+        f"{ratio_n:.2f}× without it. The ablations say why: ZUPT given TCZUPT's larger σ'_GBI "
+        f"scores {c['rms_ratio_zupt_sgbi_prime_over_tczupt_with_hysteresis']:.2f}× TCZUPT, and "
+        f"TCZUPT given the standard σ_GBI scores {c['rms_ratio_tczupt_sgbi_over_zupt_with_hysteresis']:.2f}× "
+        "ZUPT — the difference comes from the process noise, not from eq. (31). With a "
+        "calibration model and its own derivative, propagating the bias by (∂b/∂T)·(dT/dt)·Ts "
+        "does what subtracting the model does; what remains for the filter is the part no "
+        "fixed curve holds: the hysteresis step at every temperature reversal (0.03 deg/s between "
+        "the branches here) and the calibration error. A larger σ_GBI follows those steps faster and pays "
+        "with more white noise in the estimate when there is nothing to follow (the "
+        "no-hysteresis rows). The thesis' preference for TCZUPT thus holds for a gyro with "
+        "hysteresis (its own argument, §4.2.3), but the same gain is available to ZUPT by "
+        "tuning Q. Note on Table 11's metric: with σ_ARW = 3.18 deg/√h the 1σ of any bias "
+        "estimate after t s of data is ≈ σ_ARW/√t, above 1e-5 rad/s until t ≈ 8 500 s, so the "
+        "first crossing of 1e-5 rad/s is partly a chance event of the noise."
     )
 
-    # Hysteresis study.
+    # Hysteresis study, per branch (the thesis' first future development).
     w.progress("hysteresis study")
-    h = 4e-5
-    hlog = standin.static_log(duration, seed=w.seed + 7, hysteresis_rad_s=h)
-    hmodel = standin.soak_calibration(seed=w.seed + 8, hysteresis_rad_s=h)  # heating-branch reference
-    hz = zupt.run(hlog, "zupt", hmodel, base)
-    ht = zupt.run(hlog, "tczupt", hmodel, base)
-    dtemp = np.gradient(hlog.truth["temp_die"], 1.0 / hlog.sample_rate)[::dec]
-    heating, cooling = dtemp > 1e-3, dtemp < -1e-3
-    tz = (hlog.truth["gyro_bias"] - hmodel.predict(hlog.temp))[::dec]
-    tt = hlog.truth["gyro_bias"][::dec]
+    from uasnav.thermal import branch_from_temperature
+
+    heating = branch_from_temperature(log.t, log.truth["temp_die"])[::dec]
+    rz, rt = runs["nominal"]["zupt"], runs["nominal"]["tczupt"]
+    tz, tt = truth_cal[::dec], truth_raw[::dec]
+    settled = rz.t > 60.0
     hrows = []
-    for label, mask in (("heating", heating), ("cooling", cooling)):
-        ez = zupt.rms_error(hz.gyro_bias[mask], tz[mask])
-        et = zupt.rms_error(ht.gyro_bias[mask], tt[mask])
-        cal_off = np.mean(tz[mask], axis=0) - np.mean(tz[heating], axis=0)
-        hrows.append((label, *ez, *et, float(np.linalg.norm(cal_off))))
+    for label, mask in (("heating", heating & settled), ("cooling", ~heating & settled)):
+        if not mask.any():
+            w.p(f"(No {label} branch in this {duration:g} s run: the first reversal comes later.)")
+            continue
+        ez = zupt.rms_error(rz.gyro_bias[mask], tz[mask])
+        et = zupt.rms_error(rt.gyro_bias[mask], tt[mask])
+        off = np.mean(tz[mask], axis=0) - np.mean(tz[heating & settled], axis=0)
+        hrows.append((label, *ez, *et, float(np.linalg.norm(off))))
         data.setdefault("hysteresis", {})[label] = {"zupt_rms": ez.tolist(), "tczupt_rms": et.tolist()}
     w.table(
         ["branch", "ZUPT x", "ZUPT y", "ZUPT z", "TCZUPT x", "TCZUPT y", "TCZUPT z", "|calibration offset|"],
         hrows,
-        caption=f"Hysteresis (bias +{h:.0e} rad/s heating, −{h:.0e} cooling; calibration on the "
-        "heating branch): RMS error vs truth (rad/s) per branch.",
+        caption="Hysteresis (calibration on the heating branch): RMS error vs truth (rad/s) per "
+        "branch, nominal run; the last column is the mean calibrated-bias shift on the branch "
+        "relative to the heating branch.",
         fmt="{:.2e}",
     )
     fig, ax = new_figure(7.0, 4.0)
-    hz.plot_bias(0, ax=ax, reference=tz, reference_label="true residual (ZUPT)", label="ZUPT", sigma=False)
-    ht.plot_bias(0, ax=ax, reference=tt, reference_label="true bias (TCZUPT)", label="TCZUPT", sigma=False)
+    rz.plot_bias(0, ax=ax, reference=tz, reference_label="true residual (ZUPT)", label="ZUPT", sigma=False)
+    rt.plot_bias(0, ax=ax, reference=tt, reference_label="true bias (TCZUPT)", label="TCZUPT", sigma=False)
     w.figure(
         fig,
         "hysteresis_x",
-        "Hysteresis study, x axis: the fixed-reference calibration leaves a −2h offset on the "
-        "cooling branch for ZUPT to absorb.",
+        "Hysteresis study, x axis: the fixed-reference calibration leaves an offset on the "
+        "cooling branch for ZUPT to absorb; TCZUPT must follow the same step in the raw bias.",
     )
     w.p(
-        "With hysteresis the fixed calibration curve is right on one branch only: the ZUPT "
-        "filter on calibrated data must absorb a 2h step every time the temperature turns. "
-        "TCZUPT uses only the slope ∂b/∂T, equal on both branches in this model, so its "
-        "propagation is right on both; the step at the turn itself is still left to the "
-        "stochastic bias model in both filters."
+        "With hysteresis the fixed calibration curve is right on one branch only: ZUPT on "
+        "calibrated data must absorb the step at every reversal. TCZUPT uses only the slope "
+        "∂b/∂T, equal on both branches, so its propagation is right on both branches, but the "
+        "step itself happens within ~0.5 °C of travel after a reversal, where no derivative of "
+        "a single-valued curve sees it: both filters meet it as an unmodelled bias change, and "
+        "the one with the larger σ_GBI follows it sooner (table above)."
     )
 
     w.p(
         "Real data (not read by the report, which runs on simulated data only): the test "
         "suite runs ZUPT on the 2.78 h ADIS16405 static recording and checks that the "
         "estimated turn-on gyro bias agrees with the long-term mean output minus the Earth "
-        "rate (tests/test_zupt.py)."
+        "rate, and detects the x-IMU log's rest periods automatically (tests/test_zupt.py)."
     )
     w.data.update(data)
 
