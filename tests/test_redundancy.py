@@ -287,6 +287,35 @@ def test_cli_kr_and_fuse(tmp_path, cube6) -> None:
     np.testing.assert_allclose(fused.gyro, (g3 * w[:, None, :]).sum(0) / w.sum(0), rtol=1e-9, atol=1e-15)
 
 
+def test_cli_simulate_every_polyhedron_fuses_in_glob_order(tmp_path) -> None:
+    # 20 sensors: zero-padded file names keep a sorted glob in sensor order, and the face
+    # order is the one `redundancy fuse --shape icosahedron` assumes.
+    out = tmp_path / "ico.npz"
+    r = CliRunner().invoke(
+        main,
+        [
+            "simulate",
+            "--preset",
+            "lsm6dsm",
+            "--sensors",
+            "icosahedron20",
+            "--duration",
+            "2",
+            "--out",
+            str(out),
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    files = sorted(tmp_path.glob("ico_s*.npz"))
+    assert [f.name for f in files[:3]] == ["ico_s00.npz", "ico_s01.npz", "ico_s02.npz"] and len(files) == 20
+    from uasnav.io import read_log
+
+    mounts = np.array([read_log(f).meta["mounting"] for f in files], dtype=float)
+    np.testing.assert_allclose(
+        mounts, R.configuration("icosahedron", 1, triaxial=True).mountings(), atol=1e-15
+    )
+
+
 def test_ardupilot_three_imus(shared_data) -> None:
     from uasnav.redundancy_ardupilot import analyse_log
 

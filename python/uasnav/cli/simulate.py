@@ -9,13 +9,23 @@ import click
 
 from uasnav.cli._common import echo_json
 
-_SENSORS = {"single": None, "cube6": ("cube", 1), "planar6": ("planar", 6)}
+_SENSORS = {
+    "single": None,
+    "tetrahedron4": ("tetrahedron", 1),
+    "cube6": ("cube", 1),
+    "octahedron8": ("octahedron", 1),
+    "dodecahedron12": ("dodecahedron", 1),
+    "icosahedron20": ("icosahedron", 1),
+    "planar6": ("planar", 6),
+}
 
 
 def _outputs(out: Path, count: int) -> list[Path]:
     if count == 1:
         return [out]
-    return [out.with_name(f"{out.stem}_s{i}{out.suffix}") for i in range(count)]
+    # zero-padded so that a shell glob (OUT_s*.csv) lists the sensors in order
+    width = len(str(count - 1))
+    return [out.with_name(f"{out.stem}_s{i:0{width}d}{out.suffix}") for i in range(count)]
 
 
 @click.command("simulate")
@@ -41,8 +51,9 @@ def _outputs(out: Path, count: int) -> list[Path]:
     type=click.Choice(sorted(_SENSORS)),
     default="single",
     show_default=True,
-    help="cube6: six sensors on the faces of a cube; planar6: six aligned sensors. "
-    "Multi-sensor runs write one file per sensor: OUT_s0.ext … OUT_s5.ext.",
+    help="cube6: six sensors on the faces of a cube (likewise one per face of the other "
+    "Platonic solids, in the face order of `uasnav redundancy fuse --shape`); planar6: six "
+    "aligned sensors. Multi-sensor runs write one file per sensor: OUT_s0.ext, OUT_s1.ext, ….",
 )
 @click.option(
     "--table-rate",
