@@ -363,6 +363,22 @@ def test_tczupt_cli_with_a_model_file_and_the_derivative_network(tmp_path):
 
     cfg = zupt.ZuptConfig(derivative="network", decimation=50)
     via_option = zupt.run(log, "tczupt", nn, cfg)
+    r = CliRunner().invoke(
+        main,
+        ["zupt", str(lpath), "--mode", "tczupt", "--model", str(mpath), "--heading-deg", "22.918",
+         "--derivative", "network", "--json"],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    via_cli = json.loads(r.output)
+    assert via_cli["derivative"] == "network"
+    np.testing.assert_allclose(
+        via_cli["gyro_bias_rad_s"],
+        zupt.run(
+            log, "tczupt", nn, zupt.ZuptConfig(heading_rad=np.deg2rad(22.918), derivative="network")
+        ).gyro_bias[-1],
+        rtol=1e-9,
+    )
+    assert not np.allclose(via_cli["gyro_bias_rad_s"], out["gyro_bias_rad_s"], rtol=1e-9, atol=0)
     via_wrapper = zupt.run(log, "tczupt", NetworkDerivative(), cfg.replace(derivative="analytic"))
     np.testing.assert_array_equal(via_option.gyro_bias, via_wrapper.gyro_bias)
     assert not np.array_equal(

@@ -42,6 +42,13 @@ def load_model(path: str) -> object:
     help="Thermal model JSON (required for tczupt; for zupt it calibrates the gyro first).",
 )
 @click.option(
+    "--derivative",
+    type=click.Choice(["analytic", "network"]),
+    default="analytic",
+    show_default=True,
+    help="TCZUPT's ∂b/∂T: the model's analytic derivative, or its derivative network (eq. 37).",
+)
+@click.option(
     "--residual-bias",
     default="0 rad/s",
     show_default=True,
@@ -57,6 +64,7 @@ def command(
     log: str,
     mode: str,
     model_path: str | None,
+    derivative: str,
     residual_bias: str,
     latitude_deg: float,
     heading_deg: float,
@@ -87,6 +95,7 @@ def command(
         heading_rad=math.radians(heading_deg),
         levelling_s=levelling_s,
         residual_gyro_bias_rad_s=resid,
+        derivative=derivative,
     )
     res = zupt.run(data, mode, model, cfg)  # type: ignore[arg-type]
     if out_path:
@@ -96,6 +105,7 @@ def command(
     summary = {
         "log": log,
         "mode": mode,
+        "derivative": derivative,
         "n_samples": data.n,
         "rate_hz": res.meta["rate_hz"],
         "updates": res.updates,
