@@ -34,8 +34,8 @@ rust-checks:
 	cargo bench --workspace --no-run
 
 py-checks: setup
-	$(BIN)/ruff check python tests benches
-	$(BIN)/ruff format --check python tests benches
+	$(BIN)/ruff check python tests benches scripts
+	$(BIN)/ruff format --check python tests benches scripts
 	$(BIN)/python -m mypy.stubtest uasnav._core
 	$(BIN)/python -m pytest -q
 

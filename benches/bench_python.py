@@ -175,7 +175,7 @@ def bench_redundancy_ardupilot(repeat: int) -> None:
     import os
     from pathlib import Path
 
-    from uasnav.redundancy_ardupilot import analyse_log
+    from uasnav.experiments.ardupilot import analyse_log
 
     root = Path(
         os.environ.get("UASNAV_SHARED_DATA", Path(__file__).resolve().parents[1] / ".." / "shared" / "data")

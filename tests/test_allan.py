@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 
 from uasnav.allan import cluster_sizes, oadev
 from uasnav.errors import InputError, UnitError
+from uasnav.experiments.allan import NIST_OADEV, nbs14_series
 from uasnav.noise import FilterNoise, identify
-from uasnav.report.sections.s10_allan import NIST_OADEV, nbs14_series
 from uasnav.units import convert
 
 
@@ -24,6 +24,22 @@ def test_nist_sp1065_reference_values():
     r = oadev(x, rate=1.0, taus=[1, 10, 100])
     for tau, dev in zip(r.taus, r.adev, strict=True):
         assert dev == pytest.approx(NIST_OADEV[round(tau)], rel=2e-6)
+
+
+def test_allan_experiment_quick():
+    """The Allan chapter's experiment (what ``uasnav report --only allan`` renders)."""
+    from uasnav.experiments import allan as exp
+    from uasnav.experiments.thesis import TABLE3
+
+    res = exp.run(quick=True)
+    assert res.nist.rel_diff.max() < 1e-5
+    np.testing.assert_array_equal(res.nist.taus, [1.0, 10.0, 100.0])
+    g = res.gyro
+    assert g.hours == 0.25 and g.arw_configured_deg_sqrt_h == TABLE3["arw_deg_sqrt_h"] == 3.18
+    # thesis Table 3's ARW recovered from 0.25 h of simulated data, by the fit and at τ = 1 s
+    np.testing.assert_allclose(g.arw_fit_deg_sqrt_h, 3.18, rtol=0.05)
+    np.testing.assert_allclose(g.arw_points_deg_sqrt_h, 3.18, rtol=0.05)
+    assert g.rrw_fit_deg_h_sqrt_h.shape == (3,)
 
 
 @pytest.mark.parametrize("taus", ["octave", "decade", "all"])

@@ -57,6 +57,26 @@ def test_drift_table_reproduces_thesis_table7_scale():
     assert att.delta_t_percent(None, 2.0) is None
 
 
+def test_attitude_experiment_reproduces_tables_7_and_8():
+    """The attitude chapter's experiment (what ``uasnav report --only attitude`` renders)."""
+    from uasnav.experiments import attitude as exp
+    from uasnav.experiments.thesis import TABLE7, TABLE8
+
+    res = exp.run()
+    for tc, ref in ((res.table7, TABLE7), (res.table8, TABLE8)):
+        assert tc.thresholds_rad == tuple(sorted(ref))
+        # the largest threshold defines |ω|, so it is reproduced exactly; the others within 0.3 s
+        assert tc.t_nn_s[-1] == pytest.approx(ref[1.75e-2][0], abs=1e-9)
+        assert tc.t_pf_s[-1] == pytest.approx(ref[1.75e-2][1], abs=1e-9)
+        for th, t_nn, t_pf in zip(tc.thresholds_rad, tc.t_nn_s, tc.t_pf_s, strict=True):
+            assert t_nn == pytest.approx(ref[th][0], abs=0.3)
+            assert t_pf == pytest.approx(ref[th][1], abs=0.3)
+        # constant rates: Δt% is the same at every threshold
+        assert max(tc.dt_percent) - min(tc.dt_percent) < 1e-9
+    assert res.table7.w_nn_rad_s == pytest.approx(1.75e-2 / 29.4)
+    assert res.table7.dt_percent[-1] == pytest.approx((29.4 - 23.0) / 23.0 * 100, rel=1e-9)
+
+
 @settings(max_examples=60, deadline=None)
 @given(st.floats(-3.1, 3.1), st.floats(-1.5, 1.5), st.floats(-3.1, 3.1))
 def test_euler_round_trip(r, p, y):

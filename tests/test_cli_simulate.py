@@ -6,7 +6,6 @@ import json
 from pathlib import Path
 
 import numpy as np
-import pytest
 from click.testing import CliRunner
 
 from uasnav.cli import main
@@ -49,19 +48,3 @@ def test_simulate_errors(tmp_path: Path) -> None:
     assert r.exit_code == 2
     r = CliRunner().invoke(main, ["simulate", "--profile", "boil", "--out", str(tmp_path / "a.csv")])
     assert r.exit_code == 2
-
-
-def test_report_simulator_section_quick(tmp_path: Path) -> None:
-    r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--quick", "--only", "simulator"])
-    assert r.exit_code == 0, r.output
-    data = json.loads((tmp_path / "report.json").read_text())
-    sec = data["sections"]["simulator"] if "sections" in data else data["simulator"]
-    assert sec["soak_temp_range_c"][0] == pytest.approx(-20.53, abs=0.01)
-    assert sec["soak_temp_range_c"][1] == pytest.approx(37.30, abs=0.01)
-    # thesis Table 3 ARW and Table 4 VRW recovered from the simulated static AX1 log
-    assert np.mean(sec["ax1_gyro_random_walk"]["fit"]) == pytest.approx(3.18, rel=0.10)
-    assert np.mean(sec["ax1_accel_random_walk"]["fit"]) == pytest.approx(0.05, rel=0.10)
-    assert np.mean(sec["lsm6dsm_gyro_bias_instability"]["fit"]) == pytest.approx(10.8, rel=0.25)
-    for v in sec["hysteresis_output_deg_s"]:
-        assert v == pytest.approx(sec["hysteresis_configured_deg_s"], abs=0.012)
-    assert (tmp_path / "figures" / "simulator-ramp.png").stat().st_size > 10_000

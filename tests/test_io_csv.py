@@ -91,3 +91,138 @@ def test_failed_write_leaves_no_file(tmp_path):
     assert [f.name for f in tmp_path.iterdir()] == ["out.csv"]
     write_csv_v1(log, p)
     assert read_log(p).n == log.n
+
+
+# --- generic numeric tables (write_csv_table) -------------------------------------------------
+
+
+def test_csv_table_round_trip_is_exact(tmp_path):
+    from uasnav.io import read_csv_table, write_csv_table
+
+    rng = np.random.default_rng(3)
+    cols = {
+        "t": np.arange(40) * 0.01 + 1.0 / 3.0,
+        "bgx": rng.normal(size=40) * 1e-5,
+        "flag": np.arange(40) % 3,  # integers are written as numbers
+        "sigma": np.where(np.arange(40) == 7, np.nan, rng.random(40)),  # NaN: a missing value
+    }
+    p = tmp_path / "sub" / "est.csv"
+    write_csv_table(p, cols, comments={"mode": "tczupt", "unit.bgx": "rad/s"})
+    text = p.read_text()
+    assert text.startswith("# mode: tczupt\n# unit.bgx: rad/s\nt,bgx,flag,sigma\n")
+    back, notes = read_csv_table(p)
+    assert list(back) == list(cols) and notes == {"mode": "tczupt", "unit.bgx": "rad/s"}
+    for k, v in cols.items():
+        assert back[k].tobytes() == np.asarray(v, dtype=np.float64).tobytes(), k
+    assert not [f for f in p.parent.iterdir() if f.name != "est.csv"]  # no temporary file left
+    # the comments are CSV v1-style metadata lines: the CSV v1 comment parser reads them too
+    write_csv_table(p, {"t": [0.0, 0.01], **{c: [0.0, 0.0] for c in ("gx", "gy", "gz", "ax", "ay", "az")}})
+    assert read_log(p).n == 2
+
+
+@pytest.mark.parametrize(
+    ("columns", "comments", "match"),
+    [
+        ({}, None, "at least one column"),
+        ({"t": [0.0, 1.0], "x": [1.0]}, None, "different lengths"),
+        ({"t": [0.0, np.inf]}, None, r"column 't': infinite value at row 1"),
+        ({"t": [[0.0, 1.0]]}, None, "1-D"),
+        ({"t": ["a", "b"]}, None, "not numeric"),
+        ({"a,b": [0.0]}, None, "column name"),
+        ({"": [0.0]}, None, "column name"),
+        ({"t": [0.0]}, {"two words": "x"}, "comment key"),
+        ({"t": [0.0]}, {"k": "line\nbreak"}, "one line"),
+    ],
+)
+def test_csv_table_bad_input_writes_nothing(tmp_path, columns, comments, match):
+    from uasnav.errors import InputError
+    from uasnav.io import write_csv_table
+
+    p = tmp_path / "out.csv"
+    p.write_text("previous")
+    with pytest.raises(InputError, match=match):
+        write_csv_table(p, columns, comments=comments)
+    assert p.read_text() == "previous"
+    assert [f.name for f in tmp_path.iterdir()] == ["out.csv"]
+
+
+def test_csv_table_failure_while_writing_leaves_old_file(tmp_path, monkeypatch):
+    import uasnav.io.table as table
+    from uasnav.io import write_csv_table
+
+    p = tmp_path / "out.csv"
+    p.write_text("previous")
+
+    def boom(fh, block):
+        fh.write("partial")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(table, "write_rows", boom)
+    with pytest.raises(OSError, match="disk full"):
+        write_csv_table(p, {"t": [0.0, 1.0]})
+    assert p.read_text() == "previous"
+    assert [f.name for f in tmp_path.iterdir()] == ["out.csv"]
+
+
+def test_read_csv_table_errors_name_line_and_column(tmp_path):
+    from uasnav.io import read_csv_table
+
+    p = tmp_path / "x.csv"
+    p.write_text("# a: 1\nt,x\n0,1\n0.1,oops\n")
+    with pytest.raises(DataFormatError, match=r"line 4, column 'x': not a number"):
+        read_csv_table(p)
+    p.write_text("t,x\n0,1,2\n")
+    with pytest.raises(DataFormatError, match="line 2: expected 2 cells"):
+        read_csv_table(p)
+    with pytest.raises(DataFormatError, match="no such file"):
+        read_csv_table(tmp_path / "nope.csv")
+
+
+# --- CSV v1 with extra columns and metadata (the fused output of `uasnav redundancy fuse`) ------
+
+
+def test_csv_v1_extra_columns_and_metadata(tmp_path):
+    log = _log(temp=False, truth=False)
+    log = ImuLog(
+        t=log.t,
+        gyro=log.gyro,
+        accel=log.accel,
+        meta={"fused_from": "a.csv b.csv", "shape": "cube", "fdi": True, "dropped_samples": 3},
+    )
+    chi2 = np.linspace(0.0, 2.0, log.n)
+    chi2[4] = np.nan
+    health = (np.arange(log.n) % 2 * 8).astype(float)
+    p = tmp_path / "fused.csv"
+    write_csv_v1(log, p, extra_columns={"chi2_gyro": chi2, "health_0": health})
+    lines = p.read_text().splitlines()
+    assert lines[:6] == [
+        "# uasnav log format v1 (SI units: s, rad/s, m/s^2, degC, uT)",
+        "# fused_from: a.csv b.csv",
+        "# shape: cube",
+        "# fdi: True",
+        "# dropped_samples: 3",
+        "t,gx,gy,gz,ax,ay,az,chi2_gyro,health_0",
+    ]
+    assert lines[6 + 4].split(",")[7] == "nan" and lines[7].split(",")[8] == "8"
+    back = read_log(p)  # the extra columns are ignored by the reader
+    np.testing.assert_array_equal(back.gyro, log.gyro)
+    assert back.meta["fdi"] == "True" and back.meta["dropped_samples"] == "3"
+    from uasnav.io import read_csv_table
+
+    cols, _ = read_csv_table(p)
+    assert cols["chi2_gyro"].tobytes() == chi2.tobytes() and cols["health_0"].tobytes() == health.tobytes()
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        ({"chi2": np.zeros(3)}, "3 values for 50 samples"),
+        ({"gx": np.zeros(50)}, "already a column"),
+        ({"chi2": np.full(50, np.inf)}, "infinite"),
+    ],
+)
+def test_csv_v1_bad_extra_columns(tmp_path, extra, match):
+    p = tmp_path / "out.csv"
+    with pytest.raises(ValueError, match=match):
+        write_csv_v1(_log(), p, extra_columns=extra)
+    assert not p.exists() and not list(tmp_path.iterdir())

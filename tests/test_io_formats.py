@@ -106,3 +106,63 @@ def test_xio_errors_name_line_and_column(tmp_path: Path) -> None:
     p.write_text(head + "0,1,2,3,0,0,1\n0,1,2,3,0,0,1\n")
     with pytest.raises(DataFormatError, match=r"line 3.*not increasing"):
         read_log(p)
+
+
+def test_dataflash_flight_and_other_messages_in_seconds(shared_data: Path) -> None:
+    import uasnav.io.ardupilot as ap
+    from uasnav.io import read_dataflash_messages, read_flight
+    from uasnav.io.flight import FlightLog
+
+    path = shared_data / "logs" / "ardupilot_log171.bin"
+    assert ap.read_dataflash is read_dataflash and ap.read_tlog is read_tlog  # documented names kept
+    tables = read_dataflash_messages(path, ["BARO", "MAG", "ATT", "MSG"])
+    assert sorted(tables) == ["ATT", "BARO", "MAG"]  # MSG: text only, no time in this (3.3) log
+    baro = tables["BARO"]
+    assert baro["t"].size == 2383 and np.all(np.diff(baro["t"]) > 0)
+    assert baro["t"][0] == pytest.approx(11.477)  # TimeMS 11477 → s, like the IMU time stamps
+    assert 94e3 < np.median(baro["Press"]) < 96e3  # Pa, Canberra
+    assert {"Roll", "Pitch", "Yaw"} <= set(tables["ATT"])
+    flight = read_flight(path)
+    assert isinstance(flight, FlightLog) and flight.t.size > 1000 and not flight.waypoints
+    with pytest.raises(AttributeError):
+        flight.cruise_ms = 3.0  # type: ignore[misc]  # a read log is immutable
+
+
+def test_tlog_flight_mission(shared_data: Path) -> None:
+    from uasnav.io import read_flight
+
+    log = read_flight(shared_data / "flights" / "phoenix_mission1_arducopter.tlog")
+    assert sorted(log.waypoints) == [2, 3] and log.cruise_ms == pytest.approx(5.0)
+    assert len(log.reached) == 16 and log.reached == sorted(log.reached)
+    assert np.all(np.diff(log.t) > 0) and log.vel_ned.shape == (log.t.size, 3)
+
+
+def test_binary_log_errors_name_the_file(tmp_path: Path) -> None:
+    from uasnav.io import read_flight
+
+    junk = tmp_path / "junk.bin"
+    junk.write_bytes(bytes(range(64)))
+    with pytest.raises(DataFormatError, match=r"junk\.bin: no IMU/IMU2/IMU3 messages"):
+        read_dataflash(junk)
+    with pytest.raises(DataFormatError, match=r"junk\.bin: no GPS messages"):
+        read_flight(junk)
+    with pytest.raises(DataFormatError, match="no such file"):
+        read_dataflash(tmp_path / "missing.bin")
+    with pytest.raises(InputError, match="no such telemetry file"):
+        read_flight(tmp_path / "missing.tlog")
+
+
+def test_flight_csv_reader(tmp_path: Path) -> None:
+    from uasnav.io import read_flight
+
+    p = tmp_path / "f.csv"
+    p.write_text("t,lat,lon,alt,v_N,v_E,v_D,extra\n1,40.0,14.0,10,1,0,0,x\n0,40.1,14.1,11,0,1,0,y\n")
+    log = read_flight(p)
+    np.testing.assert_array_equal(log.t, [0.0, 1.0])  # sorted by time
+    np.testing.assert_array_equal(log.lat, [40.1, 40.0])
+    p.write_text("t,lat,lon,alt,v_N,v_E,v_D\n0,40.0,14.0,10,1,0,nan\n1,40.0,14.0,10,1,0,0\n")
+    with pytest.raises(DataFormatError, match=r"line 2, column 'v_D': NaN/inf"):
+        read_flight(p)
+    p.write_text("t,lat,lon\n0,1,2\n")
+    with pytest.raises(DataFormatError, match=r"line 1: missing column"):
+        read_flight(p)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from scipy import stats
 from uasnav import redundancy as R
 from uasnav.cli import main
 from uasnav.errors import InputError
+from uasnav.experiments import redundancy as X
 from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.sim import array_mountings, inject_fault, load_preset, simulate_array
 
@@ -19,7 +21,7 @@ DEG = math.pi / 180
 
 
 @pytest.fixture(scope="module")
-def cube6() -> R.Configuration:
+def cube6() -> R.SensorArray:
     """The simulator's cube: six triaxial sensors, z along the outward face normals."""
     return R.from_mountings(np.array(array_mountings("cube")))
 
@@ -33,7 +35,7 @@ def cube_logs(cube6):
 
 
 def test_table14_exact() -> None:
-    for _no, _pf, _total, ref, ours in R.table14():
+    for _no, _pf, _total, ref, ours in X.table14():
         assert round(ours, 2) == ref
     # The thesis' six-SensorTile cube (triaxial, one per face) is row 5: 18 axes.
     np.testing.assert_allclose(R.kr("cube", 1, triaxial=True), 1 / math.sqrt(6), rtol=1e-12)
@@ -74,6 +76,21 @@ def test_bad_configurations_are_named() -> None:
         R.configuration("tetrahedron", 0.5)
 
 
+def test_array_for_logs_names_the_bad_log() -> None:
+    from uasnav.imu import ImuLog
+
+    lg = ImuLog(t=[0.0, 0.01], gyro=np.zeros((2, 3)), accel=np.zeros((2, 3)))
+    with pytest.raises(InputError, match=r"b\.csv: no '# mounting:' comment"):
+        R.array_for_logs("meta", [replace(lg, meta={"mounting": np.eye(3)}), lg], names=["a.csv", "b.csv"])
+    with pytest.raises(InputError, match="do not fill the 6 faces"):
+        R.array_for_logs("cube", [lg] * 5)
+    with pytest.raises(InputError, match="shape"):
+        R.array_for_logs("sphere", [lg] * 6)
+    # json text of a '# mounting:' comment is accepted like the matrix itself
+    two = [replace(lg, meta={"mounting": "[[1, 0, 0], [0, 1, 0], [0, 0, 1]]"})] * 2
+    np.testing.assert_array_equal(R.array_for_logs("meta", two).mountings(), np.eye(3)[None].repeat(2, 0))
+
+
 def test_too_few_axes_and_nan_never_give_a_fused_value() -> None:
     c = R.configuration("cube", 1)  # six single-axis gyros
     z = np.zeros((4, 6))
@@ -89,8 +106,6 @@ def test_too_few_axes_and_nan_never_give_a_fused_value() -> None:
 
 
 def test_mismatched_sample_times(cube6, cube_logs) -> None:
-    from dataclasses import replace
-
     logs = list(cube_logs)
     logs[3] = replace(logs[3], t=logs[3].t + 0.004)
     with pytest.raises(InputError, match=r"logs\[3\].*mismatched sample times"):
@@ -201,35 +216,40 @@ def test_relative_alignment_recovers_known_mounting_errors(cube6) -> None:
     np.testing.assert_allclose(R.level([[0.0, 0.0, -9.8]]), [[0.0, 0.0]], atol=1e-12)
 
 
-def test_report_section_quick(tmp_path) -> None:
-    import json
+@pytest.fixture(scope="module")
+def experiment_quick():
+    """The report's redundancy experiments, quick mode (a few seconds)."""
+    return X.run(quick=True)
 
-    r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--quick", "--only", "redundancy"])
-    assert r.exit_code == 0, r.output
-    data = json.loads((tmp_path / "report.json").read_text())["sections"]["redundancy"]
-    assert [round(row["k_r"], 2) for row in data["table14"]] == [1.0, 0.71, 0.58, 0.5, 0.41]
+
+def test_experiment_quick(experiment_quick) -> None:
+    r = experiment_quick
+    assert [round(row.k_r, 2) for row in r.geometry.table14] == [1.0, 0.71, 0.58, 0.5, 0.41]
+    assert all(row.match for row in r.geometry.table14)
     # Fused cube vs a typical face: every threshold reached later, by about 1/k_r = √6
     # (Δt% ≈ +145 %) for bias-dominated drift; the median is over faces and runs.
-    raw = data["table15"]["raw output (no calibration)"]
-    assert all(60 < row[-1] < 300 for row in raw)
-    for _shape, _pf, _n, k_r, noise_ratio, bias_ratio, time_ratio in data["improvement"]:
-        assert noise_ratio == pytest.approx(k_r, rel=0.08)
+    raw = {v.name: v for v in r.table15.variants}["raw output (no calibration)"]
+    assert all(60 < row.dt_percent_median < 300 for row in raw.rows)
+    for row in r.improvement.rows:
+        assert row.noise_ratio == pytest.approx(row.k_r, rel=0.08)
         # ten simulated arrays in quick mode: bias and time ratios scatter around k_r
-        assert 0.4 * k_r < bias_ratio < 2.0 * k_r and 0.4 * k_r < time_ratio < 2.0 * k_r
-    for name, dev_fdi, dev_plain, envelope, _flag in data["fdi"]:
-        assert dev_fdi < envelope
-        assert name.startswith("dropout") or dev_plain > envelope
+        assert (
+            0.4 * row.k_r < row.bias_ratio < 2.0 * row.k_r and 0.4 * row.k_r < row.time_ratio < 2.0 * row.k_r
+        )
+    for f in r.fdi.rows:
+        assert f.max_dev_fdi_deg_s < f.envelope_deg_s
+        assert f.name.startswith("dropout") or f.max_dev_plain_deg_s > f.envelope_deg_s
     # mounting errors of σ 1°: recovered to the bias-instability limit with ideal sensors; the
     # preset's own 5 mrad axis misalignment and 5000 ppm scale factor limit it to tenths of °
-    assert data["alignment_max_error_deg"] < 0.03
-    assert 0.1 < data["alignment_max_error_preset_deg"] < 1.5
+    assert r.alignment.max_error_ideal_deg < 0.03
+    assert 0.1 < r.alignment.max_error_preset_deg < 1.5
     # Kalman: with a zero-rate reference every axis bias is estimated to < 0.01 deg/s
-    assert data["kalman"][2][2] < 0.01 < data["kalman"][1][2]
+    k = r.kalman.rows
+    assert k[2].worst_bias_error_deg_s < 0.01 < k[1].worst_bias_error_deg_s
 
 
 def test_cli_kr_and_fuse(tmp_path, cube6) -> None:
     import json
-    from dataclasses import replace
 
     r = CliRunner().invoke(main, ["redundancy", "kr", "--shape", "cube", "--per-face", "1", "--json"])
     assert r.exit_code == 0, r.output
@@ -251,6 +271,20 @@ def test_cli_kr_and_fuse(tmp_path, cube6) -> None:
         assert r.exit_code == 0, r.output
         fused = read_csv_v1(out)
         assert fused.n == 2000
+        # The output layout: CSV v1 header, the fusion's metadata, extra χ² and health columns.
+        head = out.read_text().splitlines()[:6]
+        assert head == [
+            "# uasnav log format v1 (SI units: s, rad/s, m/s^2, degC, uT)",
+            f"# fused_from: {' '.join(paths)}",
+            f"# shape: {shape}",
+            "# fdi: False",
+            "# dropped_samples: 0",
+            "t,gx,gy,gz,ax,ay,az,chi2_gyro,chi2_accel," + ",".join(f"health_{i}" for i in range(6)),
+        ]
+        # The library pipeline behind the command gives the same fused log.
+        ff = R.fuse_files(paths, shape)
+        np.testing.assert_array_equal(ff.fused_log().gyro, fused.gyro)
+        assert ff.result.config.n_sensors == 6 and ff.summary()["written"] == 2000
         # Independent reference (simulator truth, numpy LS): the fused rate is the true IMU
         # rate plus the sensors' mean biases through the weighted LS (HᵀWH)⁻¹HᵀW (eq. 38),
         # W from each axis' Allan white noise, ± the averaged noise.
@@ -317,7 +351,7 @@ def test_cli_simulate_every_polyhedron_fuses_in_glob_order(tmp_path) -> None:
 
 
 def test_ardupilot_three_imus(shared_data) -> None:
-    from uasnav.redundancy_ardupilot import analyse_log
+    from uasnav.experiments.ardupilot import analyse_log
 
     res = analyse_log(shared_data / "logs" / "ardupilot_log171.bin")
     assert res.n_samples > 5000

@@ -11,6 +11,8 @@ import pytest
 from uasnav import earth
 from uasnav.allan import oadev
 from uasnav.errors import DataFormatError, InputError
+from uasnav.experiments import simulator as exp
+from uasnav.experiments.thesis import FIG29_SOAK_RANGE_C, TABLE3, TABLE4
 from uasnav.noise import identify
 from uasnav.sim import (
     FAULT_KINDS,
@@ -396,3 +398,24 @@ def test_lab_block_average_and_errors() -> None:
         block_average(x, 6)
     cal = soak_calibration_data("ax1", seed=1, rate=1.0, average_s=120.0)
     assert cal.average_s == 120.0 and cal.gyro_bias.shape == (cal.temp.size, 3)
+
+
+def test_simulator_experiment_quick() -> None:
+    """The simulator chapter's experiment (what ``uasnav report --only simulator`` renders)."""
+    res = exp.run(quick=True)
+    assert res.soak.temp_range_c[0] == pytest.approx(-20.53, abs=0.01)
+    assert res.soak.temp_range_c[1] == pytest.approx(37.30, abs=0.01)
+    assert res.soak.temp_range_c == pytest.approx(FIG29_SOAK_RANGE_C, abs=0.01)
+    terms = {f"{t.preset}_{t.sensor}_{t.term}": t for sp in res.static.presets for t in sp.terms}
+    # thesis Table 3 ARW and Table 4 VRW recovered from the simulated static AX1 log
+    assert np.mean(terms["ax1_gyro_random_walk"].fit) == pytest.approx(3.18, rel=0.10)
+    assert np.mean(terms["ax1_accel_random_walk"].fit) == pytest.approx(0.05, rel=0.10)
+    assert terms["ax1_gyro_random_walk"].spec == pytest.approx(TABLE3["arw_deg_sqrt_h"])
+    assert terms["ax1_accel_random_walk"].spec == pytest.approx(TABLE4["vrw_m_s_sqrt_h"])
+    assert np.mean(terms["lsm6dsm_gyro_bias_instability"].fit) == pytest.approx(10.8, rel=0.25)
+    for v in res.ramp.hysteresis_output_deg_s:
+        assert v == pytest.approx(res.ramp.hysteresis_configured_deg_s, abs=0.012)
+    # the ramp figure's content: both branches binned over the ramp range, three axes each
+    for br in (res.ramp.heating, res.ramp.cooling):
+        assert br.bin_gyro_deg_s.shape == (br.bin_temp_c.size, 3) and br.bin_temp_c.size > 20
+        assert br.true_output_deg_s.shape == (res.ramp.grid_c.size, 3)

@@ -1,14 +1,64 @@
-"""SHOE static detection on simulated logs with known motion segments."""
+"""SHOE static detection on simulated logs with known motion segments, and the Rust-backed
+detector against an independent vectorised Python SHOE (kept here as the reference)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
+from scipy import stats
 
+from uasnav import sim, zupt
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog
 from uasnav.sim import simulate
-from uasnav.stationary import detect_static
+from uasnav.stationary import MAX_WINDOW_SAMPLES, StaticIntervals, detect_static
+
+
+def _window_sums(x, w):
+    """Sums of ``x`` (n, …) over centred windows of ``w`` samples (clipped at the ends)."""
+    n = x.shape[0]
+    c = np.concatenate([np.zeros((1, *x.shape[1:])), np.cumsum(x, axis=0)])
+    lo = np.clip(np.arange(n) - w // 2, 0, n - w)
+    return c[lo + w] - c[lo]
+
+
+def shoe_reference(log, *, window_s=0.2, threshold=None, sigma_a=None, sigma_g=None, gyro_bias=None,
+                   gravity=None, false_alarm=1e-3):  # fmt: skip
+    """The pure-Python SHOE (Skog et al. 2010, eq. 15) that uasnav.stationary used before it
+    called the Rust detector: cumulative sums, every parameter estimated the same documented
+    way. Returns (statistic, mask, γ, σ_a, σ_g, g, b_g)."""
+    rate = log.uniform_rate(rtol=0.05)
+    w = max(3, round(window_s * rate))
+    a, g = log.accel, log.gyro
+    sa = _window_sums(a, w)
+    sg = _window_sums(g, w)
+    saa = _window_sums(np.sum(a * a, axis=1), w)
+    sgg = _window_sums(g * g, w)
+    mean_a = sa / w
+    mean_g = sg / w
+    var_a = (_window_sums(a * a, w) / w - mean_a**2).mean(axis=1) * w / (w - 1)
+    var_g = (sgg / w - mean_g**2).mean(axis=1) * w / (w - 1)
+    quiet_a = var_a <= np.percentile(var_a, 20)
+    quiet_g = var_g <= np.percentile(var_g, 20)
+    quiet = quiet_a & quiet_g
+    if not quiet.any():
+        quiet = quiet_a
+    s_a = math.sqrt(max(float(np.percentile(var_a, 20)), 1e-20)) if sigma_a is None else float(sigma_a)
+    s_g = math.sqrt(max(float(np.percentile(var_g, 20)), 1e-20)) if sigma_g is None else float(sigma_g)
+    norm_a = np.linalg.norm(mean_a, axis=1)
+    g_mag = float(np.median(norm_a[quiet])) if gravity is None else float(gravity)
+    b = np.median(mean_g[quiet], axis=0) if gyro_bias is None else np.asarray(gyro_bias, dtype=np.float64)
+    u = g_mag * mean_a / np.maximum(norm_a, 1e-12)[:, None]
+    acc_term = saa - 2.0 * np.sum(u * sa, axis=1) + w * np.sum(u * u, axis=1)
+    gyr_term = sgg.sum(axis=1) - 2.0 * (sg @ b) + w * float(b @ b)
+    stat = (acc_term / s_a**2 + gyr_term / s_g**2) / w
+    if threshold is None:
+        gamma = 1.5 * float(stats.chi2.ppf(1.0 - false_alarm, 6 * w - 2)) / w
+    else:
+        gamma = float(threshold)
+    return stat, stat < gamma, gamma, s_a, s_g, g_mag, b
 
 
 def _with_motion(preset: str, seed: int) -> tuple[ImuLog, np.ndarray]:
@@ -87,3 +137,82 @@ def test_real_xio_log_quiet_and_moving_windows(shared_data) -> None:
     assert len(quiet) >= 8 and len(moving) >= 10
     assert min(quiet) > 0.9
     assert max(moving) < 0.05
+
+
+def test_rust_detector_matches_the_python_shoe_with_estimated_parameters() -> None:
+    """detect_static (statistic in Rust) against the Python reference with every default
+    estimated from the data: same parameters, statistic and decisions, at rest and in motion."""
+    for preset, seed in (("lsm6dsm", 3), ("ax1", 5)):
+        log, _ = _with_motion(preset, seed)
+        res = detect_static(log)
+        stat, mask, gamma, s_a, s_g, g_mag, b = shoe_reference(log)
+        assert (res.threshold, res.sigma_a, res.sigma_g, res.gravity) == (gamma, s_a, s_g, g_mag)
+        np.testing.assert_array_equal(res.gyro_bias, b)
+        assert res.window_samples == 20  # even: the ends come from the first/last full window
+        # The reference differences cumulative sums of |a|² ≈ 96 (m/s²)² over the whole log;
+        # with the estimated σ_a ≈ 3e-3 m/s² (not 0.05 as below) that rounding is ~1e-6 of T.
+        # The formulas still agree far inside the decision margin (≥ 10 % of γ here) …
+        np.testing.assert_allclose(res.statistic, stat, rtol=5e-6)
+        np.testing.assert_array_equal(res.mask, mask)
+        # … and the Rust statistic is the direct window sum to 1e-8, ends included.
+        w, n = res.window_samples, log.n
+        for k in (0, 5, 10, 1500, 1800, 4085, n - 11, n - 10, n - 1):
+            lo = min(max(k - w // 2, 0), n - w)
+            a, g = log.accel[lo : lo + w], log.gyro[lo : lo + w] - res.gyro_bias
+            u = res.gravity * a.mean(axis=0) / np.linalg.norm(a.mean(axis=0))
+            direct = np.mean(np.sum((a - u) ** 2, axis=1) / s_a**2 + np.sum(g**2, axis=1) / s_g**2)
+            assert res.statistic[k] == pytest.approx(direct, rel=1e-8), k
+
+
+def test_rust_detector_matches_python_shoe_with_the_same_parameters() -> None:
+    """nav_core's streaming GLRT (through both public names, uasnav.stationary.detect_static
+    and uasnav.zupt.detect_stationary) and the vectorised Python SHOE are independent
+    implementations of the same statistic: with the same σ_a, σ_g, W, γ, g and zero gyro bias
+    they give the same statistic and mask, at rest and in motion."""
+    log = sim.simulate("lsm6dsm", profile="static", duration=20.0, seed=3, table_rate_dps=0.0)
+    rng = np.random.default_rng(0)
+    gyro, accel = log.gyro.copy(), log.accel.copy()
+    gyro[800:1200] += rng.normal(0.0, 0.5, (400, 3))  # 4 s of handling in the middle
+    accel[800:1200] += rng.normal(0.0, 2.0, (400, 3))
+    moved = ImuLog(t=log.t, gyro=gyro, accel=accel)
+    kw = dict(sigma_accel_m_s2=0.05, sigma_gyro_rad_s=0.05, threshold=10.0, gravity_m_s2=9.806)
+    rust = zupt.detect_stationary(moved, window_s=0.25, **kw)
+    same = detect_static(
+        moved, window_s=0.25, sigma_a=0.05, sigma_g=0.05, threshold=10.0, gravity=9.806, gyro_bias=np.zeros(3)
+    )
+    stat, mask, *_ = shoe_reference(
+        moved, window_s=0.25, sigma_a=0.05, sigma_g=0.05, threshold=10.0, gravity=9.806, gyro_bias=np.zeros(3)
+    )
+    # The reference differences cumulative sums of |a|² ≈ 96 (m/s²)² over the whole log, which
+    # cancels to ~1e-9 relative; the formulas agree well beyond any decision margin.
+    np.testing.assert_allclose(rust.statistic, stat, rtol=1e-7)
+    np.testing.assert_array_equal(rust.mask, mask)
+    np.testing.assert_array_equal(same.statistic, rust.statistic)
+    np.testing.assert_array_equal(same.mask, rust.mask)
+    assert same.intervals == rust.intervals
+    assert rust.mask[:700].all() and not rust.mask[850:1150].any() and rust.mask[1300:].all()
+
+
+def test_one_result_type_and_the_zupt_alias() -> None:
+    """zupt.detect_stationary is detect_static with the filter's fixed thresholds; one result
+    type under both names."""
+    assert zupt.StationarityResult is StaticIntervals
+    log = simulate("lsm6dsm", duration=3.0, rate=100.0, seed=2)
+    res = zupt.detect_stationary(log)
+    assert isinstance(res, StaticIntervals)
+    assert (res.threshold, res.sigma_a, res.sigma_g, res.gravity) == (10.0, 0.05, 0.01, 9.80665)
+    assert res.window_samples == 25
+    np.testing.assert_array_equal(res.gyro_bias, np.zeros(3))
+    # Windows longer than the Rust buffer: detect_stationary clamps (documented), detect_static
+    # refuses rather than silently using another window.
+    fast = simulate("lsm6dsm", duration=1.0, rate=2000.0, seed=2)
+    assert zupt.detect_stationary(fast).window_samples == MAX_WINDOW_SAMPLES
+    with pytest.raises(InputError, match=r"window_s: window of 400 samples.*256"):
+        detect_static(fast)
+    assert detect_static(fast, window_s=0.1).window_samples == 200
+    with pytest.raises(InputError, match="window_samples"):
+        detect_static(log, window_samples=0)
+    with pytest.raises(InputError, match="gyro_bias"):
+        detect_static(log, gyro_bias=np.zeros(2))
+    with pytest.raises(InputError, match="sigma_a"):
+        detect_static(log, sigma_a=0.0)

@@ -298,3 +298,115 @@ def test_apply_subtracts_model_bias_and_counts_clipping(nn: NeuralBiasModel) -> 
         warnings.simplefilter("ignore")
         d = nn.derivative(temp, method="network")
     assert np.all(d[[0, 3]] == 0.0) and np.all(d[[1, 2]] != 0.0)
+
+
+def test_models_are_bias_models_registered_by_kind(data, nn: NeuralBiasModel) -> None:
+    """The model file reader finds each model class by the file's kind (no import circle)."""
+    from uasnav.thermal import BiasModel, dumps_model, model_class, register_model, registered_kinds
+
+    t, b = data
+    assert registered_kinds() == ("neural", "polynomial", "px4")
+    for m in (PolynomialBiasModel(2).fit(t, b), nn, Px4BiasModel().fit(t, b)):
+        assert isinstance(m, BiasModel)
+        assert model_class(m.kind) is type(m)
+        d = json.loads(dumps_model(m))
+        assert set(d) == {
+            "format", "schema_version", "kind", "quantity", "axes", "units", "calibrated_range_c",
+            "models", "derivative_models", "training", "checksum",
+        }  # fmt: skip
+    with pytest.raises(InputError, match="unknown model kind 'spline'"):
+        model_class("spline")
+
+    class Other:
+        kind = "polynomial"
+
+    with pytest.raises(InputError, match="already registered"):
+        register_model(Other)
+    assert model_class("polynomial") is PolynomialBiasModel
+    # A file of an unregistered kind (well signed) is refused by kind.
+    from uasnav.thermal.modelfile import ZEROS, file_checksum
+
+    d = json.loads(dumps_model(PolynomialBiasModel(2).fit(t, b)))
+    d["kind"] = "spline"
+    d["checksum"]["value"] = ZEROS
+    text = json.dumps(d)
+    with pytest.raises(DataFormatError, match="unknown model kind 'spline'"):
+        loads_model(text.replace(ZEROS, file_checksum(text, ZEROS)))
+
+
+def test_non_finite_model_is_not_saved(data) -> None:
+    from uasnav.thermal import dumps_model
+
+    m = PolynomialBiasModel(2).fit(*data)
+    m.coef_[1, 2] = np.nan
+    with pytest.raises(DataFormatError, match="non-finite"):
+        dumps_model(m)
+
+
+def test_bin_means_by_temperature_and_by_time() -> None:
+    from uasnav.thermal import bin_by_temperature, bin_by_time
+
+    rng = np.random.default_rng(3)
+    temp = rng.uniform(-10.0, 30.0, 4000)
+    vals = rng.normal(size=(4000, 3))
+    tm, vm = bin_by_temperature(temp, vals, 0.5)
+    # Every sample lands in one bin of 0.5 °C from the minimum (the maximum in the last one).
+    edges = temp.min() + 0.5 * np.arange(tm.size + 1)
+    for i in (0, tm.size // 2, tm.size - 1):
+        m = (temp >= edges[i]) & (temp < edges[i + 1]) if i < tm.size - 1 else temp >= edges[i]
+        assert tm[i] == pytest.approx(temp[m].mean(), rel=1e-12)
+        np.testing.assert_allclose(vm[i], vals[m].mean(axis=0), rtol=1e-10, atol=1e-14)
+    assert np.all(np.diff(tm) > 0)
+    # data_derivative differentiates exactly these bin means.
+    td, dd = data_derivative(temp, vals, 0.5)
+    np.testing.assert_array_equal(td, tm)
+    np.testing.assert_array_equal(dd, np.gradient(vm, tm, axis=0))
+    # Time blocks: 10 samples at 10 Hz per 1 s block; a gap leaves no empty block behind.
+    t = np.concatenate([np.arange(30) * 0.1, 10.0 + np.arange(10) * 0.1])
+    tb, vb = bin_by_time(t, temp[:40], vals[:40], 1.0)
+    assert tb.shape == (4,) and vb.shape == (4, 3)
+    np.testing.assert_allclose(vb, vals[:40].reshape(4, 10, 3).mean(axis=1), rtol=1e-12)
+    np.testing.assert_allclose(tb, temp[:40].reshape(4, 10).mean(axis=1), rtol=1e-12)
+    same_t, same_v = bin_by_time(t, temp[:40], vals[:40], 0.0)
+    assert np.array_equal(same_t, temp[:40]) and np.array_equal(same_v, vals[:40])
+    with pytest.raises(InputError, match="width_c"):
+        bin_by_temperature(temp, vals, 0.0)
+
+
+def test_workflow_fit_and_evaluate(tmp_path, data) -> None:
+    """The ``uasnav calibrate`` pipeline as library calls: load, fit, evaluate."""
+    from uasnav.imu import ImuLog
+    from uasnav.io.csv_v1 import write_csv_v1
+    from uasnav.thermal import evaluate_model, fit_polynomial, load_training_data
+
+    t, b = data
+    n = t.size
+    log = ImuLog(
+        t=np.arange(n) * 0.1, gyro=b, accel=np.tile([0.0, 0.0, -9.81], (n, 1)), temp=t,
+        truth={"gyro_bias_thermal": truth(t)},
+    )  # fmt: skip
+    path = tmp_path / "train.csv"
+    write_csv_v1(log, path)
+    temp, bias = load_training_data(path, average_s=1.0)
+    assert temp.shape == (n // 10,) and bias.shape == (n // 10, 3)
+    np.testing.assert_allclose(bias, b.reshape(-1, 10, 3).mean(axis=1), rtol=1e-9, atol=1e-15)
+    with pytest.raises(InputError, match=r"only 6 samples after 100\.0 s averaging"):
+        load_training_data(path, average_s=100.0)
+    fit = fit_polynomial(temp, bias, select=True)
+    assert fit.selection is not None and fit.size == fit.selection.chosen == fit.model.order  # type: ignore[attr-defined]
+    assert fit_polynomial(temp, bias, order=3).size == 3 and fit_polynomial(temp, bias).selection is None
+    ev = evaluate_model(fit.model, log)
+    # The block means span slightly less than the raw temperatures: the ends are clipped.
+    lo, hi = fit.model.range_c_
+    assert ev.n_samples == n and ev.clipped_samples == np.count_nonzero((t < lo) | (t > hi)) > 0
+    assert ev.truth_key == "gyro_bias_thermal"
+    res = b - fit.model.predict(np.clip(t, lo, hi))
+    np.testing.assert_allclose(ev.residual.rms, rms(res), rtol=1e-12)
+    assert ev.residual.sr == pytest.approx(sr(res), rel=1e-12)
+    assert ev.error_vs_truth is not None and ev.error_vs_truth.sr < ev.residual.sr
+    assert list(ev.residual.to_dict()) == ["mean", "rms", "max_abs", "sr"]
+    bare = ImuLog(t=log.t, gyro=b, accel=log.accel, temp=t + 100.0)
+    ev = evaluate_model(fit.model, bare)
+    assert ev.clipped_samples == n and ev.truth_key is None and ev.error_vs_truth is None
+    with pytest.raises(InputError, match=r"x\.csv: no temp column"):
+        evaluate_model(fit.model, ImuLog(t=log.t, gyro=b, accel=log.accel), source="x.csv")

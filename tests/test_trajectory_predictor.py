@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from uasnav.errors import DataFormatError, InputError
+from uasnav.experiments.trajectory import run_phantom4
 from uasnav.trajectory.baselines import kinematic_times, percent_error
-from uasnav.trajectory.experiment import run_phantom4
 from uasnav.trajectory.features import features, wind_vector
 from uasnav.trajectory.geometry import discretise
 from uasnav.trajectory.predictor import TrajectoryPredictor
@@ -64,9 +64,11 @@ def test_table17_reproduced_within_thesis_errors(experiment):
     # Thesis Table 17: e% 2.10–4.28 %, mean 3.22 % over its six test flights. Ours (seeded) must
     # be no worse on average, on the same 25–30 s scale.
     e_all = []
-    for _name, t_nn, reals in experiment.table17:
+    for piece in experiment.table17:
+        t_nn, reals = piece.t_nn_s, piece.t_real_s
         e_all += percent_error(np.full(len(reals), t_nn), np.array(reals)).tolist()
         assert 20.0 < np.mean(reals) < 35.0
+        np.testing.assert_allclose(piece.error_pct, e_all[-len(reals) :], rtol=0, atol=0)
     assert len(e_all) == 6
     assert np.mean(e_all) < 3.22
     assert np.max(e_all) < 6.0
@@ -179,7 +181,7 @@ def test_gap_drops_elements_with_a_warning():
 
 
 def test_lvq_fallback_beats_cell_table_on_unseen_trajectory(experiment):
-    from uasnav.trajectory.experiment import cross_trajectory
+    from uasnav.experiments.trajectory import cross_trajectory
 
     for res in cross_trajectory(experiment).values():
         e = {m.name: m.error_pct.mean() for m in res}

@@ -107,12 +107,15 @@ def test_cli_train_predict_evaluate(shared_data, tmp_path):
     assert r.exit_code == 1 and "SPEED@DIR" in r.output
 
 
-def test_report_section_quick(tmp_path):
-    r = CliRunner().invoke(main, ["report", "--quick", "--only", "trajectory", "--out", str(tmp_path)])
-    assert r.exit_code == 0, r.output
-    data = json.loads((tmp_path / "report.json").read_text())["sections"]["trajectory"]
-    assert len(data["table17"]) == 2
-    assert data["methods"]["LVQ (thesis)"]["mean"] < data["methods"]["distance ÷ speed"]["mean"]
+def test_trajectory_experiment_quick():
+    # What the report's quick trajectory section shows (uasnav.experiments.trajectory.run).
+    from uasnav.experiments import trajectory
+
+    res = trajectory.run(quick=True)
+    assert (res.n_flights, res.n_train) == (5, 3)
+    assert len(res.phantom4.table17) == 2
+    means = {m.name: m.mean_pct for m in res.methods}
+    assert means["LVQ (thesis)"] < means["distance ÷ speed"]
 
 
 def test_dataflash_without_mission(shared_data):
@@ -192,3 +195,16 @@ def test_cli_csv_flight_with_plan(tmp_path):
     # No --plan for a CSV flight: a clear error.
     r = CliRunner().invoke(main, ["trajectory", "train", str(flight), "--out", str(model)])
     assert r.exit_code == 1 and "give --plan" in r.output
+
+
+def test_documented_names_are_the_io_readers():
+    # The readers live in uasnav.io; uasnav.trajectory.telemetry keeps its documented names.
+    import uasnav.io as io
+    from uasnav.io import dataflash, flight, px4, tlog
+    from uasnav.trajectory import telemetry
+
+    assert telemetry.read_flight is io.read_flight and telemetry.FlightLog is flight.FlightLog
+    assert telemetry.read_csv is flight.read_flight_csv and telemetry.read_tlog is tlog.read_tlog_flight
+    assert telemetry.read_dataflash is dataflash.read_dataflash_flight
+    assert telemetry.read_ulog is px4.read_ulog_flight
+    assert telemetry.CSV_COLUMNS == ("t", "lat", "lon", "alt", "v_N", "v_E", "v_D")

@@ -1,6 +1,7 @@
 """ZUPT / TCZUPT: the Rust filter against filterpy (same model, dense matrices), against the
-simulator's ground truth (``uasnav.sim``, AX1 preset), against the Python SHOE detector and
-Earth model, error handling, the CLI contract and the report."""
+simulator's ground truth (``uasnav.sim``, AX1 preset), against the Earth model, error
+handling, the CLI contract and the report's experiment. (The Rust stationarity detector
+against the Python SHOE reference: tests/test_stationary.py.)"""
 
 from __future__ import annotations
 
@@ -208,14 +209,30 @@ def test_cli_writes_the_est_csv_contract(tmp_path):
     assert r.exit_code == 2 and "dimension" in r.output
 
 
-def test_report_section_quick(tmp_path):
-    r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--quick", "--only", "zupt"])
-    assert r.exit_code == 0, r.output
-    data = json.loads((tmp_path / "report.json").read_text())
-    z = data["sections"]["zupt"] if "sections" in data else data["zupt"]
-    z = z.get("data", z)
-    assert set(z["table10"]["nominal"]) == {"zupt", "tczupt"}
-    assert 0 < z["table10"]["nominal"]["zupt"]["x"]["vs_truth"] < 5e-4
+def test_to_csv_is_an_io_table_with_the_csv_columns(tmp_path):
+    """EST.csv is written by uasnav.io.write_csv_table: the CSV_COLUMNS in order, every float
+    back bit for bit."""
+    from uasnav.io import read_csv_table
+
+    log = sim.simulate("ax1", profile="static", duration=65.0, seed=2, euler_rad=EULER)
+    res = zupt.run(log, "zupt", None, zupt.ZuptConfig(decimation=50))
+    res.to_csv(tmp_path / "EST.csv")
+    cols, comments = read_csv_table(tmp_path / "EST.csv")
+    assert tuple(cols) == zupt.CSV_COLUMNS and comments == {}
+    np.testing.assert_array_equal(cols["t"], res.t)
+    np.testing.assert_array_equal(np.column_stack([cols[c] for c in ("bgx", "bgy", "bgz")]), res.gyro_bias)
+    np.testing.assert_array_equal(np.column_stack([cols[f"q{j}"] for j in range(4)]), res.attitude)
+    np.testing.assert_array_equal(cols["sbaz"], res.accel_bias_std[:, 2])
+
+
+def test_zupt_experiment_quick():
+    """The ZUPT chapter's experiment (what ``uasnav report --only zupt`` renders)."""
+    from uasnav.experiments import zupt as experiment
+
+    r = experiment.run(quick=True)
+    assert set(r.rms_vs_truth["nominal"]) == {"zupt", "tczupt"}
+    assert set(r.rms_vs_ma["nominal"]) == {"zupt", "tczupt"}
+    assert 0 < r.rms_vs_truth["nominal"]["zupt"][0] < 5e-4
 
 
 def test_adis16405_turn_on_bias_matches_mean_minus_earth_rate(shared_data):
@@ -299,30 +316,6 @@ def test_rust_earth_model_matches_uasnav_earth():
         np.testing.assert_allclose(
             [0.0, 0.0, _core.earth_normal_gravity(lat, h)], earth.gravity_ned(lat, h), rtol=1e-12
         )
-
-
-def test_rust_detector_matches_python_shoe_with_the_same_parameters():
-    """nav_core's streaming GLRT and uasnav.stationary's vectorised SHOE are independent
-    implementations of the same statistic: with the same σ_a, σ_g, W, γ, g and zero gyro bias
-    they give the same statistic and mask, at rest and in motion."""
-    from uasnav.stationary import detect_static
-
-    log = sim.simulate("lsm6dsm", profile="static", duration=20.0, seed=3, table_rate_dps=0.0)
-    rng = np.random.default_rng(0)
-    gyro, accel = log.gyro.copy(), log.accel.copy()
-    gyro[800:1200] += rng.normal(0.0, 0.5, (400, 3))  # 4 s of handling in the middle
-    accel[800:1200] += rng.normal(0.0, 2.0, (400, 3))
-    moved = ImuLog(t=log.t, gyro=gyro, accel=accel)
-    kw = dict(sigma_accel_m_s2=0.05, sigma_gyro_rad_s=0.05, threshold=10.0, gravity_m_s2=9.806)
-    rust = zupt.detect_stationary(moved, window_s=0.25, **kw)
-    py = detect_static(
-        moved, window_s=0.25, sigma_a=0.05, sigma_g=0.05, threshold=10.0, gravity=9.806, gyro_bias=np.zeros(3)
-    )
-    # uasnav.stationary differences cumulative sums of |a|² ≈ 96 (m/s²)² over the whole log,
-    # which cancels to ~1e-9 relative; the formulas agree well beyond any decision margin.
-    np.testing.assert_allclose(rust.statistic, py.statistic, rtol=1e-7)
-    np.testing.assert_array_equal(rust.mask, py.mask)
-    assert rust.mask[:700].all() and not rust.mask[850:1150].any() and rust.mask[1300:].all()
 
 
 def test_tczupt_cli_with_a_model_file_and_the_derivative_network(tmp_path):

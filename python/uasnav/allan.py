@@ -116,9 +116,53 @@ class AllanResult:
         errorbars: bool = True,
     ) -> Axes:
         """Log-log plot of σ(τ) with confidence intervals; returns the axes."""
-        from uasnav.plotting import allan_axes
+        return plot_adev(self, ax=ax, labels=labels, errorbars=errorbars)
 
-        return allan_axes(self, ax=ax, labels=labels, errorbars=errorbars)
+
+def plot_adev(
+    res: AllanResult,
+    ax: Axes | None = None,
+    labels: Sequence[str] | None = None,
+    errorbars: bool = True,
+    report: NoiseReport | None = None,
+) -> Axes:
+    """Log-log Allan deviation with χ² intervals, optional fitted model and slope guides."""
+    if ax is None:
+        from uasnav.plotting import new_figure
+
+        _, ax = new_figure()
+    adev = res.adev if res.adev.ndim == 2 else res.adev[:, None]
+    lo = res.ci_low if res.ci_low.ndim == 2 else res.ci_low[:, None]
+    hi = res.ci_high if res.ci_high.ndim == 2 else res.ci_high[:, None]
+    names = list(labels) if labels is not None else [f"axis {j}" for j in range(adev.shape[1])]
+    for j in range(adev.shape[1]):
+        (line,) = ax.loglog(res.taus, adev[:, j], "o-", ms=3, label=names[j])
+        if errorbars:
+            ax.fill_between(res.taus, lo[:, j], hi[:, j], color=line.get_color(), alpha=0.2, lw=0)
+        if report is not None:
+            model = report.model_adev()[:, j]
+            ax.loglog(res.taus, model, "--", color=line.get_color(), lw=1)
+    if report is not None and adev.size:
+        _slope_guides(ax, res, report)
+    ax.set_xlabel("cluster time τ (s)")
+    ax.set_ylabel(f"Allan deviation σ(τ) ({res.unit})" if res.unit else "Allan deviation σ(τ)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    return ax
+
+
+def _slope_guides(ax: Axes, res: AllanResult, report: NoiseReport) -> None:
+    """Dotted lines of slope −½ through N at τ = 1 s and +½ through K at τ = 3 s (axis 0)."""
+    t = res.taus
+    n = float(report.fit.random_walk[0])
+    k = float(report.fit.rate_random_walk[0])
+    b = float(report.fit.bias_instability[0])
+    if n > 0:
+        ax.loglog(t, n / np.sqrt(t), ":", color="grey", lw=1, label="slope −½ (N)")
+    if k > 0:
+        ax.loglog(t, k * np.sqrt(t / 3.0), ":", color="black", lw=1, label="slope +½ (K)")
+    if b > 0:
+        ax.axhline(0.664 * b, ls="-.", color="grey", lw=0.8, label="0.664·B")
 
 
 def _edf(n_phase: int, m: NDArray[np.int64], alpha: int) -> NDArray[np.float64]:
@@ -249,4 +293,4 @@ def oadev(
     )
 
 
-__all__ = ["AllanResult", "cluster_sizes", "oadev"]
+__all__ = ["AllanResult", "cluster_sizes", "oadev", "plot_adev"]

@@ -122,9 +122,25 @@ class DriftResult:
 
     def plot(self, ax: Axes | None = None, label: str | None = None) -> Axes:
         """Plot θ(t) with the thresholds; returns the axes."""
-        from uasnav.plotting import drift_axes
+        return plot_drift([(label or "θ(t)", self)], ax=ax)
 
-        return drift_axes([(label or "θ(t)", self)], ax=ax)
+
+def plot_drift(series: Sequence[tuple[str, DriftResult]], ax: Axes | None = None) -> Axes:
+    """θ(t) curves (rad) with the accuracy thresholds as horizontal lines."""
+    if ax is None:
+        from uasnav.plotting import new_figure
+
+        _, ax = new_figure()
+    for label, d in series:
+        ax.plot(d.t, d.theta, label=label)
+    if series:
+        for th in series[0][1].thresholds:
+            ax.axhline(th, color="grey", ls=":", lw=0.8)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("rotation angle θ (rad)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return ax
 
 
 def drift(
@@ -197,6 +213,7 @@ __all__ = [
     "delta_t_percent",
     "drift",
     "euler_to_quat",
+    "plot_drift",
     "propagate",
     "quat_to_dcm",
     "quat_to_euler",

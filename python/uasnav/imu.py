@@ -23,6 +23,9 @@ adds ``rate_true`` (n, 3) rad/s, ``specific_force_true`` (n, 3) m/s², ``gyro_bi
 ``mounting`` …). Helpers: :meth:`ImuLog.slice`, :meth:`ImuLog.between`,
 :meth:`ImuLog.segments` (e.g. the static intervals of :func:`uasnav.stationary.detect_static`)
 and :meth:`ImuLog.resample`.
+
+Files are read and written by :mod:`uasnav.io` (one module per format), which also holds the
+flight telemetry type beside this one, :class:`uasnav.io.flight.FlightLog`.
 """
 
 from __future__ import annotations

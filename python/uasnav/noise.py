@@ -30,15 +30,19 @@ numbers in SI with their units in the field names.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from uasnav import _core
-from uasnav.allan import AllanResult
 from uasnav.errors import InputError, UnitError
-from uasnav.units import convert, dimension
+from uasnav.units import convert, dimension, parse_quantity
+
+if TYPE_CHECKING:
+    # noise.identify reads an AllanResult's fields; allan imports noise for
+    # AllanResult.identify, so the type is needed for annotations only.
+    from uasnav.allan import AllanResult
 
 TERMS = ("quantization", "random_walk", "bias_instability", "rate_random_walk", "rate_ramp")
 
@@ -350,21 +354,11 @@ class FilterNoise:
         """From datasheet strings with units, e.g. ``arw="3.18 deg/√h"``, ``gbi="1.5e-4 deg/s"``,
         ``vrw="0.05 m/s/√h"``, ``abi="2 m/s/h"`` (the thesis' Tables 3–4)."""
 
-        def q(s: str, si: str) -> float:
-            parts = s.strip().split(maxsplit=1)
-            if len(parts) != 2:
-                raise UnitError(f"expected '<value> <unit>', got {s!r}")
-            try:
-                value = float(parts[0])
-            except ValueError:
-                raise InputError(f"not a number in {s!r}") from None
-            return float(convert(value, parts[1], si))
-
         return cls(
-            sigma_vrw_m_s_sqrt_s=q(vrw, "m/s/√s"),
-            sigma_arw_rad_sqrt_s=q(arw, "rad/√s"),
-            sigma_abi_m_s2=q(abi, "m/s^2"),
-            sigma_gbi_rad_s=q(gbi, "rad/s"),
+            sigma_vrw_m_s_sqrt_s=parse_quantity(vrw, "m/s/√s", what="vrw"),
+            sigma_arw_rad_sqrt_s=parse_quantity(arw, "rad/√s", what="arw"),
+            sigma_abi_m_s2=parse_quantity(abi, "m/s^2", what="abi"),
+            sigma_gbi_rad_s=parse_quantity(gbi, "rad/s", what="gbi"),
         )
 
     def white_sample_std(self, dt_s: float) -> tuple[float, float]:

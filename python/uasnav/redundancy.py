@@ -1,10 +1,21 @@
 """Redundant IMUs on regular polyhedra (thesis §4.3, eqs. 38–46).
 
-Geometry (:func:`configuration`, :func:`from_mountings`, :func:`kr`, :func:`table14`),
-weighted least-squares fusion with parity-space fault detection and isolation
-(:func:`fuse`, :func:`fuse_axes`), Kalman fusion with per-axis bias states
+Geometry (:class:`SensorArray`, built by :func:`configuration` and :func:`from_mountings`;
+:func:`kr`, :func:`table14`), weighted least-squares fusion with parity-space fault detection
+and isolation (:func:`fuse`, :func:`fuse_axes`), Kalman fusion with per-axis bias states
 (:func:`kalman_fuse`) and relative alignment (:func:`relative_alignment`,
 :func:`relative_rotation`). All numerics run in ``nav-core`` (``uasnav._core``).
+
+The log-file pipeline of ``uasnav redundancy fuse`` is here too: :func:`load_logs`,
+:func:`array_for_logs` (the sensor array from ``--shape`` or the logs' ``mounting`` metadata)
+and :func:`fuse_files` (both, then :func:`fuse`), whose :class:`FileFusion` gives the fused
+:class:`~uasnav.imu.ImuLog` to write with :func:`uasnav.io.write_log`.
+
+>>> cube = configuration("cube", 1, triaxial=True)   # the thesis' six-SensorTile cube
+>>> cube.n_sensors, cube.n_axes
+(6, 18)
+>>> [round(float(k), 3) for k in cube.k_r()]
+[0.408, 0.408, 0.408]
 
 Frames: the *IMU frame* is the polyhedron's frame (the cube's face normals are its x, y, z
 axes). A triaxial sensor's mounting ``C`` maps IMU-frame vectors into the sensor frame,
@@ -33,7 +44,9 @@ solids (their normals satisfy ``Σ n nᵀ = (F/3)·I``), and for triaxial sensor
 
 from __future__ import annotations
 
+import json
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -44,18 +57,10 @@ from numpy.typing import ArrayLike, NDArray
 from uasnav import _core
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog
+from uasnav.io import read_log
 
 SHAPES = ("tetrahedron", "cube", "octahedron", "dodecahedron", "icosahedron")
 FACES = {"tetrahedron": 4, "cube": 6, "octahedron": 8, "dodecahedron": 12, "icosahedron": 20}
-
-#: Thesis Table 14: (config no., gyros per face, total number of gyros, k_r).
-TABLE14_THESIS: tuple[tuple[int, float, int, float], ...] = (
-    (1, 0.5, 3, 1.0),
-    (2, 1.0, 6, 0.71),
-    (3, 1.5, 9, 0.58),
-    (4, 2.0, 12, 0.50),
-    (5, 3.0, 18, 0.41),
-)
 
 #: Health bit flags per sensor and sample (``FusionResult.health``).
 HEALTH_NON_FINITE = 1
@@ -67,8 +72,12 @@ FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class Configuration:
-    """A redundant sensor configuration: the rows of the design matrix ``H``.
+class SensorArray:
+    """A redundant sensor array (its configuration): the rows of the design matrix ``H``.
+
+    Built by :func:`configuration` (sensors on the faces of a polyhedron) or
+    :func:`from_mountings` (triaxial sensors with given mountings). Not to be confused with
+    :class:`uasnav.mission.RankedPair` (a ranked UAS/camera pair of the mission selector).
 
     Attributes
     ----------
@@ -135,7 +144,7 @@ def _face_counts(shape: str, per_face: float) -> list[int]:
     return [base + (extra if i < f // 2 else 0) for i in range(f)]
 
 
-def configuration(shape: str = "cube", per_face: float = 1, *, triaxial: bool = False) -> Configuration:
+def configuration(shape: str = "cube", per_face: float = 1, *, triaxial: bool = False) -> SensorArray:
     """Sensors on every face of a regular polyhedron.
 
     Parameters
@@ -155,10 +164,10 @@ def configuration(shape: str = "cube", per_face: float = 1, *, triaxial: bool = 
     """
     counts = _face_counts(shape, float(per_face))
     axes, sensor_of = _core.redundancy_face_config(shape, counts, bool(triaxial))
-    return Configuration(axes, sensor_of, shape=shape, per_face=float(per_face), triaxial=bool(triaxial))
+    return SensorArray(axes, sensor_of, shape=shape, per_face=float(per_face), triaxial=bool(triaxial))
 
 
-def from_mountings(mountings: ArrayLike, tol: float = 1e-6) -> Configuration:
+def from_mountings(mountings: ArrayLike, tol: float = 1e-6) -> SensorArray:
     """Triaxial sensors with user mountings (s, 3, 3) (IMU → sensor), validated as rotations.
 
     Raises
@@ -171,7 +180,7 @@ def from_mountings(mountings: ArrayLike, tol: float = 1e-6) -> Configuration:
     if m.ndim != 3 or m.shape[1:] != (3, 3):
         raise InputError(f"mountings: expected shape (s, 3, 3), got {m.shape}")
     axes, sensor_of = _core.redundancy_mountings_config(np.ascontiguousarray(m), float(tol))
-    return Configuration(axes, sensor_of, triaxial=True)
+    return SensorArray(axes, sensor_of, triaxial=True)
 
 
 def face_normals(shape: str) -> FloatArray:
@@ -184,17 +193,6 @@ def face_normals(shape: str) -> FloatArray:
 def kr(shape: str = "cube", per_face: float = 1, *, triaxial: bool = False) -> FloatArray:
     """``k_r`` per IMU axis (eq. 40) of :func:`configuration` ``(shape, per_face, triaxial)``."""
     return configuration(shape, per_face, triaxial=triaxial).k_r()
-
-
-def table14() -> list[tuple[int, float, int, float, float]]:
-    """Rows ``(config, gyros per face, total gyros, k_r thesis, k_r ours)`` of Table 14."""
-    rows = []
-    for no, per_face, total, ref in TABLE14_THESIS:
-        c = configuration("cube", per_face)
-        if c.n_axes != total:  # pragma: no cover - guards the documented arrangement
-            raise AssertionError(f"Table 14 row {no}: {c.n_axes} gyros, expected {total}")
-        rows.append((no, per_face, total, ref, float(c.k_r()[0])))
-    return rows
 
 
 def chi2_threshold(dof: int, p_fa: float) -> float:
@@ -217,7 +215,7 @@ def white_noise_sigma(z: ArrayLike) -> FloatArray:
     return out
 
 
-def parity_residuals(config: Configuration, z: ArrayLike, sigma: ArrayLike) -> FloatArray:
+def parity_residuals(config: SensorArray, z: ArrayLike, sigma: ArrayLike) -> FloatArray:
     """Least-squares residuals ``z − H·x̂`` (m, n) with weights ``1/σ²``; NaN rows where a
     sample is non-finite. Their mean over a window is the observable (parity-space) part of
     the axis biases; their spread measures how well the sensors agree."""
@@ -228,7 +226,7 @@ def parity_residuals(config: Configuration, z: ArrayLike, sigma: ArrayLike) -> F
     return _core.redundancy_parity_residuals(*config._args(), a, s)
 
 
-def robust_sigma(config: Configuration, z: ArrayLike, sigma: ArrayLike) -> FloatArray:
+def robust_sigma(config: SensorArray, z: ArrayLike, sigma: ArrayLike) -> FloatArray:
     """Per-axis σ (n,) implied by the robust spread of the parity residuals of ``z``.
 
     ``σ_i = 1.4826·MAD(r_i)/√(1 − h_ii)`` with ``h_ii = h_iᵀ(HᵀWH)⁻¹h_i/σ_i²`` the leverage of
@@ -285,7 +283,7 @@ class AxisFusion:
 
 
 def fuse_axes(
-    config: Configuration,
+    config: SensorArray,
     z: ArrayLike,
     *,
     sigma: ArrayLike | None = None,
@@ -301,7 +299,7 @@ def fuse_axes(
 
     Parameters
     ----------
-    config : Configuration
+    config : SensorArray
     z : array_like, shape (m, n)
         One column per sensor axis (``config.axes`` order); NaN marks a dropout.
     sigma : array_like, shape (n,), optional
@@ -401,13 +399,13 @@ class FusionResult:
         Sample times (s).
     gyro, accel : AxisFusion
         Fusion of the angular rate (rad/s) and of the specific force (m/s²).
-    config : Configuration
+    config : SensorArray
     """
 
     t: FloatArray
     gyro: AxisFusion
     accel: AxisFusion
-    config: Configuration
+    config: SensorArray
     meta: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -427,7 +425,7 @@ class FusionResult:
 
 def fuse(
     logs: Sequence[ImuLog],
-    config: Configuration | None = None,
+    config: SensorArray | None = None,
     *,
     fdi: bool = True,
     p_fa: float = 1e-6,
@@ -445,7 +443,7 @@ def fuse(
     ----------
     logs : sequence of ImuLog
         Sensor ``i``'s log, in its own sensor frame.
-    config : Configuration, optional
+    config : SensorArray, optional
         Triaxial configuration with one sensor per log; default: the logs' ``meta["mounting"]``
         (3×3, IMU → sensor) when every log has one, else an error.
     fdi, p_fa, stuck_samples
@@ -504,7 +502,7 @@ class KalmanResult:
 
 
 def kalman_fuse(
-    config: Configuration,
+    config: SensorArray,
     z: ArrayLike,
     dt: float,
     *,
@@ -576,21 +574,21 @@ class AlignmentResult:
     misalignment : ndarray, shape (s, 3)
         Small-angle rotation vector (rad) of ``relative[i]`` against the nominal relative
         rotation (zero if no nominal configuration was given).
-    config : Configuration or None
+    config : SensorArray or None
         Compensated configuration (mountings ``relative[i] · C_ref``) when a nominal
         configuration was given.
     """
 
     relative: FloatArray
     misalignment: FloatArray
-    config: Configuration | None
+    config: SensorArray | None
 
 
 def relative_alignment(
     vectors: ArrayLike,
     *,
     reference: int = 0,
-    nominal: Configuration | None = None,
+    nominal: SensorArray | None = None,
     differences: bool = True,
 ) -> AlignmentResult:
     """Relative rotations of sensors from vectors they measured together (Wahba, SVD).
@@ -603,7 +601,7 @@ def relative_alignment(
         of every attitude), or mean rates during distinct rotations.
     reference : int
         Index of the reference sensor (face 1 in the thesis' Figure 49).
-    nominal : Configuration, optional
+    nominal : SensorArray, optional
         Nominal triaxial configuration; returns misalignments against it and the compensated
         configuration whose mountings are ``C_br^bi · C_ref`` (the reference mounting is taken
         as nominal).
@@ -645,6 +643,187 @@ def relative_alignment(
     return AlignmentResult(rel, mis, comp)
 
 
+# --- log-file pipeline (``uasnav redundancy fuse``) ---------------------------------------------
+
+
+def load_logs(paths: Sequence[str | os.PathLike[str]]) -> list[ImuLog]:
+    """Read one triaxial sensor log per path (:func:`uasnav.io.read_log`: format by extension)."""
+    return [read_log(p) for p in paths]
+
+
+def array_for_logs(shape: str, logs: Sequence[ImuLog], *, names: Sequence[str] | None = None) -> SensorArray:
+    """The triaxial sensor array that carries ``logs`` (one log per sensor, in order).
+
+    Parameters
+    ----------
+    shape : str
+        A polyhedron of :data:`SHAPES` (the logs in its face order, filling its faces in whole
+        or half multiples: :func:`configuration` with ``per_face = len(logs)/F``),
+        ``"aligned"`` (every sensor in the IMU frame, e.g. an autopilot's IMUs) or ``"meta"``
+        (each log's ``meta["mounting"]``: a 3×3 IMU → sensor matrix, or its JSON text as read
+        from a ``# mounting:`` comment).
+    logs : sequence of ImuLog
+    names : sequence of str, optional
+        Names of the logs (e.g. file paths) for error messages; default ``logs[i]``.
+
+    Raises
+    ------
+    InputError
+        Unknown shape, a log without ``mounting`` (``"meta"``), a number of logs that does not
+        fill the polyhedron's faces, or mountings that are not rotations.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uasnav.imu import ImuLog
+    >>> logs = [ImuLog(t=[0.0, 0.01], gyro=np.zeros((2, 3)), accel=np.zeros((2, 3)))] * 12
+    >>> array_for_logs("cube", logs).per_face
+    2.0
+    >>> array_for_logs("aligned", logs[:3]).n_axes
+    9
+    """
+    n = len(logs)
+    labels = list(names) if names is not None else [f"logs[{i}]" for i in range(n)]
+    if shape == "aligned":
+        return from_mountings(np.repeat(np.eye(3)[None], n, axis=0))
+    if shape == "meta":
+        mounts = []
+        for p, lg in zip(labels, logs, strict=True):
+            if "mounting" not in lg.meta:
+                raise InputError(f"{p}: no '# mounting:' comment (needed by --shape meta)")
+            m = lg.meta["mounting"]
+            mounts.append(json.loads(m) if isinstance(m, str) else m)
+        return from_mountings(np.asarray(mounts, dtype=float))
+    if shape not in FACES:
+        raise InputError(f"shape: expected one of {', '.join(SHAPES)}, aligned, meta; got {shape!r}")
+    per_face = n / FACES[shape]
+    if abs(per_face * 2 - round(per_face * 2)) > 1e-9:
+        raise InputError(
+            f"logs: {n} triaxial sensors do not fill the {FACES[shape]} faces of a {shape} "
+            "in whole or half multiples"
+        )
+    return configuration(shape, per_face, triaxial=True)
+
+
+@dataclass(frozen=True)
+class FileFusion:
+    """Sensor log files fused into one IMU (:func:`fuse_files`).
+
+    Attributes
+    ----------
+    paths : tuple of str
+        The sensor logs, in sensor order.
+    shape : str
+        How the array was configured (see :func:`array_for_logs`).
+    result : FusionResult
+        The fusion; ``result.config`` is the sensor array.
+    """
+
+    paths: tuple[str, ...]
+    shape: str
+    result: FusionResult
+
+    @property
+    def health(self) -> NDArray[np.uint8]:
+        """Per-sensor bit flags (m, s) of both fusions (gyro | accel)."""
+        return self.result.gyro.health | self.result.accel.health
+
+    def fused_log(self) -> ImuLog:
+        """The valid fused samples (IMU frame) with the metadata ``fused_from`` (the paths),
+        ``shape``, ``fdi`` and ``dropped_samples`` (``# key: value`` lines in CSV v1).
+
+        Raises
+        ------
+        InputError
+            Fewer than two valid samples.
+        """
+        res = self.result
+        v = res.valid
+        if v.sum() < 2:
+            raise InputError("fused log: fewer than 2 valid samples (every sample failed FDI)")
+        meta = {
+            "fused_from": " ".join(self.paths),
+            "shape": self.shape,
+            "fdi": bool(res.meta.get("fdi", False)),
+            "dropped_samples": int((~v).sum()),
+        }
+        return ImuLog(t=res.t[v], gyro=res.gyro.value[v], accel=res.accel.value[v], meta=meta)
+
+    def extra_columns(self) -> dict[str, FloatArray]:
+        """Columns beside the fused log, valid samples only: ``chi2_gyro``, ``chi2_accel``
+        (parity statistics) and ``health_<i>`` (sensor i's bit flags :data:`HEALTH_NON_FINITE`
+        …, as floats)."""
+        res = self.result
+        v = res.valid
+        cols = {"chi2_gyro": res.gyro.chi2[v], "chi2_accel": res.accel.chi2[v]}
+        health = self.health
+        for i in range(res.config.n_sensors):
+            cols[f"health_{i}"] = health[v, i].astype(np.float64)
+        return cols
+
+    def summary(self) -> dict[str, Any]:
+        """Counts (samples, written, dropped, parity alarms, flagged samples per sensor), k_r
+        and the white-noise σ per axis (rad/s, m/s²) used as weights."""
+        res = self.result
+        v = res.valid
+        health = self.health
+        return {
+            "n_samples": int(res.t.size),
+            "written": int(v.sum()),
+            "dropped": int((~v).sum()),
+            "alarms_gyro": int(res.gyro.alarm.sum()),
+            "alarms_accel": int(res.accel.alarm.sum()),
+            "flagged_samples_per_sensor": {
+                i: int(np.count_nonzero(health[:, i])) for i in range(res.config.n_sensors)
+            },
+            "k_r": res.config.k_r(),
+            "gyro_sigma_rad_s": res.gyro.sigma,
+            "accel_sigma_m_s2": res.accel.sigma,
+        }
+
+
+def fuse_files(
+    paths: Sequence[str | os.PathLike[str]],
+    shape: str = "cube",
+    *,
+    fdi: bool = False,
+    p_fa: float = 1e-6,
+    learn_bias_s: float = 10.0,
+    stuck_samples: int = 20,
+    time_tol_s: float = 1e-6,
+) -> FileFusion:
+    """Read triaxial sensor logs, configure their array and fuse them (``uasnav redundancy fuse``).
+
+    Parameters
+    ----------
+    paths : sequence of path
+        One log per sensor, same sample times (:func:`load_logs`).
+    shape : str
+        See :func:`array_for_logs`.
+    fdi, p_fa : bool, float
+        Parity-space FDI and its false-alarm probability per sample (:func:`fuse_axes`).
+    learn_bias_s : float
+        Seconds at the start used to learn the parity-space biases (with ``fdi`` only).
+    stuck_samples : int
+        Repeated samples flagging a stuck output (with ``fdi`` only; 0 = off).
+    time_tol_s : float
+        Tolerance on the sensors' sample times (s).
+    """
+    names = tuple(str(p) for p in paths)
+    logs = load_logs(paths)
+    cfg = array_for_logs(shape, logs, names=names)
+    res = fuse(
+        logs,
+        cfg,
+        fdi=fdi,
+        p_fa=p_fa,
+        stuck_samples=stuck_samples if fdi else 0,
+        parity_bias_s=learn_bias_s if fdi else 0.0,
+        time_tol_s=time_tol_s,
+    )
+    return FileFusion(paths=names, shape=shape, result=res)
+
+
 __all__ = [
     "FACES",
     "HEALTH_NON_FINITE",
@@ -652,26 +831,28 @@ __all__ = [
     "HEALTH_SATURATED",
     "HEALTH_STUCK",
     "SHAPES",
-    "TABLE14_THESIS",
     "AlignmentResult",
     "AxisFusion",
-    "Configuration",
+    "FileFusion",
     "FusionResult",
     "KalmanResult",
+    "SensorArray",
+    "array_for_logs",
     "chi2_threshold",
     "configuration",
     "face_normals",
     "from_mountings",
     "fuse",
     "fuse_axes",
+    "fuse_files",
     "kalman_fuse",
     "kr",
     "level",
+    "load_logs",
     "parity_residuals",
     "relative_alignment",
     "relative_rotation",
     "robust_sigma",
     "stack_logs",
-    "table14",
     "white_noise_sigma",
 ]

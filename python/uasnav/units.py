@@ -10,16 +10,19 @@ Examples
 0.000925
 >>> convert(1.0, "g", "m/s^2")
 9.80665
+>>> parse_quantity("15deg/h", "rad/s") == convert(15.0, "deg/h", "rad/s")  # command-line text
+True
 """
 
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from uasnav.errors import UnitError
+from uasnav.errors import InputError, UnitError
 
 #: Standard gravity (m/s²), the conventional value used for "g" and "mg" units.
 STANDARD_GRAVITY = 9.80665
@@ -182,9 +185,60 @@ def to_si(value: ArrayLike, unit: str) -> NDArray[np.float64] | float:
     return float(arr) if arr.ndim == 0 else arr
 
 
+# A decimal number (no inf/nan), then the unit; the space between them is optional.
+_QUANTITY = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*")
+
+
+def parse_quantity(text: str, to: str, *, what: str | None = None) -> float:
+    """Parse ``"<number><unit>"`` text (``"15deg/h"``, ``"7e-5 rad/s"``, ``"3.18 deg/√h"``) into
+    a float in unit ``to``, refusing a unit of another dimension.
+
+    The one parser of quantities written as text (command-line options, datasheet strings):
+    the unit is any name :func:`lookup` knows, with its ASCII spellings (``deg/sqrt(h)``).
+
+    Parameters
+    ----------
+    text : str
+        A decimal number followed by a unit; the space between them is optional.
+    to : str
+        Unit of the result; must have the dimension of the unit in ``text``.
+    what : str, optional
+        Name of the option or field, put in front of error messages (e.g. ``"--residual-bias"``).
+
+    Returns
+    -------
+    float
+        The value in ``to``.
+
+    Raises
+    ------
+    InputError
+        ``text`` is not a string holding a number followed by a unit.
+    UnitError
+        The unit is unknown or of another dimension than ``to`` (an :class:`InputError`).
+
+    Examples
+    --------
+    >>> parse_quantity("2 m/s/h", "m/s^2") == 2.0 / 3600.0
+    True
+    >>> parse_quantity("15 m/s", "rad/s", what="--residual-bias")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    uasnav.errors.UnitError: --residual-bias: '15 m/s': cannot convert 'm/s' ... different dimensions
+    """
+    where = f"{what}: " if what else ""
+    m = _QUANTITY.fullmatch(text) if isinstance(text, str) else None
+    if m is None or not m.group(2):
+        raise InputError(f"{where}expected '<number><unit>', e.g. '15deg/h', got {text!r}")
+    try:
+        return float(convert(float(m.group(1)), m.group(2), to))
+    except UnitError as e:
+        raise UnitError(f"{where}{text!r}: {e}") from None
+
+
 def known_units() -> list[str]:
     """All unit names :func:`convert` accepts."""
     return sorted(_UNITS)
 
 
-__all__ = ["STANDARD_GRAVITY", "convert", "dimension", "known_units", "lookup", "to_si"]
+__all__ = ["STANDARD_GRAVITY", "convert", "dimension", "known_units", "lookup", "parse_quantity", "to_si"]

@@ -29,25 +29,29 @@ to 1e-5 rad/s (Table 11) and the statistics over five consecutive 5-minute segme
 from __future__ import annotations
 
 import dataclasses
+import os
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal, Protocol
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from uasnav import _core
+from uasnav.earth import OMEGA_IE
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog
 from uasnav.noise import FilterNoise
+from uasnav.stationary import MAX_WINDOW_SAMPLES, StaticIntervals, detect_static
+from uasnav.units import STANDARD_GRAVITY
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
+    from uasnav.thermal.base import BiasModel
+
 FloatArray = NDArray[np.float64]
 Mode = Literal["zupt", "tczupt"]
 
-#: WGS-84 Earth rotation rate (rad/s).
-OMEGA_IE = 7.292115e-5
 #: Convergence threshold of the thesis' Table 11 (rad/s).
 CONVERGENCE_THRESHOLD = 1e-5
 #: Moving-average window of the thesis' reference (s), Table 9.
@@ -73,18 +77,6 @@ STATE_NAMES = (
     "rN", "rE", "rD", "vN", "vE", "vD", "psiN", "psiE", "psiD",
     "bax", "bay", "baz", "bgx", "bgy", "bgz",
 )  # fmt: skip
-
-
-class ThermalModel(Protocol):
-    """What :func:`run` needs of a thermal bias model (``uasnav.thermal`` models fit)."""
-
-    def predict(self, temp: ArrayLike) -> FloatArray:
-        """Gyro bias (n, 3) rad/s at die temperatures ``temp`` (n,) °C."""
-        ...
-
-    def derivative(self, temp: ArrayLike) -> FloatArray:
-        """∂b/∂T (n, 3) rad/s/°C at die temperatures ``temp`` (n,) °C."""
-        ...
 
 
 @dataclass(frozen=True)
@@ -287,19 +279,16 @@ class ZuptResult:
         ax.legend(fontsize=8)
         return ax
 
-    def to_csv(self, path: str) -> None:
-        """Write ``t,bgx,bgy,bgz,bax,bay,baz`` (s, rad/s, m/s²), then the attitude ``q0..q3``
-        and the 1σ of the gyro and accelerometer biases, atomically."""
-        import io
-
-        from uasnav.atomicfile import atomic_write_text
+    def to_csv(self, path: str | os.PathLike[str]) -> None:
+        """Write the CLI's EST.csv atomically (:func:`uasnav.io.write_csv_table`, columns
+        :data:`CSV_COLUMNS`): ``t,bgx,bgy,bgz,bax,bay,baz`` (s, rad/s, m/s²), then the attitude
+        ``q0..q3`` and the 1σ of the gyro and accelerometer biases."""
+        from uasnav.io import write_csv_table
 
         cols = np.column_stack(
             [self.t, self.gyro_bias, self.accel_bias, self.attitude, self.gyro_bias_std, self.accel_bias_std]
         )
-        buf = io.StringIO()
-        np.savetxt(buf, cols, fmt="%.10g", delimiter=",", header=",".join(CSV_COLUMNS), comments="")
-        atomic_write_text(path, buf.getvalue())
+        write_csv_table(path, dict(zip(CSV_COLUMNS, cols.T, strict=True)))
 
 
 def _match_rows(name: str, a: ArrayLike, m: int) -> FloatArray:
@@ -312,7 +301,7 @@ def _match_rows(name: str, a: ArrayLike, m: int) -> FloatArray:
 def run(
     log: ImuLog,
     mode: Mode = "zupt",
-    model: ThermalModel | None = None,
+    model: BiasModel | None = None,
     config: ZuptConfig | None = None,
     *,
     stationary: ArrayLike | Literal["auto"] | None = None,
@@ -325,8 +314,9 @@ def run(
         Uniformly sampled log; ``temp`` (°C) is required for TCZUPT and for ZUPT with a model.
     mode : {"zupt", "tczupt"}
         See the module docs.
-    model : object with ``predict(temp)`` and ``derivative(temp)`` (rad/s, rad/s/°C), optional
-        Thermal bias model. ZUPT: subtracted before filtering (None → data already calibrated).
+    model : uasnav.thermal.base.BiasModel, optional
+        Thermal bias model; only its ``predict(temp)`` (rad/s) and ``derivative(temp)``
+        (rad/s/°C) are used. ZUPT: subtracted before filtering (None → data already calibrated).
         TCZUPT: required; its derivative drives eq. (31).
     config : ZuptConfig, optional
     stationary : array_like of bool, shape (n,), or "auto", optional
@@ -417,23 +407,8 @@ def run(
     )
 
 
-@dataclass(frozen=True)
-class StationarityResult:
-    """Output of :func:`detect_stationary`.
-
-    Attributes
-    ----------
-    mask : ndarray of bool, shape (n,)
-        True where the unit is declared stationary (``statistic < threshold``).
-    statistic : ndarray, shape (n,)
-        GLRT statistic T (dimensionless) over the centred window.
-    intervals : list of (float, float)
-        ``(t_start, t_end)`` (s) of each stationary run.
-    """
-
-    mask: NDArray[np.bool_]
-    statistic: FloatArray
-    intervals: list[tuple[float, float]]
+#: The result type of :func:`detect_stationary` (the one static-detection result type).
+StationarityResult = StaticIntervals
 
 
 def detect_stationary(
@@ -443,8 +418,8 @@ def detect_stationary(
     sigma_accel_m_s2: float = 0.05,
     sigma_gyro_rad_s: float = 0.01,
     threshold: float = 10.0,
-    gravity_m_s2: float = 9.80665,
-) -> StationarityResult:
+    gravity_m_s2: float = STANDARD_GRAVITY,
+) -> StaticIntervals:
     """Per-sample stationarity by the generalised likelihood ratio test ("SHOE", Skog et al.
     2010) computed in Rust (``nav_core::zupt::StationarityDetector``, the same test the
     filter can run per sample on a microcontroller).
@@ -453,25 +428,24 @@ def detect_stationary(
     stationary where ``T < threshold``. The defaults (σ_a = 0.05 m/s², σ_ω = 0.01 rad/s,
     0.25 s, γ = 10) give T ≈ 2–3 for a consumer MEMS IMU at rest and 10²–10⁴ in motion; raise
     the σ for noisier sensors.
+
+    This is :func:`uasnav.stationary.detect_static` with these fixed thresholds, no gyro bias
+    removed, and the window rounded to 1–256 samples (clamped, as the filter's detector is)
+    at the median sample rate.
     """
-    rate = log.sample_rate
-    w = max(1, min(256, round(window_s * rate)))
-    stat, mask = _core.zupt_detect_static(
-        np.ascontiguousarray(log.accel),
-        np.ascontiguousarray(log.gyro),
-        sigma_accel_m_s2=sigma_accel_m_s2,
-        sigma_gyro_rad_s=sigma_gyro_rad_s,
+    w = max(1, min(MAX_WINDOW_SAMPLES, round(window_s * log.sample_rate), log.n))
+    return detect_static(
+        log,
         window_samples=w,
+        sigma_a=sigma_accel_m_s2,
+        sigma_g=sigma_gyro_rad_s,
         threshold=threshold,
-        gravity_m_s2=gravity_m_s2,
+        gravity=gravity_m_s2,
+        gyro_bias=np.zeros(3),
     )
-    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
-    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
-    intervals = [(float(log.t[a]), float(log.t[b])) for a, b in zip(starts, ends, strict=True)]
-    return StationarityResult(mask=mask, statistic=stat, intervals=intervals)
 
 
-def _model_derivative(model: ThermalModel, temp: FloatArray, method: str, n: int) -> FloatArray:
+def _model_derivative(model: BiasModel, temp: FloatArray, method: str, n: int) -> FloatArray:
     if method == "analytic":
         return _model_rows("model.derivative(temp)", model.derivative(temp), n)
     try:
@@ -516,7 +490,7 @@ def moving_average_reference(
     initial_attitude: ArrayLike,
     *,
     latitude_deg: float = 45.0,
-    model: ThermalModel | None = None,
+    model: BiasModel | None = None,
     window_s: float = REFERENCE_WINDOW_S,
 ) -> FloatArray:
     """The thesis' benchmark (Table 9): 30 s moving average of the (calibrated when ``model``
@@ -533,7 +507,7 @@ def reference_residual(
     initial_attitude: ArrayLike,
     *,
     latitude_deg: float = 45.0,
-    model: ThermalModel | None = None,
+    model: BiasModel | None = None,
 ) -> FloatArray:
     """Table 9: absolute mean (3,) rad/s of the residuals ``gyro − C_nᵇ·ω_ie − reference`` of
     the moving-average reference (calibrated gyro when ``model`` is given)."""
@@ -575,7 +549,7 @@ def segment_rms(
     mode: Mode,
     reference: ArrayLike,
     *,
-    model: ThermalModel | None = None,
+    model: BiasModel | None = None,
     config: ZuptConfig | None = None,
     segments: int = 5,
     segment_s: float = 300.0,
@@ -606,7 +580,6 @@ __all__ = [
     "THESIS_TCZUPT_NOISE",
     "THESIS_ZUPT_NOISE",
     "StationarityResult",
-    "ThermalModel",
     "ZuptConfig",
     "ZuptResult",
     "convergence_time",

@@ -3,26 +3,13 @@
 from __future__ import annotations
 
 import json
-import math
 from typing import Any
 
 import click
-import numpy as np
 
-
-def to_jsonable(obj: Any) -> Any:
-    """Convert numpy scalars/arrays (recursively) to plain JSON types; non-finite → None."""
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, np.generic):
-        return to_jsonable(obj.item())
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
+from uasnav.errors import InputError
+from uasnav.jsonable import to_jsonable
+from uasnav.units import parse_quantity
 
 
 def echo_json(obj: Any) -> None:
@@ -39,3 +26,29 @@ def parse_float_list(text: str, what: str) -> list[float]:
     if not vals:
         raise click.BadParameter(f"{what}: empty list")
     return vals
+
+
+class Quantity(click.ParamType):
+    """A click option type for a quantity with its unit (``"15deg/h"``, ``"7e-5 rad/s"``),
+    converted to a float in ``unit`` by :func:`uasnav.units.parse_quantity`.
+
+    A malformed value or a unit of another dimension is a usage error (exit code 2) naming
+    the option and the text, e.g.
+    ``@click.option("--residual-bias", type=Quantity("rad/s"), default="0 rad/s")``.
+    """
+
+    name = "quantity"
+
+    def __init__(self, unit: str) -> None:
+        self.unit = unit
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> float:
+        if isinstance(value, float):  # already converted (a default given as a number)
+            return value
+        try:
+            return parse_quantity(value, self.unit)
+        except InputError as e:
+            self.fail(str(e), param, ctx)
+
+    def __repr__(self) -> str:
+        return f"Quantity({self.unit!r})"

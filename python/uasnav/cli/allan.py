@@ -76,12 +76,13 @@ def command(log: str, rate: float | None, taus: str, as_json: bool, plot_path: s
 
 
 def _plot(reports: dict, path: str) -> None:
-    from uasnav.plotting import allan_axes, new_figure, save_png
+    from uasnav.allan import plot_adev
+    from uasnav.plotting import new_figure, save_png
 
     fig, ax = new_figure(11, 4.5)
     ax.remove()
     axes = fig.subplots(1, 2)
     for a, (kind, r) in zip(axes, reports.items(), strict=True):
-        allan_axes(r.curve, ax=a, labels=[f"{kind} x", f"{kind} y", f"{kind} z"], report=r)
+        plot_adev(r.curve, ax=a, labels=[f"{kind} x", f"{kind} y", f"{kind} z"], report=r)
         a.set_title(f"{kind}: Allan deviation, fit (dashed), slope guides")
     save_png(fig, path)

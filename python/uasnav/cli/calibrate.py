@@ -13,39 +13,12 @@ that truth.
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 from typing import Any
 
 import click
-import numpy as np
 
 from uasnav.cli._common import echo_json
-from uasnav.errors import InputError
-
-
-def _bin_average(
-    t: np.ndarray, temp: np.ndarray, gyro: np.ndarray, seconds: float
-) -> tuple[np.ndarray, np.ndarray]:
-    if seconds <= 0:
-        return temp, gyro
-    idx = np.floor((t - t[0]) / seconds).astype(np.int64)
-    counts = np.bincount(idx)
-    ok = counts > 0
-    tm = np.bincount(idx, temp)[ok] / counts[ok]
-    gm = np.stack([np.bincount(idx, g)[ok] for g in gyro.T], 1) / counts[ok][:, None]
-    return tm, gm
-
-
-def _residual_stats(res: np.ndarray) -> dict[str, Any]:
-    from uasnav.thermal import sr
-
-    return {
-        "mean": res.mean(axis=0),
-        "rms": np.sqrt(np.mean(res**2, axis=0)),
-        "max_abs": np.abs(res).max(axis=0),
-        "sr": sr(res),
-    }
 
 
 @click.command("calibrate")
@@ -78,8 +51,6 @@ def command(
     as_json: bool,
 ) -> None:
     """Fit a thermal gyro-bias model to TRAIN (static log with temp), or test --model on --test."""
-    from uasnav.io import read_log
-
     if model_path or test_path:
         if train is not None or out is not None:
             raise click.UsageError(
@@ -93,19 +64,9 @@ def command(
         raise click.UsageError("fitting needs TRAIN and --out MODEL.json")
     if (method == "poly" and hidden is not None) or (method == "nn" and order is not None):
         raise click.UsageError("--order goes with --method poly, --hidden with --method nn")
-    from uasnav.thermal import (
-        NeuralBiasModel,
-        PolynomialBiasModel,
-        select_hidden_neurons,
-        select_polynomial_order,
-    )
+    from uasnav.thermal import fit_neural, fit_polynomial, load_training_data
 
-    log = read_log(train)
-    if log.temp is None:
-        raise InputError(f"{train}: no temp column; thermal calibration needs the sensor temperature")
-    temp, bias = _bin_average(log.t, log.temp, log.gyro, average)
-    if temp.size < 20:
-        raise InputError(f"{train}: only {temp.size} samples after {average} s averaging; need at least 20")
+    temp, bias = load_training_data(train, average)
     summary: dict[str, Any] = {
         "train": train,
         "n_samples": int(temp.size),
@@ -115,27 +76,23 @@ def command(
     written = []
     meta = {"train_file": str(train), "average_s": average, "seed": seed}
     if method in ("poly", "both"):
-        m = order if order is not None else 2
-        if select:
-            sel = select_polynomial_order(temp, bias, seed=seed)
-            m = sel.chosen
-            summary["poly_selection"] = {"orders": sel.candidates, "sr": sel.sr, "chosen": m}
-        poly = PolynomialBiasModel(m).fit(temp, bias)
+        poly = fit_polynomial(temp, bias, order=order, select=select, seed=seed)
+        if poly.selection is not None:
+            sel = poly.selection
+            summary["poly_selection"] = {"orders": sel.candidates, "sr": sel.sr, "chosen": sel.chosen}
         path = outp if method == "poly" else outp.with_suffix(".poly.json")
-        poly.save(str(path), training={**meta, "order": m})
+        poly.model.save(str(path), training={**meta, "order": poly.size})
         written.append(str(path))
-        summary["poly_order"] = m
+        summary["poly_order"] = poly.size
     if method in ("nn", "both"):
-        n = hidden if hidden is not None else 2
-        if select:
-            sel = select_hidden_neurons(temp, bias, seed=seed)
-            n = sel.chosen
-            summary["nn_selection"] = {"neurons": sel.candidates, "sr": sel.sr, "chosen": n}
-        nn = NeuralBiasModel(n, seed=seed, derivative_network=True).fit(temp, bias)
+        nn = fit_neural(temp, bias, hidden=hidden, select=select, seed=seed)
+        if nn.selection is not None:
+            sel = nn.selection
+            summary["nn_selection"] = {"neurons": sel.candidates, "sr": sel.sr, "chosen": sel.chosen}
         path = outp if method == "nn" else outp.with_suffix(".nn.json")
-        nn.save(str(path), training={**meta, "hidden": n})
+        nn.model.save(str(path), training={**meta, "hidden": nn.size})
         written.append(str(path))
-        summary["nn_hidden"] = n
+        summary["nn_hidden"] = nn.size
     summary["written"] = written
     if as_json:
         echo_json(summary)
@@ -148,33 +105,27 @@ def command(
 
 def _test(model_path: str, test_path: str, as_json: bool) -> None:
     from uasnav.io import read_log
-    from uasnav.thermal import TemperatureRangeWarning, load_model
+    from uasnav.thermal import evaluate_model, load_model
 
     model = load_model(model_path)
-    log = read_log(test_path)
-    if log.temp is None:
-        raise InputError(f"{test_path}: no temp column; cannot evaluate a thermal model")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", TemperatureRangeWarning)
-        pred, clipped = model.predict(log.temp, return_clipped=True)
+    ev = evaluate_model(model, read_log(test_path), source=test_path)
     out: dict[str, Any] = {
         "model": model_path,
         "kind": model.kind,
         "test": test_path,
-        "n_samples": log.n,
-        "clipped_samples": int(clipped.sum()),
+        "n_samples": ev.n_samples,
+        "clipped_samples": ev.clipped_samples,
         "calibrated_range_c": list(model.range_c_),
         "units": "rad/s",
-        "residual": _residual_stats(log.gyro - pred),
+        "residual": ev.residual.to_dict(),
     }
-    key = next((k for k in ("gyro_bias_thermal", "gyro_bias") if k in log.truth), None)
-    if key is not None:
-        out["error_vs_truth"] = {"truth": key, **_residual_stats(log.truth[key] - pred)}
+    if ev.error_vs_truth is not None:
+        out["error_vs_truth"] = {"truth": ev.truth_key, **ev.error_vs_truth.to_dict()}
     if as_json:
         echo_json(out)
         return
     click.echo(
-        f"{model_path} ({model.kind}) on {test_path}: {log.n} samples, {out['clipped_samples']} clipped"
+        f"{model_path} ({model.kind}) on {test_path}: {ev.n_samples} samples, {ev.clipped_samples} clipped"
     )
     for name in ("residual", "error_vs_truth"):
         if name in out:

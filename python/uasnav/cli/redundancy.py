@@ -111,69 +111,20 @@ def fuse_command(
     2 saturated, 4 stuck, 8 isolated by the parity test). Samples where no valid fusion is
     possible are left out and counted.
     """
-    import json
+    from uasnav.io.csv_v1 import write_csv_v1
+    from uasnav.redundancy import fuse_files
 
-    from uasnav.atomicfile import atomic_open
-    from uasnav.errors import InputError
-    from uasnav.io import read_log
-    from uasnav.redundancy import FACES, configuration, from_mountings, fuse
-
-    data = [read_log(p) for p in logs]
-    n = len(data)
-    if shape == "aligned":
-        cfg = from_mountings(np.repeat(np.eye(3)[None], n, axis=0))
-    elif shape == "meta":
-        mounts = []
-        for p, lg in zip(logs, data, strict=True):
-            if "mounting" not in lg.meta:
-                raise InputError(f"{p}: no '# mounting:' comment (needed by --shape meta)")
-            m = lg.meta["mounting"]
-            mounts.append(json.loads(m) if isinstance(m, str) else m)
-        cfg = from_mountings(np.asarray(mounts, dtype=float))
-    else:
-        per_face = n / FACES[shape]
-        if abs(per_face * 2 - round(per_face * 2)) > 1e-9:
-            raise InputError(
-                f"logs: {n} triaxial sensors do not fill the {FACES[shape]} faces of a {shape} "
-                "in whole or half multiples"
-            )
-        cfg = configuration(shape, per_face, triaxial=True)
-    res = fuse(
-        data,
-        cfg,
-        fdi=fdi,
-        p_fa=p_fa,
-        stuck_samples=stuck if fdi else 0,
-        parity_bias_s=learn_bias if fdi else 0.0,
-        time_tol_s=1e-6,
+    fused = fuse_files(
+        logs, shape, fdi=fdi, p_fa=p_fa, learn_bias_s=learn_bias, stuck_samples=stuck, time_tol_s=1e-6
     )
-    v = res.valid
-    health = res.gyro.health | res.accel.health
-    cols = ["t", "gx", "gy", "gz", "ax", "ay", "az", "chi2_gyro", "chi2_accel"]
-    cols += [f"health_{i}" for i in range(cfg.n_sensors)]
-    block = np.column_stack(
-        [res.t, res.gyro.value, res.accel.value, res.gyro.chi2, res.accel.chi2, health.astype(float)]
-    )[v]
-    with atomic_open(out_path, "w") as fh:
-        fh.write("# uasnav log format v1 (SI units: s, rad/s, m/s^2, degC, uT)\n")
-        fh.write(f"# fused_from: {' '.join(logs)}\n")
-        fh.write(f"# shape: {shape}\n# fdi: {fdi}\n# dropped_samples: {int((~v).sum())}\n")
-        fh.write(",".join(cols) + "\n")
-        np.savetxt(fh, block, fmt="%.17g", delimiter=",")
-    flagged = {i: int(np.count_nonzero(health[:, i])) for i in range(cfg.n_sensors)}
-    k = cfg.k_r()
-    summary = {
-        "out": out_path,
-        "n_samples": int(res.t.size),
-        "written": int(v.sum()),
-        "dropped": int((~v).sum()),
-        "alarms_gyro": int(res.gyro.alarm.sum()),
-        "alarms_accel": int(res.accel.alarm.sum()),
-        "flagged_samples_per_sensor": flagged,
-        "k_r": k,
-        "gyro_sigma_rad_s": res.gyro.sigma,
-        "accel_sigma_m_s2": res.accel.sigma,
-    }
+    # CSV v1 whatever the extension (as always); the fused log's metadata become the
+    # `# key: value` lines, the χ² and health flags extra columns.
+    write_csv_v1(fused.fused_log(), out_path, extra_columns=fused.extra_columns())
+    summary = {"out": out_path, **fused.summary()}
+    n = len(logs)
+    cfg = fused.result.config
+    k = summary["k_r"]
+    flagged = summary["flagged_samples_per_sensor"]
     if as_json:
         echo_json(summary)
         return

@@ -109,6 +109,7 @@ def command(
         load_regulations,
         select,
     )
+    from uasnav.mission.regulations import DEFAULT_CATEGORY
 
     size = _parse_size(image_size)
     if weights:
@@ -133,7 +134,7 @@ def command(
                 raise click.BadParameter(f"--targets: {k}={v!r} is not TARGET:LIMIT")
         t = Targets(**{**t.__dict__, **kw})
     if category is None:
-        category = {"easa": "open", "faa": "part107"}.get(jurisdiction)
+        category = DEFAULT_CATEGORY.get(jurisdiction)
         if category is None:
             raise InputError(f"--jurisdiction {jurisdiction!r}: give --category too")
     req = Requirements(
@@ -184,10 +185,10 @@ def command(
         f"resolution {w.resolution:g}; lower is better):"
     )
     click.echo(f"  {'#':>2} {'UAS':<30} {'camera':<26} {'score':>6} {'mass g':>7} {'cost $':>7}  open")
-    for k, c in enumerate(sel.ranking, 1):
+    for rank_no, pair in enumerate(sel.ranking, 1):
         click.echo(
-            f"  {k:>2} {c.uas:<30} {c.camera:<26} {c.score:6.2f} {c.mass_g:7.0f} {c.cost_usd:7.0f}"
-            f"  {c.open_subcategory or '-'}"
+            f"  {rank_no:>2} {pair.uas:<30} {pair.camera:<26} {pair.score:6.2f} {pair.mass_g:7.0f}"
+            f" {pair.cost_usd:7.0f}  {pair.open_subcategory or '-'}"
         )
     if not sel.ranking:
         click.echo("  (no feasible configuration)")

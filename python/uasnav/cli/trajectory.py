@@ -22,40 +22,6 @@ def parse_wind(text: str) -> np.ndarray:
     return wind_vector(speed, direction)
 
 
-def _flight_samples(paths, plan, speed, wind, segment, max_gap):  # type: ignore[no-untyped-def]
-    """Element samples of every mission run of every flight file (run index across files)."""
-    from uasnav.trajectory.geometry import geodetic_to_local
-    from uasnav.trajectory.plans import read_plan
-    from uasnav.trajectory.samples import ElementSamples, measure_elements
-    from uasnav.trajectory.telemetry import read_flight, run_samples
-
-    runs_all, samples_all = [], []
-    for path in paths:
-        log = read_flight(path)
-        if log.waypoints:
-            runs, samples = run_samples(log, segment, speed, wind, max_gap_s=max_gap)
-        else:
-            if plan is None:
-                raise InputError(f"{path}: no mission waypoints in the log; give --plan")
-            plan_ne, origin = read_plan(plan)
-            if origin is None:
-                raise InputError("--plan for telemetry must be geodetic (lat,lon,alt)")
-            if speed is None:
-                raise InputError(f"{path}: no waypoint speed in the log; give --speed")
-            pos = geodetic_to_local(log.lat, log.lon, log.alt, origin=origin)[:, :2]
-            w = wind if wind is not None else (log.wind_ne if log.wind_ne is not None else np.zeros(2))
-            _, s = measure_elements(
-                plan_ne, log.t, pos, log.vel_ned[:, :2], w, speed, segment, max_gap_s=max_gap
-            )
-            runs, samples = [None], [s]
-        for r, s in zip(runs, samples, strict=True):
-            k = len(samples_all)
-            s.flight[:] = k
-            runs_all.append((path, r))
-            samples_all.append(s)
-    return runs_all, samples_all, ElementSamples
-
-
 @click.group("trajectory")
 def command() -> None:
     """Trajectory prediction with LVQ networks: element times, ETA and 4D waypoint times."""
@@ -99,16 +65,17 @@ def _apply(opts):  # type: ignore[no-untyped-def]
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, prototypes, seed, as_json):  # type: ignore[no-untyped-def]
     """Train a model on the flown elements of FLIGHT... (.tlog, .bin, .ulg, .csv) and write it."""
+    from uasnav.trajectory.flights import flight_samples
     from uasnav.trajectory.predictor import TrajectoryPredictor
 
     wind = parse_wind(wind_text) if wind_text else None
-    _, samples, es = _flight_samples(flights, plan, speed, wind, segment, max_gap)
-    all_s = es.concat(samples)
+    fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
+    all_s = fs.concat()
     model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
     model.save(out)
     info = {
         "model": out,
-        "n_runs": len(samples),
+        "n_runs": len(fs),
         "n_elements": len(all_s),
         "n_classes": int((model.count_table_ > 0).sum()),
         "cruise_ms": model.cruise_ms_,
@@ -136,7 +103,6 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
     With --required, also checks the 4D plan's feasibility: each waypoint reached within
     --tolerance of its required time (exit code 0 either way; see "feasible").
     """
-    from uasnav.trajectory.geometry import KINDS
     from uasnav.trajectory.plans import read_plan
     from uasnav.trajectory.predictor import TrajectoryPredictor
 
@@ -171,7 +137,6 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
             out["waypoint_ok"] = feas.ok
         echo_json(out)
         return
-    del KINDS
     click.echo(f"{'#':>3} {'kind':8} {'L m':>6} {'θ°':>6} {'θw°':>6} {'ΔV m/s':>7} {'t s':>7}")
     for r in rows:
         mark = "  *low confidence: " + "; ".join(r["flags"]) if r["flags"] else ""
@@ -196,11 +161,8 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
     Real FLIGHT...: leave-one-run-out (each mission run predicted by a model trained on the
     others). --simulated: the thesis' experiment, 7 flights per trajectory train, 3 test.
     """
-    from uasnav.trajectory.baselines import evaluate_methods, kinematic_times
-    from uasnav.trajectory.geometry import discretise
-
     if simulated:
-        from uasnav.trajectory.experiment import run_phantom4
+        from uasnav.experiments.trajectory import run_phantom4
 
         r = run_phantom4(seed=seed)
         table = {
@@ -210,42 +172,25 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             }
             for m in r.methods
         }
-        t17 = [{"piece": n, "t_nn_s": t, "t_real_s": reals} for n, t, reals in r.table17]
+        t17 = [{"piece": p.piece, "t_nn_s": p.t_nn_s, "t_real_s": list(p.t_real_s)} for p in r.table17]
         out = {"methods": table, "table17": t17, "n_train": len(r.train), "n_test": len(r.test)}
     else:
+        from uasnav.trajectory.flights import flight_samples, leave_one_run_out
+
         if not flights:
             raise click.UsageError("give FLIGHT files or --simulated")
         wind = parse_wind(wind_text) if wind_text else None
-        runs, samples, es = _flight_samples(flights, plan, speed, wind, segment, max_gap)
-        if len(samples) < 2:
-            raise InputError("leave-one-run-out needs at least two mission runs")
-        per: dict[str, dict[str, list[float]]] = {}
-        for k, test in enumerate(samples):
-            train = es.concat([s for i, s in enumerate(samples) if i != k])
-            _, run = runs[k]
-            kin = None
-            if run is not None:
-                el = discretise(run.plan_ne, segment)
-                kin = kinematic_times(
-                    run.plan_ne,
-                    el.s_start_m[test.element],
-                    el.s_start_m[test.element] + test.length_m,
-                    test.v_ref_ms[0],
-                )
-            for m in evaluate_methods(train, test, kinematic_s=kin, random_state=seed):
-                d = per.setdefault(m.name, {"element": [], "run": []})
-                d["element"] += m.error_pct.tolist()
-                d["run"].append(abs(m.time_s.sum() - test.t_real_s.sum()) / test.t_real_s.sum() * 100)
+        fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
         table = {
-            n: {
-                "element_e_pct_mean": float(np.mean(d["element"])),
-                "element_e_pct_median": float(np.median(d["element"])),
-                "run_e_pct_mean": float(np.mean(d["run"])),
-                "run_e_pct": d["run"],
+            e.name: {
+                "element_e_pct_mean": float(np.mean(e.element_pct)),
+                "element_e_pct_median": float(np.median(e.element_pct)),
+                "run_e_pct_mean": float(np.mean(e.run_pct)),
+                "run_e_pct": list(e.run_pct),
             }
-            for n, d in per.items()
+            for e in leave_one_run_out(fs, segment, random_state=seed)
         }
-        out = {"methods": table, "n_runs": len(samples), "n_elements": int(sum(len(s) for s in samples))}
+        out = {"methods": table, "n_runs": len(fs), "n_elements": fs.n_elements}
     if as_json:
         echo_json(out)
         return

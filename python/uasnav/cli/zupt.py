@@ -2,34 +2,14 @@
 
 from __future__ import annotations
 
-import re
+from typing import TYPE_CHECKING, Literal
 
 import click
 
-from uasnav.cli._common import echo_json
-from uasnav.errors import InputError, UasnavError
+from uasnav.cli._common import Quantity, echo_json
 
-
-def parse_rate(text: str, what: str) -> float:
-    """``"15deg/h"`` / ``"15 deg/h"`` / ``"7e-5 rad/s"`` → rad/s (dimension checked)."""
-    from uasnav.units import convert
-
-    m = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S+)\s*", text)
-    if not m:
-        raise click.BadParameter(f"{what}: expected '<number><unit>', e.g. '15deg/h', got {text!r}")
-    try:
-        return float(convert(float(m.group(1)), m.group(2), "rad/s"))
-    except UasnavError as e:
-        raise click.BadParameter(f"{what}: {e}") from None
-
-
-def load_model(path: str) -> object:
-    """A thermal model from the calibration issue's JSON format (``uasnav.thermal``)."""
-    try:
-        from uasnav.thermal import load_model as _load  # type: ignore[import-not-found,attr-defined,unused-ignore]
-    except ImportError:
-        raise InputError(f"{path}: thermal models (uasnav.thermal) are not available in this build") from None
-    return _load(path)
+if TYPE_CHECKING:
+    from uasnav.zupt import ZuptResult
 
 
 @click.command("zupt")
@@ -50,6 +30,7 @@ def load_model(path: str) -> object:
 )
 @click.option(
     "--residual-bias",
+    type=Quantity("rad/s"),
     default="0 rad/s",
     show_default=True,
     help="Error added to the initial gyro-bias estimate on every axis, e.g. 15deg/h.",
@@ -62,10 +43,10 @@ def load_model(path: str) -> object:
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write a PNG of the gyro bias.")
 def command(
     log: str,
-    mode: str,
+    mode: Literal["zupt", "tczupt"],
     model_path: str | None,
-    derivative: str,
-    residual_bias: str,
+    derivative: Literal["analytic", "network"],
+    residual_bias: float,
     latitude_deg: float,
     heading_deg: float,
     levelling_s: float,
@@ -84,20 +65,20 @@ def command(
 
     from uasnav import zupt
     from uasnav.io import read_log
+    from uasnav.thermal import load_model
 
     if mode == "tczupt" and model_path is None:
         raise click.UsageError("--model is required for --mode tczupt")
-    resid = parse_rate(residual_bias, "--residual-bias")
     data = read_log(log)
     model = load_model(model_path) if model_path else None
     cfg = zupt.ZuptConfig(
         latitude_deg=latitude_deg,
         heading_rad=math.radians(heading_deg),
         levelling_s=levelling_s,
-        residual_gyro_bias_rad_s=resid,
+        residual_gyro_bias_rad_s=residual_bias,
         derivative=derivative,
     )
-    res = zupt.run(data, mode, model, cfg)  # type: ignore[arg-type]
+    res = zupt.run(data, mode, model, cfg)
     if out_path:
         res.to_csv(out_path)
     if plot_path:
@@ -110,7 +91,7 @@ def command(
         "rate_hz": res.meta["rate_hz"],
         "updates": res.updates,
         "mean_nis": res.mean_nis,
-        "residual_bias_rad_s": resid,
+        "residual_bias_rad_s": residual_bias,
         "gyro_bias_rad_s": res.gyro_bias[-1],
         "gyro_bias_std_rad_s": res.gyro_bias_std[-1],
         "accel_bias_m_s2": res.accel_bias[-1],
@@ -130,12 +111,12 @@ def command(
         )
 
 
-def _plot(res: object, path: str) -> None:
+def _plot(res: ZuptResult, path: str) -> None:
     from uasnav.plotting import new_figure, save_png
 
     fig, _ = new_figure(7.0, 7.5)
     fig.clear()
     axes = fig.subplots(3, 1, sharex=True)
     for j in range(3):
-        res.plot_bias(j, ax=axes[j])  # type: ignore[attr-defined]
+        res.plot_bias(j, ax=axes[j])
     save_png(fig, path)

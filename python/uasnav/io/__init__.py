@@ -1,4 +1,6 @@
-"""Reading and writing IMU logs. :func:`read_log` picks the reader from the file extension.
+"""Every file format of uasnav: IMU logs, flight telemetry and numeric tables.
+
+IMU logs → :class:`~uasnav.imu.ImuLog`; :func:`read_log` picks the reader from the extension.
 
 ========== ================================ ===========================================
 extension  reader                           notes
@@ -10,7 +12,18 @@ extension  reader                           notes
 .tlog      :func:`read_tlog`                MAVLink; ``read_log`` returns the first stream
 ========== ================================ ===========================================
 
-Writers (:func:`write_log` by extension: ``.csv`` → CSV v1, ``.npz``) are atomic.
+Flight telemetry → :class:`~uasnav.io.flight.FlightLog`; :func:`read_flight` picks the reader
+from the extension (``.csv`` flight CSV, ``.tlog``, ``.bin``, ``.ulg``; see
+:mod:`uasnav.io.flight`).
+
+Writers are atomic: :func:`write_log` by extension (``.csv`` → CSV v1, ``.npz``) for IMU logs,
+:func:`write_csv_table` for any other numeric table (:mod:`uasnav.io.table`).
+
+One module per format: :mod:`~uasnav.io.csv_v1`, :mod:`~uasnav.io.npz`, :mod:`~uasnav.io.px4`
+(ULog), :mod:`~uasnav.io.dataflash`, :mod:`~uasnav.io.tlog`, :mod:`~uasnav.io.xio`,
+:mod:`~uasnav.io.flight` (flight CSV), :mod:`~uasnav.io.table`. Nothing here imports from the
+rest of uasnav except :mod:`uasnav.imu`, :mod:`uasnav.errors`, :mod:`uasnav.units` and
+:mod:`uasnav.atomicfile`.
 """
 
 from __future__ import annotations
@@ -20,14 +33,18 @@ from pathlib import Path
 
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog
-from uasnav.io.ardupilot import read_dataflash, read_tlog
 from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
+from uasnav.io.dataflash import read_dataflash, read_dataflash_flight, read_dataflash_messages
+from uasnav.io.flight import FlightLog, read_flight_csv
 from uasnav.io.npz import read_npz, write_npz
-from uasnav.io.px4 import read_ulog
+from uasnav.io.px4 import read_ulog, read_ulog_flight
+from uasnav.io.table import read_csv_table, write_csv_table
+from uasnav.io.tlog import read_tlog, read_tlog_flight
 from uasnav.io.xio import is_xio_csv, read_xio_csv
 
 READ_EXTENSIONS = (".csv", ".txt", ".npz", ".ulg", ".bin", ".tlog")
 WRITE_EXTENSIONS = (".csv", ".npz")
+FLIGHT_EXTENSIONS = (".csv", ".tlog", ".bin", ".ulg")
 
 
 def read_log(path: str | os.PathLike[str]) -> ImuLog:
@@ -56,6 +73,31 @@ def read_log(path: str | os.PathLike[str]) -> ImuLog:
     raise InputError(f"{p}: unknown log format {suffix!r} (supported: {', '.join(READ_EXTENSIONS)})")
 
 
+def read_flight(path: str | os.PathLike[str]) -> FlightLog:
+    """Read the flight telemetry of a log; the format follows the extension (.csv, .tlog, .bin, .ulg).
+
+    Raises
+    ------
+    InputError
+        If ``path`` is not a file or has another extension.
+    DataFormatError
+        If the file is malformed (names the file, and the line and column for CSV).
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"no such telemetry file: {p}")
+    ext = p.suffix.lower()
+    if ext == ".csv":
+        return read_flight_csv(p)
+    if ext == ".tlog":
+        return read_tlog_flight(p)
+    if ext == ".bin":
+        return read_dataflash_flight(p)
+    if ext == ".ulg":
+        return read_ulog_flight(p)
+    raise InputError(f"{p}: unknown telemetry format {ext!r} (expected .csv, .tlog, .bin, .ulg)")
+
+
 def write_log(log: ImuLog, path: str | os.PathLike[str]) -> None:
     """Write ``log`` atomically; ``.csv`` → CSV v1 (with truth columns), ``.npz``."""
     p = Path(path)
@@ -69,15 +111,25 @@ def write_log(log: ImuLog, path: str | os.PathLike[str]) -> None:
 
 
 __all__ = [
+    "FLIGHT_EXTENSIONS",
     "READ_EXTENSIONS",
     "WRITE_EXTENSIONS",
+    "FlightLog",
+    "read_csv_table",
     "read_csv_v1",
     "read_dataflash",
+    "read_dataflash_flight",
+    "read_dataflash_messages",
+    "read_flight",
+    "read_flight_csv",
     "read_log",
     "read_npz",
     "read_tlog",
+    "read_tlog_flight",
     "read_ulog",
+    "read_ulog_flight",
     "read_xio_csv",
+    "write_csv_table",
     "write_csv_v1",
     "write_log",
     "write_npz",

@@ -14,9 +14,12 @@ truth_*  SI       no — ground truth of simulated logs, e.g.
 ======== ======== ==========================================
 
 Lines starting with ``#`` before the header are comments; ``# key: value`` comments become
-``ImuLog.meta``. Any other column is ignored. Missing required columns, non-numeric cells,
-NaN/inf and non-increasing ``t`` are errors naming the line and column. Numbers are written
-with 17 significant digits, so write → read round-trips bit for bit.
+``ImuLog.meta`` (and :func:`write_csv_v1` writes ``ImuLog.meta`` back as such comments, e.g.
+the ``# fused_from:``, ``# shape:``, ``# fdi:``, ``# dropped_samples:`` of a fused log). Any
+other column is ignored on reading; :func:`write_csv_v1` can append such columns
+(``extra_columns``, e.g. ``chi2_gyro`` and ``health_<i>`` of a fused log). Missing required
+columns, non-numeric cells, NaN/inf and non-increasing ``t`` are errors naming the line and
+column. Numbers are written with 17 significant digits, so write → read round-trips bit for bit.
 """
 
 from __future__ import annotations
@@ -25,13 +28,16 @@ import csv
 import io
 import os
 import re
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from uasnav.atomicfile import atomic_open
-from uasnav.errors import DataFormatError
+from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog
+from uasnav.io.table import as_column, write_rows
 
 REQUIRED = ("t", "gx", "gy", "gz", "ax", "ay", "az")
 _AXES = ("x", "y", "z")
@@ -171,8 +177,31 @@ def _truth_columns(name: str, arr: np.ndarray) -> list[tuple[str, np.ndarray]]:
     return [(f"truth_{name}_{s}", arr[:, j]) for j, s in enumerate(suffixes)]
 
 
-def write_csv_v1(log: ImuLog, path: str | os.PathLike[str]) -> None:
-    """Write ``log`` as CSV v1, atomically (temporary file + rename)."""
+def write_csv_v1(
+    log: ImuLog,
+    path: str | os.PathLike[str],
+    *,
+    extra_columns: Mapping[str, ArrayLike] | None = None,
+) -> None:
+    """Write ``log`` as CSV v1, atomically (temporary file + rename).
+
+    Parameters
+    ----------
+    log : ImuLog
+        Its ``meta`` (except ``source`` and ``format``) becomes ``# key: value`` comments (first
+        line of each value), its ``truth`` channels ``truth_*`` columns.
+    path : path-like
+        Output file.
+    extra_columns : mapping of str → array_like, each shape (n,), optional
+        Further columns after the log's own (readers of CSV v1 ignore them), e.g. per-sample
+        diagnostics; NaN is written ``nan``.
+
+    Raises
+    ------
+    InputError
+        An extra column that is not 1-D numeric with one value per sample, is infinite, or
+        whose name is already a column.
+    """
     cols: list[tuple[str, np.ndarray]] = [("t", log.t)]
     cols += [(f"g{a}", log.gyro[:, j]) for j, a in enumerate(_AXES)]
     cols += [(f"a{a}", log.accel[:, j]) for j, a in enumerate(_AXES)]
@@ -182,6 +211,13 @@ def write_csv_v1(log: ImuLog, path: str | os.PathLike[str]) -> None:
         cols += [(f"m{a}", log.mag[:, j]) for j, a in enumerate(_AXES)]
     for name, arr in log.truth.items():
         cols += _truth_columns(name, arr)
+    for name, values in (extra_columns or {}).items():
+        arr = as_column(name, values)
+        if arr.size != log.n:
+            raise InputError(f"extra column {name!r}: {arr.size} values for {log.n} samples")
+        if name in {c for c, _ in cols}:
+            raise InputError(f"extra column {name!r}: already a column of the log")
+        cols.append((name, arr))
     with atomic_open(path, "w") as fh:
         fh.write("# uasnav log format v1 (SI units: s, rad/s, m/s^2, degC, uT)\n")
         for k, v in log.meta.items():
@@ -189,9 +225,8 @@ def write_csv_v1(log: ImuLog, path: str | os.PathLike[str]) -> None:
                 continue
             fh.write(f"# {k}: {str(v).splitlines()[0] if str(v) else ''}\n")
         fh.write(",".join(c for c, _ in cols) + "\n")
-        block = np.column_stack([a for _, a in cols])
-        # %.17g round-trips every float64 exactly.
-        np.savetxt(fh, block, fmt="%.17g", delimiter=",")
+        # 17 significant digits round-trip every float64 exactly.
+        write_rows(fh, np.column_stack([a for _, a in cols]))
 
 
 __all__ = ["REQUIRED", "parse_csv_v1", "read_csv_v1", "write_csv_v1"]

@@ -19,13 +19,13 @@ from uasnav.mission.loading import fetch, load_document, parse_bytes, validate
 from uasnav.mission.matrices import Matrices, load_matrices
 from uasnav.mission.regulations import Regulations, load_regulations
 from uasnav.mission.scoring import Targets, Weights, rank, score_matrix, transfer
-from uasnav.mission.selection import Configuration, Selection, select
+from uasnav.mission.selection import RankedPair, Selection, select
 
 __all__ = [
     "CameraTable",
-    "Configuration",
     "Database",
     "Matrices",
+    "RankedPair",
     "Regulations",
     "Rejection",
     "Requirements",

@@ -19,6 +19,9 @@ _MASS_G = {"g": 1.0, "kg": 1000.0, "lb": 453.59237}
 _SI = {"mtom": "g", "height": "m", "span": "m", "speed": "m/s"}
 _EPS = 1e-12
 
+#: The category assumed per jurisdiction when none is given (``uasnav select --category``).
+DEFAULT_CATEGORY: dict[str, str] = {"easa": "open", "faa": "part107"}
+
 
 @dataclass(frozen=True)
 class Limit:

@@ -34,8 +34,13 @@ class EquipmentNeed:
 
 
 @dataclass(frozen=True)
-class Configuration:
-    """One ranked UAS/camera pair with its partial scores (eq. 61)."""
+class RankedPair:
+    """One ranked UAS/camera pair (a configuration of Table 24) with its partial scores (eq. 61).
+
+    Scores are dimensionless (0 inside the target, 1 at the limit; lower is better); ``mass_g``
+    is the take-off mass of UAS + camera (g), ``cost_usd`` their cost (USD) and
+    ``open_subcategory`` the EASA open subcategory of that mass (None outside the EASA rules).
+    """
 
     uas_id: str
     uas: str
@@ -66,7 +71,7 @@ class Selection:
     camera_ok: np.ndarray
     pair_ok: np.ndarray
     rejections: list[Rejection]
-    ranking: list[Configuration]
+    ranking: list[RankedPair]
     scores: ScoreMatrix
     database: Database
     notes: list[str] = field(default_factory=list)
@@ -75,13 +80,13 @@ class Selection:
     def feasible_uas(self) -> list[str]:
         """Labels of the UAS passing every aircraft test."""
         u = self.database.uas
-        return [u.label(i) for i in np.flatnonzero(self.uas_ok)]
+        return [u.label(int(i)) for i in np.flatnonzero(self.uas_ok)]
 
     @property
     def feasible_cameras(self) -> list[str]:
         """Labels of the cameras passing every camera test."""
         c = self.database.cameras
-        return [c.label(i) for i in np.flatnonzero(self.camera_ok)]
+        return [c.label(int(i)) for i in np.flatnonzero(self.camera_ok)]
 
     def to_dict(self) -> dict:
         """Plain-JSON view (used by ``uasnav select --json``)."""
@@ -174,17 +179,17 @@ def select(
     rejections: list[Rejection] = []
     height_checks = regs.check(req.jurisdiction, req.category, height_m=req.altitude_m)
     mission_ok = all(c.ok for c in height_checks)
-    for c in height_checks:
-        if not c.ok:
+    for chk in height_checks:
+        if not chk.ok:
             rejections.append(
                 Rejection(
                     "mission",
                     req.mission,
                     "regulation-height",
                     req.altitude_m,
-                    c.limit.value_si,
+                    chk.limit.value_si,
                     "m",
-                    f"required altitude {req.altitude_m:g} m exceeds {c.limit.describe()}",
+                    f"required altitude {req.altitude_m:g} m exceeds {chk.limit.describe()}",
                 )
             )
     if cat.vlos_required:
@@ -223,7 +228,7 @@ def select(
     for i, j in rank(scores.total, top):
         m = float(scores.mass_g[i, j])
         ranking.append(
-            Configuration(
+            RankedPair(
                 u.ids[i],
                 u.label(i),
                 c.ids[j],

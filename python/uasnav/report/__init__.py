@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from uasnav.atomicfile import atomic_write_bytes, atomic_write_text
 from uasnav.errors import InputError
+from uasnav.jsonable import to_jsonable
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -197,8 +198,6 @@ def build_report(
     )
     html_path, json_path = out / "report.html", out / "report.json"
     atomic_write_text(html_path, doc)
-    from uasnav.cli._common import to_jsonable
-
     atomic_write_text(
         json_path,
         json.dumps(

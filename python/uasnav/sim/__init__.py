@@ -29,7 +29,7 @@ from uasnav.sim.model import (
     PRESET_NAMES,
     SensorModel,
     TemperatureSensorModel,
-    ThermalModel,
+    ThermalErrorTruth,
     TriadModel,
     load_preset,
 )
@@ -43,7 +43,7 @@ __all__ = [
     "SensorModel",
     "TemperatureProfile",
     "TemperatureSensorModel",
-    "ThermalModel",
+    "ThermalErrorTruth",
     "TriadModel",
     "array_mountings",
     "die_temperature",

@@ -34,7 +34,7 @@ from scipy.spatial.transform import Rotation
 from uasnav import earth
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog
-from uasnav.sim.model import SensorModel, TriadModel, load_preset
+from uasnav.sim.model import SensorModel, ThermalErrorTruth, TriadModel, load_preset
 from uasnav.sim.profiles import TemperatureProfile, named_profile
 
 FloatArray = NDArray[np.float64]
@@ -652,8 +652,13 @@ def simulate_array(
     return logs
 
 
-def thermal_model(preset: str | SensorModel, sensor: str = "gyro", factors: ArrayLike | None = None):  # type: ignore[no-untyped-def]
-    """The :class:`~uasnav.sim.model.ThermalModel` of a preset's gyro (or ``"accel"``)."""
+def thermal_model(
+    preset: str | SensorModel, sensor: str = "gyro", factors: ArrayLike | None = None
+) -> ThermalErrorTruth | None:
+    """The :class:`~uasnav.sim.model.ThermalErrorTruth` of a preset's gyro (or ``"accel"``).
+
+    None if the triad has no thermal block; ``factors`` (3,) scale each axis' curve.
+    """
     model = _as_model(preset)
     tri = model.gyro if sensor == "gyro" else model.accel
     th = tri.thermal

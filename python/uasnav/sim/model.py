@@ -37,16 +37,20 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from uasnav.errors import DataFormatError, InputError, UnitError
-from uasnav.units import convert, dimension
+from uasnav.errors import DataFormatError, InputError
+from uasnav.units import parse_quantity
 
 FloatArray = NDArray[np.float64]
 PRESET_NAMES = ("crs05-02", "ms8010", "ax1", "lsm6dsm")
 
 
 @dataclass(frozen=True)
-class ThermalModel:
-    """Temperature-dependent errors of one triad (SI; temperatures in °C).
+class ThermalErrorTruth:
+    """The simulator's true temperature-dependent errors of one triad (SI; temperatures in °C).
+
+    Ground truth that the simulated output is generated from (thermal bias curve with
+    hysteresis, thermal scale-factor drift, temperature-dependent noise); not a calibration
+    model fitted to data (those live in :mod:`uasnav.thermal`).
 
     Attributes
     ----------
@@ -157,7 +161,7 @@ class ThermalModel:
             out += 0.5 * self.hysteresis * self.branch_state(t)[:, None]
         return out
 
-    def scaled(self, factors: FloatArray) -> ThermalModel:
+    def scaled(self, factors: FloatArray) -> ThermalErrorTruth:
         """A copy with each axis' bias curve multiplied by ``factors`` (3,); hysteresis unchanged."""
         f = np.asarray(factors, dtype=np.float64)
         steps = [s * np.array([f[i], 1.0, 1.0]) for i, s in enumerate(self.steps)]
@@ -187,7 +191,7 @@ class TriadModel:
     scale_factor: float = 0.0
     misalignment: float = 0.0
     g_sensitivity: float = 0.0
-    thermal: ThermalModel | None = None
+    thermal: ThermalErrorTruth | None = None
 
     def without(self, *terms: str) -> TriadModel:
         """A copy with the named terms switched off (``"thermal"`` removes the thermal block)."""
@@ -290,29 +294,21 @@ _TERM_UNITS: dict[str, dict[str, str]] = {
 }
 
 
-def parse_quantity(text: Any, si_unit: str, where: str) -> float:
-    """``"3.18 deg/√h"`` → value in ``si_unit`` (dimension-checked); numbers pass as SI."""
-    if isinstance(text, (int, float)):
+def preset_quantity(text: Any, si_unit: str, where: str) -> float:
+    """A preset field: ``"3.18 deg/√h"`` → value in ``si_unit`` (dimension-checked by
+    :func:`uasnav.units.parse_quantity`); plain numbers are taken as SI."""
+    if isinstance(text, int | float) and not isinstance(text, bool):
         return float(text)
-    if not isinstance(text, str) or " " not in text.strip():
-        raise DataFormatError(f"{where}: expected '<number> <unit>', got {text!r}")
-    num, unit = text.strip().split(" ", 1)
     try:
-        value = float(num)
-    except ValueError:
-        raise DataFormatError(f"{where}: {num!r} is not a number") from None
-    try:
-        if dimension(unit) != dimension(si_unit):
-            raise UnitError(f"unit {unit!r} has dimension {dimension(unit)}, expected {dimension(si_unit)}")
-        return float(convert(value, unit, si_unit))
-    except UnitError as e:
+        return parse_quantity(text, si_unit)
+    except InputError as e:
         raise DataFormatError(f"{where}: {e}") from None
 
 
-def _thermal_from(d: dict[str, Any], kind: str, where: str) -> ThermalModel:
+def _thermal_from(d: dict[str, Any], kind: str, where: str) -> ThermalErrorTruth:
     unit = d["unit"]
     si = "rad/s" if kind == "gyro" else "m/s^2"
-    k = parse_quantity(f"1 {unit}", si, f"{where}.unit")
+    k = preset_quantity(f"1 {unit}", si, f"{where}.unit")
     curve = d["curve"]
     if len(curve) != 3:
         raise DataFormatError(f"{where}.curve: expected 3 axes, got {len(curve)}")
@@ -324,16 +320,16 @@ def _thermal_from(d: dict[str, Any], kind: str, where: str) -> ThermalModel:
             raise DataFormatError(f"{where}: widths of steps/bumps must be > 0")
         return arr
 
-    return ThermalModel(
+    return ThermalErrorTruth(
         t_ref_c=float(d.get("t_ref_c", 25.0)),
         linear=np.array([float(c["linear"]) * k for c in curve]),
         steps=[rows(c.get("steps", [])) for c in curve],
         bumps=[rows(c.get("bumps", [])) for c in curve],
-        hysteresis=parse_quantity(d.get("hysteresis", 0.0), si, f"{where}.hysteresis"),
+        hysteresis=preset_quantity(d.get("hysteresis", 0.0), si, f"{where}.hysteresis"),
         hysteresis_width_c=float(d.get("hysteresis_width_c", 0.5)),
         hysteresis_initial=float(d.get("hysteresis_initial", 1.0)),
-        scale_factor_tc=parse_quantity(d.get("scale_factor_tc", 0.0), "1/K", f"{where}.scale_factor_tc"),
-        noise_tc=parse_quantity(d.get("noise_tc", 0.0), "1/K", f"{where}.noise_tc"),
+        scale_factor_tc=preset_quantity(d.get("scale_factor_tc", 0.0), "1/K", f"{where}.scale_factor_tc"),
+        noise_tc=preset_quantity(d.get("noise_tc", 0.0), "1/K", f"{where}.noise_tc"),
     )
 
 
@@ -342,7 +338,7 @@ def _triad_from(d: dict[str, Any], kind: str, where: str) -> TriadModel:
     unknown = set(d) - set(units) - {"thermal", "bias_instability_tau_s"}
     if unknown:
         raise DataFormatError(f"{where}: unknown keys {sorted(unknown)}")
-    vals = {k: parse_quantity(d.get(k, 0.0), u, f"{where}.{k}") for k, u in units.items()}
+    vals = {k: preset_quantity(d.get(k, 0.0), u, f"{where}.{k}") for k, u in units.items()}
     for k, v in vals.items():
         if v < 0:
             raise DataFormatError(f"{where}.{k}: must be >= 0 (a 1-σ or density), got {v}")
@@ -398,9 +394,9 @@ __all__ = [
     "PRESET_NAMES",
     "SensorModel",
     "TemperatureSensorModel",
-    "ThermalModel",
+    "ThermalErrorTruth",
     "TriadModel",
     "load_preset",
     "model_from_dict",
-    "parse_quantity",
+    "preset_quantity",
 ]

@@ -1,6 +1,7 @@
 """Thermal calibration of gyro bias (thesis §4.2.2.1, §4.2.3.1, §4.2.5, §4.2.6.1).
 
-Models of bias against die temperature, all with the same scikit-learn-like API —
+Models of bias against die temperature, all with the same scikit-learn-like API
+(:class:`BiasModel`, :mod:`uasnav.thermal.base`) —
 ``fit(temp (n,) °C, bias (n, k) rad/s) → self``, ``predict(temp) → (n, k) rad/s``,
 ``derivative(temp) → (n, k) rad/s/°C``, ``save(path)``:
 
@@ -14,15 +15,18 @@ Models of bias against die temperature, all with the same scikit-learn-like API 
 
 Temperatures outside the calibrated range are clipped to it and flagged
 (:class:`TemperatureRangeWarning`, ``return_clipped=True``) — never extrapolated silently.
-:func:`load_model` reads the one JSON model file format (:mod:`uasnav.thermal.modelfile`);
-:func:`apply` calibrates a log.
+:func:`load_model` reads the one JSON model file format (:mod:`uasnav.thermal.modelfile`),
+rebuilding the model registered for the file's kind (:func:`register_model`);
+:func:`apply` calibrates a log. :func:`bin_by_temperature` / :func:`bin_by_time` average data
+into bins; :mod:`uasnav.thermal.workflow` is the calibration of logged static tests
+(``uasnav calibrate``): :func:`load_training_data`, :func:`fit_polynomial`,
+:func:`fit_neural`, :func:`evaluate_model`.
 """
 
 from __future__ import annotations
 
 import warnings
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 
@@ -36,14 +40,25 @@ from uasnav.thermal._common import (
     split_uniform,
     sr,
 )
+from uasnav.thermal.base import BiasModel, model_class, register_model, registered_kinds
+from uasnav.thermal.binning import bin_by_temperature, bin_by_time, bin_means
 from uasnav.thermal.hysteresis import HysteresisFit, branch_from_temperature, fit_hysteresis
 from uasnav.thermal.modelfile import dumps_model, load_model, loads_model, save_model
 from uasnav.thermal.neural import NeuralBiasModel, data_derivative, forward, select_hidden_neurons, train_lm
 from uasnav.thermal.polynomial import PolynomialBiasModel, select_polynomial_order
 from uasnav.thermal.px4 import Px4BiasModel
+from uasnav.thermal.workflow import (
+    FittedModel,
+    ModelEvaluation,
+    ResidualStats,
+    evaluate_model,
+    fit_neural,
+    fit_polynomial,
+    load_training_data,
+)
 
 
-def apply(model: Any, log: ImuLog) -> ImuLog:
+def apply(model: BiasModel, log: ImuLog) -> ImuLog:
     """Calibrated copy of ``log``: gyro minus the model bias at the log's temperature.
 
     Temperatures outside the calibrated range are clipped (the count goes to
@@ -69,22 +84,36 @@ def apply(model: Any, log: ImuLog) -> ImuLog:
 
 
 __all__ = [
+    "BiasModel",
+    "FittedModel",
     "HysteresisFit",
+    "ModelEvaluation",
     "NeuralBiasModel",
     "NotFittedError",
     "PolynomialBiasModel",
     "Px4BiasModel",
+    "ResidualStats",
     "SelectionResult",
     "TemperatureRangeWarning",
     "apply",
+    "bin_by_temperature",
+    "bin_by_time",
+    "bin_means",
     "branch_from_temperature",
     "choose",
     "data_derivative",
     "dumps_model",
+    "evaluate_model",
     "fit_hysteresis",
+    "fit_neural",
+    "fit_polynomial",
     "forward",
     "load_model",
+    "load_training_data",
     "loads_model",
+    "model_class",
+    "register_model",
+    "registered_kinds",
     "save_model",
     "select_hidden_neurons",
     "select_polynomial_order",

@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike, NDArray
 from uasnav.errors import InputError, UasnavError
 
 FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
 
 
 class TemperatureRangeWarning(UserWarning):
@@ -54,7 +55,7 @@ def check_fit_data(temp: ArrayLike, bias: ArrayLike, min_samples: int = 4) -> tu
     return t, b
 
 
-def clip_temp(temp: FloatArray, lo: float, hi: float, model: str) -> tuple[FloatArray, NDArray[np.bool_]]:
+def clip_temp(temp: FloatArray, lo: float, hi: float, model: str) -> tuple[FloatArray, BoolArray]:
     """Clip to [lo, hi]; warn with :class:`TemperatureRangeWarning` if any sample was clipped."""
     clipped = (temp < lo) | (temp > hi)
     if clipped.any():

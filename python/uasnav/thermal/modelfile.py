@@ -16,6 +16,9 @@ Layout (schema version 1)::
 The checksum is the SHA-256 of the file's bytes with its own hex value replaced by 64 ``0``
 characters, so Python and Rust (``nav_core::mlp::json``) verify it byte-exactly without
 re-serialising; any edit or truncation is detected on load. Files are written atomically.
+
+The reader rebuilds the model with the class registered for the file's ``"kind"``
+(:func:`uasnav.thermal.base.register_model`); it imports no concrete model.
 """
 
 from __future__ import annotations
@@ -24,12 +27,13 @@ import hashlib
 import json
 import os
 from datetime import datetime, timezone
-from typing import Any
 
 import numpy as np
 
 from uasnav.atomicfile import atomic_write_text
-from uasnav.errors import DataFormatError
+from uasnav.errors import DataFormatError, InputError
+from uasnav.jsonable import to_jsonable
+from uasnav.thermal.base import BiasModel, ModelDict, model_class
 
 FORMAT = "uasnav.thermal-model"
 SCHEMA_VERSION = 1
@@ -45,23 +49,28 @@ def file_checksum(text: str, value: str) -> str:
     return hashlib.sha256(text.replace(value, ZEROS, 1).encode("utf-8")).hexdigest()
 
 
-def _plain(x: Any) -> Any:
+def _finite(x: object) -> bool:
+    """True if every number in the nested dicts / lists / arrays ``x`` is finite."""
     if isinstance(x, dict):
-        return {str(k): _plain(v) for k, v in x.items()}
+        return all(_finite(v) for v in x.values())
     if isinstance(x, list | tuple):
-        return [_plain(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return _plain(x.tolist())
-    if isinstance(x, np.generic):
-        return x.item()
-    return x
+        return all(_finite(v) for v in x)
+    if isinstance(x, np.ndarray | np.generic | float):
+        return bool(np.all(np.isfinite(x)))
+    return True
 
 
-def model_payload(model: Any, training: dict[str, Any] | None = None) -> dict[str, Any]:
-    """The file's content (with checksum) as a dict."""
+def model_payload(model: BiasModel, training: ModelDict | None = None) -> ModelDict:
+    """The file's content (with checksum) as a dict.
+
+    Raises :class:`DataFormatError` if the model's numbers are not all finite: JSON has no NaN,
+    and :func:`uasnav.jsonable.to_jsonable` would turn them into ``null`` (an unloadable model).
+    """
     body = model.to_dict()
+    if not _finite(body):
+        raise DataFormatError(f"{model.kind} model holds non-finite numbers and cannot be saved")
     k = len(body["models"])
-    payload: dict[str, Any] = {
+    payload: ModelDict = {
         "format": FORMAT,
         "schema_version": SCHEMA_VERSION,
         "kind": model.kind,
@@ -79,26 +88,24 @@ def model_payload(model: Any, training: dict[str, Any] | None = None) -> dict[st
     recs = getattr(model, "training_", None)
     if recs:
         payload["training"].setdefault("networks", [{**r.__dict__} for r in recs])
-    payload = _plain(payload)
+    payload = to_jsonable(payload)
     payload["checksum"] = {"algorithm": "sha256", "value": ZEROS}
     return payload
 
 
-def dumps_model(model: Any, training: dict[str, Any] | None = None) -> str:
+def dumps_model(model: BiasModel, training: ModelDict | None = None) -> str:
     """The model file text (checksum filled in)."""
-    try:
-        text = json.dumps(model_payload(model, training), indent=1, allow_nan=False) + "\n"
-    except ValueError as e:
-        raise DataFormatError(f"model holds non-finite numbers and cannot be saved: {e}") from e
+    # model_payload refuses non-finite model numbers; allow_nan=False guards the rest.
+    text = json.dumps(model_payload(model, training), indent=1, allow_nan=False) + "\n"
     return text.replace(ZEROS, file_checksum(text, ZEROS), 1)
 
 
-def save_model(model: Any, path: str | os.PathLike[str], training: dict[str, Any] | None = None) -> None:
+def save_model(model: BiasModel, path: str | os.PathLike[str], training: ModelDict | None = None) -> None:
     """Write ``model`` (fitted) to ``path`` atomically."""
     atomic_write_text(path, dumps_model(model, training))
 
 
-def loads_model(text: str, source: str = "<string>") -> Any:
+def loads_model(text: str, source: str = "<string>") -> BiasModel:
     """Parse model file text; verifies format, schema version, units and checksum."""
     try:
         d = json.loads(text)
@@ -130,18 +137,10 @@ def loads_model(text: str, source: str = "<string>") -> Any:
         )
     if d.get("units") != UNITS:
         raise DataFormatError(f"{source}: units {d.get('units')!r}, expected {UNITS!r}", path=source)
-    from uasnav.thermal.neural import NeuralBiasModel
-    from uasnav.thermal.polynomial import PolynomialBiasModel
-    from uasnav.thermal.px4 import Px4BiasModel
-
-    kinds: dict[str, Any] = {
-        "polynomial": PolynomialBiasModel,
-        "neural": NeuralBiasModel,
-        "px4": Px4BiasModel,
-    }
-    cls = kinds.get(str(d.get("kind")))
-    if cls is None:
-        raise DataFormatError(f"{source}: unknown model kind {d.get('kind')!r}", path=source)
+    try:
+        cls = model_class(str(d.get("kind")))
+    except InputError:
+        raise DataFormatError(f"{source}: unknown model kind {d.get('kind')!r}", path=source) from None
     try:
         rng = d["calibrated_range_c"]
         model = cls.from_dict(d, (float(rng[0]), float(rng[1])))
@@ -149,11 +148,12 @@ def loads_model(text: str, source: str = "<string>") -> Any:
         raise DataFormatError(
             f"{source}: malformed {d.get('kind')} model ({type(e).__name__}: {e})", path=source
         ) from e
-    model.training_meta_ = d.get("training", {})
+    # The file's free-form training metadata, kept for the user (not part of BiasModel).
+    model.training_meta_ = d.get("training", {})  # type: ignore[attr-defined]
     return model
 
 
-def load_model(path: str | os.PathLike[str]) -> Any:
+def load_model(path: str | os.PathLike[str]) -> BiasModel:
     """Load a model file written by :func:`save_model` (any kind)."""
     p = os.fspath(path)
     try:

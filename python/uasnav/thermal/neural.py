@@ -16,15 +16,17 @@ the NumPy reference it is tested against.
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from uasnav.errors import InputError, NumericalError
 from uasnav.thermal._common import (
+    BoolArray,
     FloatArray,
     NotFittedError,
     SelectionResult,
@@ -36,6 +38,9 @@ from uasnav.thermal._common import (
     sr,
     subsample_uniform,
 )
+from uasnav.thermal.base import ModelDict, register_model
+from uasnav.thermal.binning import bin_by_temperature
+from uasnav.thermal.modelfile import dumps_model, save_model
 
 
 @dataclass
@@ -324,6 +329,7 @@ def _train_lm(
     return unpack(best[1], hidden, hidden, base), rec
 
 
+@register_model
 class NeuralBiasModel:
     """BPNN bias(T) per axis: 1-n-n-1, tanh hidden layers, linear output, LM-trained.
 
@@ -418,13 +424,11 @@ class NeuralBiasModel:
         """The model file text (cached; what the Rust engine parses)."""
         self._check()
         if getattr(self, "_json", None) is None:
-            from uasnav.thermal.modelfile import dumps_model
-
             self._json = dumps_model(self)
         assert self._json is not None
         return self._json
 
-    def _eval(self, temp: ArrayLike, derivative_networks: bool) -> tuple[FloatArray, FloatArray, Any]:
+    def _eval(self, temp: ArrayLike, derivative_networks: bool) -> tuple[FloatArray, FloatArray, BoolArray]:
         self._check()
         t = check_temp(temp)
         nets = self.derivative_networks_ if derivative_networks else self.networks_
@@ -444,7 +448,15 @@ class NeuralBiasModel:
         d[clipped] = 0.0
         return v, d, clipped
 
-    def predict(self, temp: ArrayLike, *, return_clipped: bool = False) -> Any:
+    @overload
+    def predict(self, temp: ArrayLike, *, return_clipped: Literal[False] = ...) -> FloatArray: ...
+
+    @overload
+    def predict(self, temp: ArrayLike, *, return_clipped: Literal[True]) -> tuple[FloatArray, BoolArray]: ...
+
+    def predict(
+        self, temp: ArrayLike, *, return_clipped: bool = False
+    ) -> FloatArray | tuple[FloatArray, BoolArray]:
         """Bias (n, k) rad/s at temperatures (n,) °C; clipped to the calibrated range with a
         :class:`TemperatureRangeWarning`; ``return_clipped`` adds the (n,) clip mask."""
         v, _, clipped = self._eval(temp, False)
@@ -462,7 +474,7 @@ class NeuralBiasModel:
             return v
         raise InputError(f"method: expected 'analytic' or 'network', got {method!r}")
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> ModelDict:
         """The ``models`` / ``derivative_models`` entries of the model file."""
         self._check()
         return {
@@ -473,7 +485,7 @@ class NeuralBiasModel:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any], range_c: tuple[float, float]) -> NeuralBiasModel:
+    def from_dict(cls, d: ModelDict, range_c: tuple[float, float]) -> NeuralBiasModel:
         """Inverse of :meth:`to_dict`."""
         nets = [Network.from_dict(m) for m in d["models"]]
         m = cls(hidden=int(nets[0].b1.size))
@@ -485,10 +497,8 @@ class NeuralBiasModel:
         m._json = None
         return m
 
-    def save(self, path: str, training: dict[str, Any] | None = None) -> None:
-        """Write the model file atomically."""
-        from uasnav.thermal.modelfile import save_model
-
+    def save(self, path: str | os.PathLike[str], training: ModelDict | None = None) -> None:
+        """Write the model file atomically (see :mod:`uasnav.thermal.modelfile`)."""
         save_model(self, path, training=training)
 
     def __repr__(self) -> str:
@@ -496,17 +506,10 @@ class NeuralBiasModel:
 
 
 def data_derivative(temp: FloatArray, bias: FloatArray, bin_c: float = 1.0) -> tuple[FloatArray, FloatArray]:
-    """∂b/∂T of data: bias averaged in temperature bins of ``bin_c`` °C, then central
-    differences between bin means (rad/s/°C) at the bins' mean temperatures (°C)."""
-    edges = np.arange(temp.min(), temp.max() + bin_c, bin_c)
-    idx = np.clip(np.digitize(temp, edges) - 1, 0, edges.size - 2)
-    counts = np.bincount(idx, minlength=edges.size - 1)
-    ok = counts > 0
-    tm = np.bincount(idx, temp, minlength=counts.size)[ok] / counts[ok]
-    bm = (
-        np.stack([np.bincount(idx, col, minlength=counts.size)[ok] for col in bias.T], 1)
-        / counts[ok][:, None]
-    )
+    """∂b/∂T of data: bias averaged in temperature bins of ``bin_c`` °C
+    (:func:`uasnav.thermal.binning.bin_by_temperature`), then central differences between bin
+    means (rad/s/°C) at the bins' mean temperatures (°C)."""
+    tm, bm = bin_by_temperature(temp, bias, bin_c)
     if tm.size < 3:
         raise InputError(f"temp: span {np.ptp(temp):.2f} °C too small for derivative bins of {bin_c} °C")
     return tm, np.gradient(bm, tm, axis=0)

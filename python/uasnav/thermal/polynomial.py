@@ -9,13 +9,15 @@ order 6 already over −20…40 °C).
 
 from __future__ import annotations
 
-from typing import Any
+import os
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from uasnav.errors import InputError
 from uasnav.thermal._common import (
+    BoolArray,
     FloatArray,
     NotFittedError,
     SelectionResult,
@@ -26,8 +28,11 @@ from uasnav.thermal._common import (
     split_uniform,
     sr,
 )
+from uasnav.thermal.base import ModelDict, register_model
+from uasnav.thermal.modelfile import save_model
 
 
+@register_model
 class PolynomialBiasModel:
     """Least-squares polynomial bias(T) per axis (eq. 6–7).
 
@@ -68,7 +73,15 @@ class PolynomialBiasModel:
         if not hasattr(self, "coef_"):
             raise NotFittedError("PolynomialBiasModel: call fit() or load_model() first")
 
-    def predict(self, temp: ArrayLike, *, return_clipped: bool = False) -> Any:
+    @overload
+    def predict(self, temp: ArrayLike, *, return_clipped: Literal[False] = ...) -> FloatArray: ...
+
+    @overload
+    def predict(self, temp: ArrayLike, *, return_clipped: Literal[True]) -> tuple[FloatArray, BoolArray]: ...
+
+    def predict(
+        self, temp: ArrayLike, *, return_clipped: bool = False
+    ) -> FloatArray | tuple[FloatArray, BoolArray]:
         """Bias (n, k) rad/s at temperatures (n,) °C (clipped to the calibrated range, with a
         :class:`TemperatureRangeWarning`); with ``return_clipped`` also the (n,) clip mask."""
         self._check()
@@ -87,7 +100,7 @@ class PolynomialBiasModel:
         out[clipped] = 0.0
         return np.asarray(out, dtype=np.float64)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> ModelDict:
         """The ``models`` entries of the model file (one per axis)."""
         self._check()
         return {
@@ -98,7 +111,7 @@ class PolynomialBiasModel:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any], range_c: tuple[float, float]) -> PolynomialBiasModel:
+    def from_dict(cls, d: ModelDict, range_c: tuple[float, float]) -> PolynomialBiasModel:
         """Inverse of :meth:`to_dict`."""
         models = d["models"]
         coefs = [m["coefficients"] for m in models]
@@ -111,10 +124,8 @@ class PolynomialBiasModel:
         m.range_c_ = (float(range_c[0]), float(range_c[1]))
         return m
 
-    def save(self, path: str, training: dict[str, Any] | None = None) -> None:
+    def save(self, path: str | os.PathLike[str], training: ModelDict | None = None) -> None:
         """Write the model file atomically (see :mod:`uasnav.thermal.modelfile`)."""
-        from uasnav.thermal.modelfile import save_model
-
         save_model(self, path, training=training)
 
 

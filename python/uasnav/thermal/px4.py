@@ -11,15 +11,26 @@ through the bins, ``TREF`` the middle of the calibrated range.
 
 from __future__ import annotations
 
-from typing import Any
+import os
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.ndimage import median_filter
 
-from uasnav.thermal._common import FloatArray, NotFittedError, check_fit_data, check_temp, clip_temp
+from uasnav.thermal._common import (
+    BoolArray,
+    FloatArray,
+    NotFittedError,
+    check_fit_data,
+    check_temp,
+    clip_temp,
+)
+from uasnav.thermal.base import ModelDict, register_model
+from uasnav.thermal.modelfile import save_model
 
 
+@register_model
 class Px4BiasModel:
     """PX4 ``TC_G`` cubic offset model.
 
@@ -66,11 +77,21 @@ class Px4BiasModel:
         if not hasattr(self, "coef_"):
             raise NotFittedError("Px4BiasModel: call fit() or load_model() first")
 
-    def predict(self, temp: ArrayLike, *, return_clipped: bool = False) -> Any:
+    @overload
+    def predict(self, temp: ArrayLike, *, return_clipped: Literal[False] = ...) -> FloatArray: ...
+
+    @overload
+    def predict(self, temp: ArrayLike, *, return_clipped: Literal[True]) -> tuple[FloatArray, BoolArray]: ...
+
+    def predict(
+        self, temp: ArrayLike, *, return_clipped: bool = False
+    ) -> FloatArray | tuple[FloatArray, BoolArray]:
         """Offset (n, k) rad/s; temperature clipped to [TMIN, TMAX] (flagged, warned)."""
         self._check()
         t, clipped = clip_temp(check_temp(temp), *self.range_c_, "Px4BiasModel")
-        out = np.polynomial.polynomial.polyval(t - self.tref_c_, self.coef_).T.copy()
+        out = np.asarray(
+            np.polynomial.polynomial.polyval(t - self.tref_c_, self.coef_).T, dtype=np.float64
+        ).copy()
         return (out, clipped) if return_clipped else out
 
     def derivative(self, temp: ArrayLike) -> FloatArray:
@@ -111,13 +132,13 @@ class Px4BiasModel:
         lines.append(f"{vehicle}\t{component}\tTC_G_ENABLE\t1\t6")
         return "\n".join(lines) + "\n"
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> ModelDict:
         """``models`` entries of the model file."""
         self._check()
         return {"models": [{"tref_c": self.tref_c_, "coefficients": c.tolist()} for c in self.coef_.T]}
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any], range_c: tuple[float, float]) -> Px4BiasModel:
+    def from_dict(cls, d: ModelDict, range_c: tuple[float, float]) -> Px4BiasModel:
         """Inverse of :meth:`to_dict`."""
         m = cls()
         m.tref_c_ = float(d["models"][0]["tref_c"])
@@ -127,8 +148,6 @@ class Px4BiasModel:
         m.range_c_ = (float(range_c[0]), float(range_c[1]))
         return m
 
-    def save(self, path: str, training: dict[str, Any] | None = None) -> None:
-        """Write the model file atomically."""
-        from uasnav.thermal.modelfile import save_model
-
+    def save(self, path: str | os.PathLike[str], training: ModelDict | None = None) -> None:
+        """Write the model file atomically (see :mod:`uasnav.thermal.modelfile`)."""
         save_model(self, path, training=training)

@@ -27,8 +27,7 @@ import numpy as np
 from uasnav.errors import InputError
 from uasnav.trajectory.features import wind_vector
 from uasnav.trajectory.geometry import check_plan, signed_angle_deg
-
-G0 = 9.80665
+from uasnav.units import STANDARD_GRAVITY
 
 
 @dataclass(frozen=True)
@@ -54,7 +53,7 @@ class MultirotorParams:
     cruise_ms: float = 3.33
     altitude_m: float = 12.0
     tilt_max_deg: float = 15.0
-    k_drag_per_m: float = G0 * np.tan(np.radians(42.0)) / 20.0**2
+    k_drag_per_m: float = STANDARD_GRAVITY * np.tan(np.radians(42.0)) / 20.0**2
     kp_vel_per_s: float = 1.2
     ki_vel_per_s2: float = 0.25
     a_brake_ms2: float = 0.8
@@ -129,7 +128,7 @@ def simulate_flight(
     cruise = prm.cruise_ms * float(np.clip(1.0 + rng.normal(0.0, prm.speed_sigma_frac), 0.5, 1.5))
     v_corner = [_corner_speed(cruise, turns[k]) if k < n_wp - 1 else 0.0 for k in range(n_wp)]
     w_mean = wind_vector(speed_this_flight, wm.from_deg)
-    a_max = G0 * np.tan(np.radians(prm.tilt_max_deg))
+    a_max = STANDARD_GRAVITY * np.tan(np.radians(prm.tilt_max_deg))
     total = seg_len.sum()
     t_end = max_time_s or 20.0 + 4.0 * total / prm.cruise_ms
     n_steps = int(t_end / dt)

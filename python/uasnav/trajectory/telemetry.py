@@ -1,298 +1,59 @@
-"""Flight telemetry readers (CSV, MAVLink .tlog, DataFlash .bin, PX4 ULog) and flown legs.
+"""Flown mission runs of flight telemetry, and the elements measured on them.
 
-Each reader returns a :class:`FlightLog`: time (s), WGS-84 position, NED ground velocity, the
-mission's navigation waypoints, waypoint-reached events and the wind estimate when the log has
-them. :func:`flown_runs` cuts a log into mission runs (consecutive reached events of increasing
+The telemetry readers live in :mod:`uasnav.io` (one module per log format); this module keeps
+their documented names: :func:`read_flight` (by extension: .csv, .tlog, .bin, .ulg) and
+:class:`FlightLog` are :func:`uasnav.io.read_flight` and :class:`uasnav.io.flight.FlightLog`,
+and ``read_csv``, ``read_tlog``, ``read_dataflash``, ``read_ulog`` the per-format flight readers.
+
+:func:`flown_runs` cuts a log into mission runs (consecutive reached events of increasing
 sequence number) and :func:`run_samples` measures their elements.
 """
 
 from __future__ import annotations
 
-import csv
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
-from uasnav.errors import DataFormatError, InputError
-from uasnav.trajectory.features import wind_vector
+from uasnav.errors import InputError
+from uasnav.io import read_flight
+from uasnav.io.dataflash import read_dataflash_flight as read_dataflash
+from uasnav.io.flight import FLIGHT_CSV_COLUMNS as CSV_COLUMNS
+from uasnav.io.flight import FlightLog
+from uasnav.io.flight import read_flight_csv as read_csv
+from uasnav.io.px4 import read_ulog_flight as read_ulog
+from uasnav.io.tlog import read_tlog_flight as read_tlog
 from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, arc_length_along, geodetic_to_local, plan_length
 from uasnav.trajectory.samples import ElementSamples, measure_elements
 
-CSV_COLUMNS = ("t", "lat", "lon", "alt", "v_N", "v_E", "v_D")
-_MAV_NAV_WAYPOINT = 16
-_MAV_DO_CHANGE_SPEED = 178
+FloatArray = NDArray[np.float64]
 
 
-@dataclass
-class FlightLog:
-    """Telemetry of one log.
+@dataclass(frozen=True)
+class FlownRun:
+    """One run of the mission: the waypoint sequence reached, their times and the telemetry.
 
     Attributes
     ----------
-    t : ndarray, shape (k,) — time, s (wall clock for .tlog, boot time otherwise).
-    lat, lon, alt : ndarray, shape (k,) — degrees, degrees, m.
-    vel_ned : ndarray, shape (k, 3) — ground velocity, m/s.
-    waypoints : dict seq → (lat, lon, alt) — mission navigation waypoints.
-    reached : list of (t, seq) — waypoint-reached events.
-    wind_ne : ndarray, shape (2,) or None — mean wind velocity (m/s, toward), if logged.
-    cruise_ms : float or None — mission/waypoint speed, if logged.
-    source : str
+    seqs : list of int
+        Sequence numbers of the navigation waypoints reached, in order (m of them).
+    reached_t : ndarray, shape (m,)
+        Times the waypoints were reached (s).
+    plan_ne : ndarray, shape (m, 2)
+        The waypoints in local north, east (m).
+    t : ndarray, shape (k,)
+        Telemetry time over the run (s).
+    pos_ne, vel_ne : ndarray, shape (k, 2)
+        Local position (m) and ground velocity (m/s), north and east.
     """
 
-    t: np.ndarray
-    lat: np.ndarray
-    lon: np.ndarray
-    alt: np.ndarray
-    vel_ned: np.ndarray
-    waypoints: dict[int, tuple[float, float, float]] = field(default_factory=dict)
-    reached: list[tuple[float, int]] = field(default_factory=list)
-    wind_ne: np.ndarray | None = None
-    cruise_ms: float | None = None
-    source: str = ""
-
-    def __post_init__(self) -> None:
-        n = np.asarray(self.t).size
-        if n < 2:
-            raise InputError(f"{self.source}: fewer than 2 position samples")
-        order = np.argsort(self.t, kind="stable")
-        for name in ("t", "lat", "lon", "alt", "vel_ned"):
-            setattr(self, name, np.asarray(getattr(self, name), dtype=float)[order])
-        keep = np.concatenate([[True], np.diff(self.t) > 0])
-        for name in ("t", "lat", "lon", "alt", "vel_ned"):
-            setattr(self, name, getattr(self, name)[keep])
-
-
-def read_flight(path: str | Path) -> FlightLog:
-    """Read any supported log by extension (.csv, .tlog, .bin, .ulg)."""
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"no such telemetry file: {p}")
-    ext = p.suffix.lower()
-    if ext == ".csv":
-        return read_csv(p)
-    if ext == ".tlog":
-        return read_tlog(p)
-    if ext == ".bin":
-        return read_dataflash(p)
-    if ext == ".ulg":
-        return read_ulog(p)
-    raise InputError(f"{p}: unknown telemetry format {ext!r} (expected .csv, .tlog, .bin, .ulg)")
-
-
-def read_csv(path: str | Path) -> FlightLog:
-    """CSV with header ``t,lat,lon,alt,v_N,v_E,v_D`` (s, deg, deg, m, m/s NED); no mission."""
-    with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
-    if not rows:
-        raise DataFormatError("empty file", path=str(path))
-    head = [h.strip() for h in rows[0]]
-    missing = [c for c in CSV_COLUMNS if c not in head]
-    if missing:
-        raise DataFormatError(f"missing column(s) {missing}; need {CSV_COLUMNS}", path=str(path), line=1)
-    idx = [head.index(c) for c in CSV_COLUMNS]
-    data = np.empty((len(rows) - 1, len(CSV_COLUMNS)))
-    for i, r in enumerate(rows[1:]):
-        for j, k in enumerate(idx):
-            try:
-                data[i, j] = float(r[k])
-            except (ValueError, IndexError):
-                raise DataFormatError(
-                    "not a number", path=str(path), line=i + 2, column=CSV_COLUMNS[j]
-                ) from None
-    bad = ~np.isfinite(data)
-    if bad.any():
-        i, j = np.argwhere(bad)[0]
-        raise DataFormatError("NaN/inf", path=str(path), line=int(i) + 2, column=CSV_COLUMNS[j])
-    return FlightLog(
-        t=data[:, 0], lat=data[:, 1], lon=data[:, 2], alt=data[:, 3], vel_ned=data[:, 4:7], source=str(path)
-    )
-
-
-def _from_fixes(
-    fixes: list[tuple[float, ...]],
-    path: str | Path,
-    *,
-    waypoints: dict[int, tuple[float, float, float]],
-    reached: list[tuple[float, int]],
-    wind: list[Any],
-    cruise_ms: float | None = None,
-) -> FlightLog:
-    """A FlightLog from position fixes ``(t, lat, lon, alt, v_N, v_E, v_D)`` and mission events."""
-    if not fixes:
-        raise DataFormatError("no position fixes", path=str(path))
-    a = np.array(fixes, dtype=np.float64)
-    return FlightLog(
-        t=a[:, 0],
-        lat=a[:, 1],
-        lon=a[:, 2],
-        alt=a[:, 3],
-        vel_ned=a[:, 4:7],
-        waypoints=waypoints,
-        reached=sorted(reached),
-        wind_ne=np.mean(wind, axis=0) if wind else None,
-        cruise_ms=cruise_ms,
-        source=str(path),
-    )
-
-
-def read_tlog(path: str | Path) -> FlightLog:
-    """MAVLink telemetry log: GLOBAL_POSITION_INT, MISSION_ITEM(_INT), MISSION_ITEM_REACHED,
-    WIND (ArduPilot, if present), WPNAV_SPEED / DO_CHANGE_SPEED. Times are the log's wall clock."""
-    from pymavlink import mavutil
-
-    conn = mavutil.mavlink_connection(str(path), dialect="ardupilotmega")
-    fixes: list[tuple[float, ...]] = []
-    items: dict[int, tuple[int, float, float, float, float]] = {}
-    reached: list[tuple[float, int]] = []
-    wind = []
-    wpnav = None
-    while True:
-        m = conn.recv_match(
-            type=[
-                "GLOBAL_POSITION_INT",
-                "MISSION_ITEM_INT",
-                "MISSION_ITEM",
-                "MISSION_ITEM_REACHED",
-                "WIND",
-                "PARAM_VALUE",
-            ]
-        )
-        if m is None:
-            break
-        kind = m.get_type()
-        if kind == "GLOBAL_POSITION_INT":
-            fixes.append(
-                (
-                    m._timestamp,
-                    m.lat * 1e-7,
-                    m.lon * 1e-7,
-                    m.alt * 1e-3,
-                    m.vx * 0.01,
-                    m.vy * 0.01,
-                    m.vz * 0.01,
-                )
-            )
-        elif kind in ("MISSION_ITEM_INT", "MISSION_ITEM"):
-            scale = 1e-7 if kind == "MISSION_ITEM_INT" else 1.0
-            items[m.seq] = (m.command, m.x * scale, m.y * scale, m.z, m.param2)
-        elif kind == "MISSION_ITEM_REACHED":
-            reached.append((m._timestamp, int(m.seq)))
-        elif kind == "WIND":
-            wind.append(wind_vector(float(m.speed), float(m.direction)))
-        elif kind == "PARAM_VALUE" and m.param_id.rstrip("\x00") == "WPNAV_SPEED":
-            wpnav = float(m.param_value) * 0.01
-    if not fixes:
-        raise DataFormatError("no GLOBAL_POSITION_INT messages", path=str(path))
-    # seq 0 is the home position on ArduPilot; navigation waypoints carry a position.
-    wps = {
-        s: (x, y, z)
-        for s, (cmd, x, y, z, _) in items.items()
-        if s > 0 and cmd == _MAV_NAV_WAYPOINT and (x != 0 or y != 0)
-    }
-    speeds = [p2 for s, (cmd, *_, p2) in items.items() if cmd == _MAV_DO_CHANGE_SPEED and p2 > 0]
-    cruise = speeds[0] if speeds else wpnav
-    return _from_fixes(fixes, path, waypoints=wps, reached=reached, wind=wind, cruise_ms=cruise)
-
-
-def read_dataflash(path: str | Path) -> FlightLog:
-    """ArduPilot DataFlash log: GPS (position, speed, course, VZ), CMD (mission) and the
-    "Reached command #N" messages; time from TimeUS."""
-    import re
-
-    from pymavlink import mavutil
-
-    conn = mavutil.mavlink_connection(str(path))
-    fixes: list[tuple[float, ...]] = []
-    wps: dict[int, tuple[float, float, float]] = {}
-    reached: list[tuple[float, int]] = []
-    wind = []
-    pat = re.compile(r"Reached (?:command|waypoint) #(\d+)")
-    while True:
-        m = conn.recv_match(type=["GPS", "CMD", "MSG", "XKF2", "NKF2", "EKF2"])
-        if m is None:
-            break
-        kind = m.get_type()
-        # Copter ≥ 3.4 logs TimeUS; older logs (3.3) TimeMS.
-        if hasattr(m, "TimeUS"):
-            ts = m.TimeUS * 1e-6
-        elif hasattr(m, "TimeMS"):
-            ts = m.TimeMS * 1e-3
-        else:
-            continue
-        if kind == "GPS" and getattr(m, "Status", 3) >= 3:
-            crs = np.radians(m.GCrs)
-            fixes.append(
-                (ts, m.Lat, m.Lng, m.Alt, m.Spd * np.cos(crs), m.Spd * np.sin(crs), getattr(m, "VZ", 0.0))
-            )
-        elif kind == "CMD" and m.CId == _MAV_NAV_WAYPOINT and m.CNum > 0 and (m.Lat != 0 or m.Lng != 0):
-            wps[int(m.CNum)] = (m.Lat, m.Lng, m.Alt)
-        elif kind == "MSG":
-            hit = pat.search(m.Message)
-            if hit:
-                reached.append((ts, int(hit.group(1))))
-        elif kind in ("XKF2", "NKF2", "EKF2") and hasattr(m, "VWN"):
-            wind.append((m.VWN, m.VWE))
-    if not fixes:
-        raise DataFormatError("no GPS messages with a 3D fix", path=str(path))
-    return _from_fixes(fixes, path, waypoints=wps, reached=reached, wind=wind)
-
-
-def read_ulog(path: str | Path) -> FlightLog:
-    """PX4 ULog: vehicle_global_position (or vehicle_gps_position), mission_result reached
-    sequence numbers and wind_estimate. PX4 logs hold no waypoint coordinates (the mission
-    lives in dataman), so ``waypoints`` stays empty unless a plan is given separately."""
-    from pyulog import ULog
-
-    try:
-        ulog = ULog(str(path))
-    except Exception as exc:  # pyulog raises bare exceptions on corrupt files
-        raise DataFormatError(f"cannot parse ULog: {exc}", path=str(path)) from None
-
-    def topic(name: str) -> dict[str, np.ndarray] | None:
-        for d in ulog.data_list:
-            if d.name == name and d.multi_id == 0:
-                return d.data
-        return None
-
-    g = topic("vehicle_global_position")
-    if g is not None and "vel_n" in g:
-        t = g["timestamp"] * 1e-6
-        lat, lon, alt = g["lat"], g["lon"], g["alt"]
-        vel = np.column_stack([g["vel_n"], g["vel_e"], g["vel_d"]])
-    else:
-        g = topic("vehicle_gps_position")
-        if g is None:
-            raise DataFormatError("no vehicle_global_position / vehicle_gps_position topic", path=str(path))
-        t = g["timestamp"] * 1e-6
-        lat, lon, alt = g["lat"] * 1e-7, g["lon"] * 1e-7, g["alt"] * 1e-3
-        vel = np.column_stack([g["vel_n_m_s"], g["vel_e_m_s"], g["vel_d_m_s"]])
-    reached: list[tuple[float, int]] = []
-    mr = topic("mission_result")
-    if mr is not None and "seq_reached" in mr:
-        last = -1
-        for ts, s in zip(mr["timestamp"], mr["seq_reached"], strict=True):
-            if s >= 0 and s != last:
-                reached.append((ts * 1e-6, int(s)))
-            last = s
-    w = topic("wind_estimate")
-    wind = np.array([w["windspeed_north"].mean(), w["windspeed_east"].mean()]) if w is not None else None
-    return FlightLog(
-        t=t, lat=lat, lon=lon, alt=alt, vel_ned=vel, reached=reached, wind_ne=wind, source=str(path)
-    )
-
-
-@dataclass
-class FlownRun:
-    """One run of the mission: the waypoint sequence reached, their times and the telemetry."""
-
     seqs: list[int]
-    reached_t: np.ndarray
-    plan_ne: np.ndarray
-    t: np.ndarray
-    pos_ne: np.ndarray
-    vel_ne: np.ndarray
+    reached_t: FloatArray
+    plan_ne: FloatArray
+    t: FloatArray
+    pos_ne: FloatArray
+    vel_ne: FloatArray
 
 
 def flown_runs(log: FlightLog, origin: tuple[float, float, float] | None = None) -> list[FlownRun]:

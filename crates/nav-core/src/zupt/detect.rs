@@ -207,12 +207,17 @@ pub fn detect_static<T: Real>(
             stat_out[k - lag] = t;
         }
     }
-    let first = stat_out[lag];
-    let last = stat_out[n - 1 - (w - 1 - lag)];
-    for v in stat_out.iter_mut().take(lag) {
+    // Full windows filled stat_out[w - 1 - lag ..= n - 1 - lag]; for an even W that range is
+    // not symmetric (it starts at lag + 1), so the ends are filled from its own first and last
+    // entries, not from index `lag`.
+    let head = w - 1 - lag;
+    let tail = n - 1 - lag;
+    let first = stat_out[head];
+    let last = stat_out[tail];
+    for v in stat_out.iter_mut().take(head) {
         *v = first;
     }
-    for v in stat_out.iter_mut().skip(n - (w - 1 - lag)) {
+    for v in stat_out.iter_mut().skip(tail + 1) {
         *v = last;
     }
     for (m, t) in mask_out.iter_mut().zip(stat_out.iter()) {
@@ -291,5 +296,46 @@ mod tests {
         };
         assert!(StationarityDetector::new(bad).is_err());
         assert!(det.push(&[f64::NAN, 0.0, 0.0], &[0.0; 3]).is_err());
+    }
+
+    #[test]
+    fn ends_of_the_log_take_the_nearest_full_window_for_odd_and_even_windows() {
+        // A moving unit (rate 1 rad/s, never static) with a rate that grows along the log:
+        // every centred statistic is large and differs from its neighbours, so an end sample
+        // left at 0 (static) or filled from the wrong window shows.
+        let n = 40;
+        let accel: std::vec::Vec<[f64; 3]> = (0..n).map(|_| [0.0, 0.0, -9.80665]).collect();
+        let gyro: std::vec::Vec<[f64; 3]> =
+            (0..n).map(|k| [1.0 + 0.01 * k as f64, 0.0, 0.0]).collect();
+        for w in [4usize, 5, 6, 7, 20] {
+            let cfg = StationarityConfig::<f64> {
+                window_samples: w,
+                ..StationarityConfig::default()
+            };
+            let mut stat = std::vec![0.0; n];
+            let mut mask = std::vec![true; n];
+            detect_static(&accel, &gyro, cfg, &mut stat, &mut mask).unwrap();
+            assert!(
+                mask.iter().all(|&m| !m),
+                "W={w}: a moving sample declared static"
+            );
+            // Direct statistic of the full window ending at sample e (centre e − lag).
+            let lag = (w - 1) / 2;
+            let full = |e: usize| -> f64 {
+                let mut s = 0.0;
+                for g in &gyro[e + 1 - w..=e] {
+                    s += g.iter().map(|x| x * x).sum::<f64>() / 0.01f64.powi(2);
+                }
+                s / w as f64
+            };
+            for (k, &got) in stat.iter().enumerate() {
+                let e = (k + lag).clamp(w - 1, n - 1);
+                let want = full(e);
+                assert!(
+                    (got - want).abs() < 1e-9 * want,
+                    "W={w} k={k}: {got} vs {want}"
+                );
+            }
+        }
     }
 }

@@ -1,19 +1,17 @@
-"""Report section: quaternion attitude and free-inertial drift (thesis §4.2.5.3, Tables 7–8)."""
+"""Report section: quaternion attitude and free-inertial drift (thesis §4.2.5.3, Tables 7–8).
+
+Renders :func:`uasnav.experiments.attitude.run`.
+"""
 
 from __future__ import annotations
 
-import numpy as np
-
 from uasnav.report import Section, SectionWriter
-
-# Thesis Tables 7 and 8: threshold (rad) → (t_NN, t_PF) in seconds.
-TABLE7 = {1.70e-3: (2.9, 2.4), 3.50e-3: (5.9, 4.6), 8.70e-3: (14.5, 11.5), 1.75e-2: (29.4, 23.0)}
-TABLE8 = {1.70e-3: (3.3, 2.7), 3.50e-3: (6.7, 5.4), 8.70e-3: (17.2, 13.8), 1.75e-2: (34.9, 28.2)}
 
 
 def build(w: SectionWriter) -> None:
-    from uasnav.attitude import crossing_table, drift
-    from uasnav.plotting import drift_axes, new_figure
+    from uasnav.attitude import plot_drift
+    from uasnav.experiments import attitude
+    from uasnav.plotting import new_figure
 
     w.p(
         "θ(t) = 2·acos(|q_s|) (eq. 35) of the attitude error accumulated by integrating a "
@@ -23,19 +21,21 @@ def build(w: SectionWriter) -> None:
         "with the propagator: agreement with the thesis' other rows checks both the tool and "
         "the reading of the tables."
     )
-    dt = 0.01
-    for name, table in (("Table 7 (Δω_MAX)", TABLE7), ("Table 8 (Δω_RMS)", TABLE8)):
-        th_max = max(table)
-        w_nn = th_max / table[th_max][0]
-        w_pf = th_max / table[th_max][1]
-        # Split the residual over the three axes: θ depends only on |ω| for a constant rate.
-        u = np.array([1.0, -1.0, 1.0]) / np.sqrt(3.0)
-        d_nn = drift(w_nn * u, dt, duration=40.0)
-        d_pf = drift(w_pf * u, dt, duration=40.0)
-        rows = []
-        for th, t_nn, t_pf, dtp in crossing_table(d_nn, d_pf):
-            ref_nn, ref_pf = table[th]
-            rows.append((f"{th:.2e}", ref_nn, t_nn, ref_pf, t_pf, (ref_nn - ref_pf) / ref_pf * 100, dtp))
+    res = attitude.run(seed=w.seed, quick=w.quick, progress=w.progress)
+    for tc in (res.table7, res.table8):
+        rows = [
+            (f"{th:.2e}", *cols)
+            for th, *cols in zip(
+                tc.thresholds_rad,
+                tc.thesis_t_nn_s,
+                tc.t_nn_s,
+                tc.thesis_t_pf_s,
+                tc.t_pf_s,
+                tc.thesis_dt_percent,
+                tc.dt_percent,
+                strict=True,
+            )
+        ]
         w.table(
             [
                 "θ (rad)",
@@ -47,13 +47,16 @@ def build(w: SectionWriter) -> None:
                 "Δt% ours",
             ],
             rows,
-            caption=f"{name}: |ω_NN| = {w_nn:.3e} rad/s, |ω_PF| = {w_pf:.3e} rad/s",
+            caption=(
+                f"Table {tc.table} ({tc.residual}): |ω_NN| = {tc.w_nn_rad_s:.3e} rad/s, "
+                f"|ω_PF| = {tc.w_pf_rad_s:.3e} rad/s"
+            ),
             fmt="{:.2f}",
         )
-        w.data[name.split()[1]] = {"w_nn": w_nn, "w_pf": w_pf, "rows": rows}
-        if name.startswith("Table 7"):
+        w.data[str(tc.table)] = {"w_nn": tc.w_nn_rad_s, "w_pf": tc.w_pf_rad_s, "rows": rows}
+        if tc.table == 7:
             fig, ax = new_figure()
-            drift_axes([("BPNN residual", d_nn), ("polynomial residual", d_pf)], ax=ax)
+            plot_drift([("BPNN residual", tc.drift_nn), ("polynomial residual", tc.drift_pf)], ax=ax)
             ax.set_title("Free-inertial attitude drift (thresholds dotted)")
             w.figure(fig, "drift", "θ(t) for the residual rates implied by Table 7.")
 

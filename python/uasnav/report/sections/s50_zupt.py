@@ -1,123 +1,35 @@
-"""Report section: ZUPT and TCZUPT filters (thesis §4.2.6.2, Figures 38–45, Tables 9–13)."""
+"""Report section: ZUPT and TCZUPT filters (thesis §4.2.6.2, Figures 38–45, Tables 9–13).
+Computed by :mod:`uasnav.experiments.zupt`."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
+from uasnav.experiments import zupt as ex
+from uasnav.experiments.thesis import TABLE9, TABLE10, TABLE11, TABLE12, TABLE13
 from uasnav.report import Section, SectionWriter
 
 if TYPE_CHECKING:
     from uasnav.zupt import Mode
 
-# Thesis Table 9 (rad/s): mean residual of the moving-average reference, calibrated / raw.
-TABLE9 = {"x": (1.68e-6, 9.53e-6), "y": (2.98e-6, 6.80e-6), "z": (3.43e-6, 1.03e-5)}
-# Table 10 (rad/s): RMS error, (ZUPT, TCZUPT) per axis, nominal and residual 15 deg/h.
-TABLE10 = {
-    "nominal": {"x": (4.15e-5, 5.33e-5), "y": (7.48e-5, 2.97e-5), "z": (6.07e-5, 3.30e-5)},
-    "residual": {"x": (3.98e-5, 4.13e-5), "y": (9.72e-5, 3.88e-5), "z": (8.17e-5, 3.01e-5)},
-}
-# Table 11 (s): convergence time to 1e-5 rad/s, residual 15 deg/h, (ZUPT, TCZUPT).
-TABLE11 = {"x": (140, 65), "y": (345, 127), "z": (85, 53)}
-# Tables 12–13 (rad/s): mean and std of the RMS error over 5 × 5 min, (mean, std) per filter.
-TABLE12 = {
-    "zupt": {"x": (3.42e-5, 0.77e-5), "y": (3.58e-5, 0.89e-5), "z": (4.36e-5, 0.82e-5)},
-    "tczupt": {"x": (4.70e-5, 0.61e-5), "y": (2.63e-5, 0.65e-5), "z": (3.89e-5, 0.70e-5)},
-}
-TABLE13 = {
-    "zupt": {"x": (6.49e-5, 0.92e-5), "y": (8.88e-5, 0.92e-5), "z": (7.16e-5, 0.79e-5)},
-    "tczupt": {"x": (3.81e-5, 0.54e-5), "y": (4.58e-5, 0.84e-5), "z": (3.36e-5, 0.35e-5)},
-}
-AXES = "xyz"
-MODES: tuple[Mode, ...] = ("zupt", "tczupt")
-PRESET = "ax1"
-#: Attitude of the static unit (roll, pitch, yaw; rad) and its true heading.
-EULER = (0.012, -0.021, 0.4)
+AXES, MODES = ex.AXES, ex.MODES
 
 
-def _sensor(hysteresis: bool) -> Any:
-    """The simulator's AX1 (CRS05-02 gyros), optionally without its thermal hysteresis."""
-    import dataclasses
-
-    from uasnav import sim
-
-    m = sim.load_preset(PRESET)
-    if hysteresis or m.gyro.thermal is None:
-        return m
-    th = dataclasses.replace(m.gyro.thermal, hysteresis=0.0)
-    return dataclasses.replace(m, gyro=dataclasses.replace(m.gyro, thermal=th))
+def _fmt_t(v: float | None) -> str:
+    return "never" if v is None else f"{v:.0f}"
 
 
-def _calibration(sensor: Any, seed: int, quick: bool) -> Any:
-    """The thesis' BPNN (two hidden layers of two neurons, plus the derivative networks of
-    eq. 37) fitted on a simulated soak test of the same sensor type (another seed)."""
-    from uasnav.sim.lab import soak_calibration_data
-    from uasnav.thermal import NeuralBiasModel
-
-    cal = soak_calibration_data(sensor, seed=seed, rate=1.0 if quick else 10.0)
-    return NeuralBiasModel(2, restarts=2 if quick else 4, derivative_network=True, seed=seed).fit(
-        cal.temp, cal.gyro_bias
-    )
-
-
-def _ramp_log(sensor: Any, duration: float, seed: int) -> Any:
-    from uasnav import sim
-
-    return sim.simulate(sensor, profile="cycles", duration=duration, seed=seed, euler_rad=EULER)
-
-
-def build(w: SectionWriter) -> None:
-    from uasnav import zupt
+def _input_figures(w: SectionWriter, r: ex.ZuptExperiment) -> None:
+    """Figures 38–39: the filters' input data (1 Hz low-pass for display, as in the thesis)."""
     from uasnav.plotting import new_figure
 
-    quick = w.quick
-    seg_s = 60.0 if quick else 300.0
-    duration = 60.0 + 5 * seg_s
-    dec = 100
-    w.p(
-        "The 15-state error-state Kalman filter of eq. (8) (δr, δv, ψ, accelerometer and gyro "
-        "bias) on a local-level NED strapdown solution with Earth rate and WGS-84 gravity; "
-        "Φ = I + F·Ts, Γ = G·Q·Gᵀ·Ts, Q from σ_VRW, σ_ARW, σ_ABI, σ_GBI (eqs. 22–25, Tables 3–6); "
-        "nine ZUPT measurements (frozen position, zero velocity, frozen attitude) once per "
-        "second, Joseph form; 60 s coarse levelling and zeroing. TCZUPT propagates the bias "
-        "with (∂b/∂T)·(dT/dt)·Ts (eq. 31), dT/dt from a 30 s sliding least-squares slope."
-    )
-    w.p(
-        f"Data: the simulator's `{PRESET}` preset (CRS05-02 gyros, σ_ARW = 3.18 deg/√h, 30 Hz "
-        "anti-alias filter, thermal curve with a heating/cooling hysteresis of 0.03 deg/s, 90 s "
-        "die lag), static at roll 0.012, pitch −0.021, heading 0.4 rad, 45° N, in the `cycles` "
-        "profile: 60 s at 27.28 °C for the zeroing, then the thesis' ramp test (27.28 ↔ 34.08 °C "
-        f"at 2 °C/min) repeated with 5-min dwells, {duration:g} s in all. Calibration model: the "
-        "thesis' BPNN (2 × 2 hidden neurons, Levenberg–Marquardt) fitted on a simulated soak "
-        "test (−20.5 … 37.3 °C, heating only, 60 s means) of the same sensor type with another "
-        "seed; ZUPT takes the gyro calibrated by it, TCZUPT the raw gyro and its analytic "
-        "derivative. The simulator's truth is exact, so we report errors against the true bias "
-        "beside the thesis' moving-average reference."
-    )
-    w.progress("simulating the ramp test")
-    sensor = _sensor(True)
-    log = _ramp_log(sensor, duration, w.seed)
-    model = _calibration(sensor, w.seed + 1, quick)
-    heading = EULER[2]  # the unit's true heading (an external input in the thesis)
-    truth_raw = log.truth["gyro_bias"]
-    truth_cal = truth_raw - model.predict(log.temp)
-    base = zupt.ZuptConfig(decimation=dec, heading_rad=heading)
-
-    # Figures 38–39: the filters' input data (1 Hz low-pass for display, as in the thesis).
-    from scipy.signal import butter, sosfiltfilt
-
-    sos = butter(2, 1.0, fs=log.sample_rate, output="sos")
-    for name, series, fig_no in (
-        ("calibrated", log.gyro - model.predict(log.temp), 38),
-        ("raw", log.gyro, 39),
-    ):
+    fi = r.filter_input
+    for name, series, fig_no in (("calibrated", fi.calibrated, 38), ("raw", fi.raw, 39)):
         fig, ax = new_figure(7.0, 4.0)
-        lp = sosfiltfilt(sos, series, axis=0)
         for j in range(3):
-            ax.plot(log.t[::dec], lp[::dec, j], lw=0.8, label=f"ω{AXES[j]}")
+            ax.plot(fi.t, series[:, j], lw=0.8, label=f"ω{AXES[j]}")
         ax2 = ax.twinx()
-        ax2.plot(log.t[::dec], log.temp[::dec], "k:", lw=0.8, label="temperature")
+        ax2.plot(fi.t, fi.temp, "k:", lw=0.8, label="temperature")
         ax2.set_ylabel("die temperature (°C)")
         ax.set_xlabel("time (s)")
         ax.set_ylabel("gyro output (rad/s)")
@@ -130,51 +42,25 @@ def build(w: SectionWriter) -> None:
             f"Figure {fig_no}: input data of the {filt} filter ({name} gyro, 1 Hz low-pass for display).",
         )
 
-    runs: dict[str, Any] = {}
-    w.progress("running ZUPT and TCZUPT")
-    for scen, resid in (("nominal", 0.0), ("residual", zupt.RESIDUAL_BIAS_15DEG_H)):
-        cfg = base.replace(residual_gyro_bias_rad_s=resid)
-        runs[scen] = {
-            "zupt": zupt.run(log, "zupt", model, cfg),
-            "tczupt": zupt.run(log, "tczupt", model, cfg),
-        }
-    q0 = runs["nominal"]["zupt"].initial_attitude
-    ref_cal = zupt.moving_average_reference(log, q0, model=model)
-    ref_raw = zupt.moving_average_reference(log, q0)
-    refs = {"zupt": (ref_cal, truth_cal), "tczupt": (ref_raw, truth_raw)}
 
-    # Table 9.
-    res_cal = zupt.reference_residual(log, ref_cal, q0, model=model)
-    res_raw = zupt.reference_residual(log, ref_raw, q0)
-    w.table(
-        ["axis", "calibrated thesis", "calibrated ours", "raw thesis", "raw ours"],
-        [(a, TABLE9[a][0], res_cal[j], TABLE9[a][1], res_raw[j]) for j, a in enumerate(AXES)],
-        caption="Table 9: mean residual of the 30 s moving-average reference (rad/s).",
-        fmt="{:.2e}",
-    )
-    ma_noise = zupt.THESIS_ZUPT_NOISE.sigma_arw_rad_sqrt_s / np.sqrt(zupt.REFERENCE_WINDOW_S)
-    w.p(
-        f"The mean residual is small by construction, but the moving average itself carries "
-        f"white noise σ_ARW/√30 s = {ma_noise:.1e} rad/s for this gyro, larger than the "
-        "filters' errors below; so against the moving average the RMS errors are dominated by "
-        "the reference. We therefore also report errors against the stand-in's true bias."
-    )
+def _bias_figures(w: SectionWriter, r: ex.ZuptExperiment) -> None:
+    """Figures 40–45: bias estimates beside the moving average and the truth."""
+    from uasnav.plotting import new_figure
 
-    # Figures 40–45.
     for scen, first in (("nominal", 40), ("residual", 43)):
         for j in range(3):
             fig, ax = new_figure(7.0, 4.0)
-            for mode, label in (("zupt", "ZUPT (calibrated data)"), ("tczupt", "TCZUPT (raw data)")):
-                r = runs[scen][mode]
-                r.plot_bias(j, ax=ax, label=label)
+            for mode, label in zip(MODES, ("ZUPT (calibrated data)", "TCZUPT (raw data)"), strict=True):
+                run = r.runs[scen][mode]
+                run.plot_bias(j, ax=ax, label=label)
                 ax.plot(
-                    r.t,
-                    refs[mode][0][::dec, j],
+                    run.t,
+                    r.reference[mode][:, j],
                     lw=0.6,
                     alpha=0.6,
                     label=f"moving average ({mode.upper()} input)",
                 )
-                ax.plot(r.t, refs[mode][1][::dec, j], "k--", lw=0.8)
+                ax.plot(run.t, r.truth[mode][:, j], "k--", lw=0.8)
             ax.set_title(
                 ("nominal" if scen == "nominal" else "residual 15 deg/h")
                 + f", {AXES[j]} axis (dashed: true bias)"
@@ -187,6 +73,48 @@ def build(w: SectionWriter) -> None:
                 f"Figure {first + j}: gyro bias ({title}, {AXES[j]}-axis).",
             )
 
+
+def build(w: SectionWriter) -> None:
+    r = ex.run(seed=w.seed, quick=w.quick, progress=w.progress)
+    w.p(
+        "The 15-state error-state Kalman filter of eq. (8) (δr, δv, ψ, accelerometer and gyro "
+        "bias) on a local-level NED strapdown solution with Earth rate and WGS-84 gravity; "
+        "Φ = I + F·Ts, Γ = G·Q·Gᵀ·Ts, Q from σ_VRW, σ_ARW, σ_ABI, σ_GBI (eqs. 22–25, Tables 3–6); "
+        "nine ZUPT measurements (frozen position, zero velocity, frozen attitude) once per "
+        "second, Joseph form; 60 s coarse levelling and zeroing. TCZUPT propagates the bias "
+        "with (∂b/∂T)·(dT/dt)·Ts (eq. 31), dT/dt from a 30 s sliding least-squares slope."
+    )
+    w.p(
+        f"Data: the simulator's `{ex.PRESET}` preset (CRS05-02 gyros, σ_ARW = 3.18 deg/√h, 30 Hz "
+        "anti-alias filter, thermal curve with a heating/cooling hysteresis of 0.03 deg/s, 90 s "
+        "die lag), static at roll 0.012, pitch −0.021, heading 0.4 rad, 45° N, in the `cycles` "
+        "profile: 60 s at 27.28 °C for the zeroing, then the thesis' ramp test (27.28 ↔ 34.08 °C "
+        f"at 2 °C/min) repeated with 5-min dwells, {r.duration:g} s in all. Calibration model: the "
+        "thesis' BPNN (2 × 2 hidden neurons, Levenberg–Marquardt) fitted on a simulated soak "
+        "test (−20.5 … 37.3 °C, heating only, 60 s means) of the same sensor type with another "
+        "seed; ZUPT takes the gyro calibrated by it, TCZUPT the raw gyro and its analytic "
+        "derivative. The simulator's truth is exact, so we report errors against the true bias "
+        "beside the thesis' moving-average reference."
+    )
+    _input_figures(w, r)
+
+    w.table(
+        ["axis", "calibrated thesis", "calibrated ours", "raw thesis", "raw ours"],
+        [
+            (a, TABLE9[a][0], r.table9_calibrated[j], TABLE9[a][1], r.table9_raw[j])
+            for j, a in enumerate(AXES)
+        ],
+        caption="Table 9: mean residual of the 30 s moving-average reference (rad/s).",
+        fmt="{:.2e}",
+    )
+    w.p(
+        f"The mean residual is small by construction, but the moving average itself carries "
+        f"white noise σ_ARW/√30 s = {r.ma_noise:.1e} rad/s for this gyro, larger than the "
+        "filters' errors below; so against the moving average the RMS errors are dominated by "
+        "the reference. We therefore also report errors against the stand-in's true bias."
+    )
+    _bias_figures(w, r)
+
     # Table 10.
     data: dict[str, Any] = {"table10": {}, "table11": {}, "table12": {}, "table13": {}}
     rows = []
@@ -194,9 +122,7 @@ def build(w: SectionWriter) -> None:
         for j, a in enumerate(AXES):
             row: list[Any] = [scen, a]
             for mode in MODES:
-                r = runs[scen][mode]
-                rms_ma = zupt.rms_error(r.gyro_bias, refs[mode][0][::dec])[j]
-                rms_tr = zupt.rms_error(r.gyro_bias, refs[mode][1][::dec])[j]
+                rms_ma, rms_tr = r.rms_vs_ma[scen][mode][j], r.rms_vs_truth[scen][mode][j]
                 row += [TABLE10[scen][a][0 if mode == "zupt" else 1], rms_ma, rms_tr]
                 data["table10"].setdefault(scen, {}).setdefault(mode, {})[a] = {
                     "vs_moving_average": rms_ma,
@@ -219,26 +145,12 @@ def build(w: SectionWriter) -> None:
         fmt="{:.2e}",
     )
 
-    # Table 11. Two starts: after the 60 s zeroing (as in the thesis; its own error is
-    # σ_ARW/√60 s ≈ 1.2e-4 rad/s per axis, larger than 15 deg/h), and from the exact initial
-    # bias + 15 deg/h (zeroing off), which isolates the scenario.
-    exact = {}
-    for mode in MODES:
-        tru0 = refs[mode][1][0]
-        cfg = base.replace(
-            zeroing=False,
-            gyro_bias0_rad_s=tuple(float(v) for v in tru0),
-            residual_gyro_bias_rad_s=zupt.RESIDUAL_BIAS_15DEG_H,
-        )
-        exact[mode] = zupt.run(log, mode, model, cfg)
+    # Table 11.
     rows = []
     for j, a in enumerate(AXES):
         row = [a]
         for mode in MODES:
-            tru = refs[mode][1][::dec]
-            r = runs["residual"][mode]
-            ct = zupt.convergence_time(r.t, r.gyro_bias, tru)[j]
-            ce = zupt.convergence_time(exact[mode].t, exact[mode].gyro_bias, tru)[j]
+            ct, ce = r.convergence_zeroed[mode][j], r.convergence_exact[mode][j]
             row += [TABLE11[a][0 if mode == "zupt" else 1], _fmt_t(ct), _fmt_t(ce)]
             data["table11"].setdefault(mode, {})[a] = {"after_zeroing": ct, "exact_start": ce}
         rows.append(tuple(row))
@@ -260,88 +172,52 @@ def build(w: SectionWriter) -> None:
     )
 
     # Tables 12–13: five consecutive segments.
-    w.progress("segment statistics")
-    skip = int(60 * log.sample_rate)
-    piece_log = log.slice(skip, log.n)
     for tab_no, scen, thesis in ((12, "nominal", TABLE12), (13, "residual", TABLE13)):
-        resid = 0.0 if scen == "nominal" else zupt.RESIDUAL_BIAS_15DEG_H
-        cfg = base.replace(residual_gyro_bias_rad_s=resid, decimation=10)
         rows = []
         for mode in MODES:
-            _, mean, std = zupt.segment_rms(
-                piece_log, mode, refs[mode][1][skip:], model=model, config=cfg, segment_s=seg_s
-            )
+            seg = r.segments[scen][mode]
             for j, a in enumerate(AXES):
-                rows.append((mode.upper(), a, thesis[mode][a][0], mean[j], thesis[mode][a][1], std[j]))
-                data[f"table{tab_no}"].setdefault(mode, {})[a] = {"mean": mean[j], "std": std[j]}
+                rows.append(
+                    (mode.upper(), a, thesis[mode][a][0], seg.mean[j], thesis[mode][a][1], seg.std[j])
+                )
+                data[f"table{tab_no}"].setdefault(mode, {})[a] = {"mean": seg.mean[j], "std": seg.std[j]}
         w.table(
             ["filter", "axis", "mean thesis", "mean ours", "std thesis", "std ours"],
             rows,
             caption=f"Table {tab_no}: mean and standard deviation of the RMS error vs truth over "
-            f"5 × {seg_s:g} s segments "
+            f"5 × {r.segment_s:g} s segments "
             f"({'nominal' if scen == 'nominal' else 'residual 15 deg/h'}), rad/s.",
             fmt="{:.2e}",
         )
 
-    # What makes the difference: Monte Carlo over seeds, with and without hysteresis, and
-    # ablations that separate eq. 31 from TCZUPT's larger σ'_GBI.
-    w.progress("Monte Carlo: hysteresis and ablations")
-    n_mc = 2 if quick else 6
-    variants: dict[str, tuple[Mode, dict[str, Any]]] = {
-        "ZUPT (σ_GBI, Table 3)": ("zupt", {}),
-        "ZUPT with σ'_GBI": ("zupt", {"noise": zupt.THESIS_TCZUPT_NOISE}),
-        "TCZUPT (σ'_GBI, Table 5)": ("tczupt", {}),
-        "TCZUPT, derivative network": ("tczupt", {"derivative": "network"}),
-        "TCZUPT with σ_GBI": ("tczupt", {"noise": zupt.THESIS_ZUPT_NOISE}),
-    }
-    mc: dict[str, dict[str, list[Any]]] = {}
+    # Monte Carlo over units with and without hysteresis, and the ablations.
+    mc = r.monte_carlo
     mc_rows = []
-    for hyst in (True, False):
-        sens = _sensor(hyst)
-        key = "with hysteresis" if hyst else "without hysteresis"
-        acc: dict[str, list[Any]] = {v: [] for v in variants}
-        acc["nees_zupt"], acc["nees_tczupt"] = [], []
-        for s in range(n_mc):
-            lg = log if (hyst and s == 0) else _ramp_log(sens, duration, w.seed + 1000 + s)
-            md = model if (hyst and s == 0) else _calibration(sens, w.seed + 2000 + s, quick)
-            tr_raw = lg.truth["gyro_bias"][::dec]
-            tr_cal = (lg.truth["gyro_bias"] - md.predict(lg.temp))[::dec]
-            cfg0 = base.replace(residual_gyro_bias_rad_s=zupt.RESIDUAL_BIAS_15DEG_H)
-            for v, (mode, change) in variants.items():
-                r = zupt.run(lg, mode, md, cfg0.replace(**change))
-                tru = tr_cal if mode == "zupt" else tr_raw
-                acc[v].append(zupt.rms_error(r.gyro_bias, tru))
-                if not change:
-                    acc[f"nees_{mode}"].append(r.nees(tru))
-        mc[key] = acc
-        for v in variants:
-            m = np.mean(acc[v], axis=0)
-            mc_rows.append((key, v, *m, float(np.mean(m))))
+    for key in ex.MC_KEYS:
+        for v in ex.VARIANTS:
+            m = mc.mean_rms(key, v)
+            mc_rows.append((key, v, *m, float(m.mean())))
             data.setdefault("monte_carlo", {}).setdefault(key, {})[v] = m.tolist()
     w.table(
         ["data", "filter", "RMS x", "RMS y", "RMS z", "mean"],
         mc_rows,
-        caption=f"Whole-run RMS error vs truth (rad/s), residual 15 deg/h, mean over {n_mc} "
+        caption=f"Whole-run RMS error vs truth (rad/s), residual 15 deg/h, mean over {mc.n_runs} "
         "simulated units (own seeds and calibrations). σ_GBI = 1.5e-4 deg/s (Table 3), "
         "σ'_GBI = 5e-4 deg/s (Table 5).",
         fmt="{:.2e}",
     )
 
     # NEES consistency (beyond the thesis).
-    from scipy.stats import chi2
-
-    lo, hi = chi2.ppf([0.005, 0.995], 3 * n_mc) / n_mc
     nees_rows = []
-    for key, acc in mc.items():
+    for key in ex.MC_KEYS:
         for mode in MODES:
-            nees = np.mean(np.array(acc[f"nees_{mode}"]), axis=0)  # average over runs per time
-            inside = float(np.mean((nees >= lo) & (nees <= hi))) * 100
-            nees_rows.append((key, mode.upper(), n_mc, float(np.mean(nees)), lo, hi, inside))
+            n = mc.nees[key][mode]
+            nees_rows.append((key, mode.upper(), mc.n_runs, n.mean, n.lo, n.hi, n.inside_pct))
             data.setdefault("nees", {}).setdefault(key, {})[mode] = {
-                "mean": float(np.mean(nees)),
-                "lo": float(lo),
-                "hi": float(hi),
-                "inside_pct": inside,
+                "mean": n.mean,
+                "lo": n.lo,
+                "hi": n.hi,
+                "inside_pct": n.inside_pct,
             }
     w.table(
         ["data", "filter", "runs", "mean NEES (3 dof)", "99 % lower", "99 % upper", "% of time inside"],
@@ -351,10 +227,9 @@ def build(w: SectionWriter) -> None:
         fmt="{:.3g}",
     )
 
-    def verdict_nees(key: str, mode: str) -> str:
-        d = data["nees"][key][mode]
-        word = "consistent" if d["lo"] <= d["mean"] <= d["hi"] else "over-confident"
-        return f"{mode.upper()} {word} (mean {d['mean']:.2g})"
+    def verdict_nees(key: str, mode: Mode) -> str:
+        n = mc.nees[key][mode]
+        return f"{mode.upper()} {'consistent' if n.consistent else 'over-confident'} (mean {n.mean:.2g})"
 
     w.p(
         "Consistency: a filter whose σ_GBI covers the bias changes it meets has a mean NEES "
@@ -367,36 +242,24 @@ def build(w: SectionWriter) -> None:
         "Allan bias instability alone."
     )
 
-    # Claim check, from the numbers above.
-    faster = 0
-    for a in AXES:
-        tz_, tt_ = data["table11"]["zupt"][a]["exact_start"], data["table11"]["tczupt"][a]["exact_start"]
-        faster += int(tt_ is not None and (tz_ is None or tt_ < tz_))
-    mean_rms = {k: {v: float(np.mean(acc[v])) for v in variants} for k, acc in mc.items()}
-    hy, nh = mean_rms["with hysteresis"], mean_rms["without hysteresis"]
-    ratio_h = hy["TCZUPT (σ'_GBI, Table 5)"] / hy["ZUPT (σ_GBI, Table 3)"]
-    ratio_n = nh["TCZUPT (σ'_GBI, Table 5)"] / nh["ZUPT (σ_GBI, Table 3)"]
-    not_worse = ratio_h <= 1.1
-    verdict = "confirmed" if faster >= 2 and not_worse else "not confirmed"
+    c = r.claim
+    verdict = "confirmed" if c.confirmed else "not confirmed"
     data["claim"] = {
-        "tczupt_faster_axes_exact_start": faster,
-        "rms_ratio_tczupt_over_zupt_with_hysteresis": ratio_h,
-        "rms_ratio_tczupt_over_zupt_without_hysteresis": ratio_n,
-        "rms_ratio_zupt_sgbi_prime_over_tczupt_with_hysteresis": hy["ZUPT with σ'_GBI"]
-        / hy["TCZUPT (σ'_GBI, Table 5)"],
-        "rms_ratio_tczupt_sgbi_over_zupt_with_hysteresis": hy["TCZUPT with σ_GBI"]
-        / hy["ZUPT (σ_GBI, Table 3)"],
+        "tczupt_faster_axes_exact_start": c.faster_axes,
+        "rms_ratio_tczupt_over_zupt_with_hysteresis": c.ratio_with_hysteresis,
+        "rms_ratio_tczupt_over_zupt_without_hysteresis": c.ratio_without_hysteresis,
+        "rms_ratio_zupt_sgbi_prime_over_tczupt_with_hysteresis": c.ratio_zupt_sgbi_prime,
+        "rms_ratio_tczupt_sgbi_over_zupt_with_hysteresis": c.ratio_tczupt_sgbi,
         "verdict": verdict,
     }
-    c = data["claim"]
     w.p(
         "Thesis claim — TCZUPT converges faster in the 15 deg/h scenario and is not worse in "
         f"RMS over the whole run: {verdict.upper()} on the simulated AX1. From the exact start + "
-        f"15 deg/h TCZUPT reached 1e-5 rad/s first on {faster}/3 axes; over the Monte Carlo its "
-        f"whole-run RMS error is {ratio_h:.2f}× ZUPT's with the preset's hysteresis and "
-        f"{ratio_n:.2f}× without it. The ablations say why: ZUPT given TCZUPT's larger σ'_GBI "
-        f"scores {c['rms_ratio_zupt_sgbi_prime_over_tczupt_with_hysteresis']:.2f}× TCZUPT, and "
-        f"TCZUPT given the standard σ_GBI scores {c['rms_ratio_tczupt_sgbi_over_zupt_with_hysteresis']:.2f}× "
+        f"15 deg/h TCZUPT reached 1e-5 rad/s first on {c.faster_axes}/3 axes; over the Monte Carlo its "
+        f"whole-run RMS error is {c.ratio_with_hysteresis:.2f}× ZUPT's with the preset's hysteresis and "
+        f"{c.ratio_without_hysteresis:.2f}× without it. The ablations say why: ZUPT given TCZUPT's "
+        f"larger σ'_GBI scores {c.ratio_zupt_sgbi_prime:.2f}× TCZUPT, and "
+        f"TCZUPT given the standard σ_GBI scores {c.ratio_tczupt_sgbi:.2f}× "
         "ZUPT — the difference comes from the process noise, not from eq. (31). With a "
         "calibration model and its own derivative, propagating the bias by (∂b/∂T)·(dT/dt)·Ts "
         "does what subtracting the model does; what remains for the filter is the part no "
@@ -410,24 +273,30 @@ def build(w: SectionWriter) -> None:
         "first crossing of 1e-5 rad/s is partly a chance event of the noise."
     )
 
-    # Hysteresis study, per branch (the thesis' first future development).
-    w.progress("hysteresis study")
-    from uasnav.thermal import branch_from_temperature
+    _hysteresis(w, r, data)
+    w.p(
+        "Real data (not read by the report, which runs on simulated data only): the test "
+        "suite runs ZUPT on the 2.78 h ADIS16405 static recording and checks that the "
+        "estimated turn-on gyro bias agrees with the long-term mean output minus the Earth "
+        "rate, and detects the x-IMU log's rest periods automatically (tests/test_zupt.py)."
+    )
+    w.data.update(data)
 
-    heating = branch_from_temperature(log.t, log.truth["temp_die"])[::dec]
-    rz, rt = runs["nominal"]["zupt"], runs["nominal"]["tczupt"]
-    tz, tt = truth_cal[::dec], truth_raw[::dec]
-    settled = rz.t > 60.0
+
+def _hysteresis(w: SectionWriter, r: ex.ZuptExperiment, data: dict[str, Any]) -> None:
+    """The hysteresis study, per branch (the thesis' first future development)."""
+    from uasnav.plotting import new_figure
+
     hrows = []
-    for label, mask in (("heating", heating & settled), ("cooling", ~heating & settled)):
-        if not mask.any():
-            w.p(f"(No {label} branch in this {duration:g} s run: the first reversal comes later.)")
+    for label, b in r.branches.items():
+        if b is None:
+            w.p(f"(No {label} branch in this {r.duration:g} s run: the first reversal comes later.)")
             continue
-        ez = zupt.rms_error(rz.gyro_bias[mask], tz[mask])
-        et = zupt.rms_error(rt.gyro_bias[mask], tt[mask])
-        off = np.mean(tz[mask], axis=0) - np.mean(tz[heating & settled], axis=0)
-        hrows.append((label, *ez, *et, float(np.linalg.norm(off))))
-        data.setdefault("hysteresis", {})[label] = {"zupt_rms": ez.tolist(), "tczupt_rms": et.tolist()}
+        hrows.append((label, *b.zupt, *b.tczupt, b.offset))
+        data.setdefault("hysteresis", {})[label] = {
+            "zupt_rms": b.zupt.tolist(),
+            "tczupt_rms": b.tczupt.tolist(),
+        }
     w.table(
         ["branch", "ZUPT x", "ZUPT y", "ZUPT z", "TCZUPT x", "TCZUPT y", "TCZUPT z", "|calibration offset|"],
         hrows,
@@ -436,9 +305,19 @@ def build(w: SectionWriter) -> None:
         "relative to the heating branch.",
         fmt="{:.2e}",
     )
+    rz, rt = r.runs["nominal"]["zupt"], r.runs["nominal"]["tczupt"]
     fig, ax = new_figure(7.0, 4.0)
-    rz.plot_bias(0, ax=ax, reference=tz, reference_label="true residual (ZUPT)", label="ZUPT", sigma=False)
-    rt.plot_bias(0, ax=ax, reference=tt, reference_label="true bias (TCZUPT)", label="TCZUPT", sigma=False)
+    rz.plot_bias(
+        0, ax=ax, reference=r.truth["zupt"], reference_label="true residual (ZUPT)", label="ZUPT", sigma=False
+    )
+    rt.plot_bias(
+        0,
+        ax=ax,
+        reference=r.truth["tczupt"],
+        reference_label="true bias (TCZUPT)",
+        label="TCZUPT",
+        sigma=False,
+    )
     w.figure(
         fig,
         "hysteresis_x",
@@ -453,18 +332,6 @@ def build(w: SectionWriter) -> None:
         "a single-valued curve sees it: both filters meet it as an unmodelled bias change, and "
         "the one with the larger σ_GBI follows it sooner (table above)."
     )
-
-    w.p(
-        "Real data (not read by the report, which runs on simulated data only): the test "
-        "suite runs ZUPT on the 2.78 h ADIS16405 static recording and checks that the "
-        "estimated turn-on gyro bias agrees with the long-term mean output minus the Earth "
-        "rate, and detects the x-IMU log's rest periods automatically (tests/test_zupt.py)."
-    )
-    w.data.update(data)
-
-
-def _fmt_t(v: float | None) -> str:
-    return "never" if v is None else f"{v:.0f}"
 
 
 SECTION = Section(key="zupt", title="ZUPT and TCZUPT filters", order=50, build=build)

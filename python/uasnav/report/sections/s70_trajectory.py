@@ -1,4 +1,7 @@
-"""Report section: trajectory prediction with LVQ networks (thesis §5.1, Table 17, Figures 57–65)."""
+"""Report section: trajectory prediction with LVQ networks (thesis §5.1, Table 17, Figures 57–65).
+
+Renders :func:`uasnav.experiments.trajectory.run`.
+"""
 
 from __future__ import annotations
 
@@ -6,22 +9,16 @@ import numpy as np
 
 from uasnav.report import Section, SectionWriter
 
-# Thesis §5.1.4.2: the four training elements (θ°, θ_w°, ΔV m/s).
-THESIS_TRAINING = [(72.0, 64.0, 0.25), (105.0, 140.0, 0.35), (80.0, 90.0, 0.35), (130.0, 170.0, 0.40)]
-# Thesis Table 17: per test element, t_NN (s) and t_Real, e% of the three test flights.
-THESIS_TABLE17 = [
-    (27.27, [(26.15, 4.28), (26.28, 3.77), (28.18, 3.23)]),
-    (25.13, [(25.67, 2.10), (24.50, 2.57), (26.00, 3.35)]),
-]
-
 
 def build(w: SectionWriter) -> None:
-    from uasnav.plotting import new_figure
-    from uasnav.trajectory.baselines import percent_error
-    from uasnav.trajectory.experiment import run_phantom4, table17_piece
-    from uasnav.trajectory.geometry import discretise
+    from matplotlib.figure import Figure
 
-    n_flights, n_train = (5, 3) if w.quick else (10, 7)
+    from uasnav.experiments import trajectory
+    from uasnav.experiments.thesis import TABLE17
+    from uasnav.plotting import new_figure
+
+    res = trajectory.run(seed=w.seed, quick=w.quick, progress=w.progress)
+    r, n_train = res.phantom4, res.n_train
     w.p(
         "A plan is cut into elements of two 10 m segments (eq. 47); each element's turn angle θ "
         "(eq. 52), wind direction relative to its first segment θ_w (eq. 56) and wind speed are "
@@ -32,10 +29,8 @@ def build(w: SectionWriter) -> None:
         "the experiment is reproduced with a simulated multirotor (PI velocity loop, 15° tilt "
         "limit, quadratic drag, waypoint braking, 3.33 m/s, wind 2.78 m/s from NNE with "
         "Ornstein–Uhlenbeck gusts): two trajectories flown "
-        f"{n_flights} times each, the first {n_train} for training, the rest for testing."
+        f"{res.n_flights} times each, the first {n_train} for training, the rest for testing."
     )
-    w.progress("simulating the Phantom-4 experiment")
-    r = run_phantom4(n_flights=n_flights, n_train=n_train, seed=w.seed)
 
     # Figure 57/58/63 analogue: plans, flown tracks, training/test pieces, wind.
     fig, ax = new_figure(7.0, 5.0)
@@ -46,9 +41,8 @@ def build(w: SectionWriter) -> None:
                 tel.pos_ne[:, 1], tel.pos_ne[:, 0], lw=0.5, color="C0" if k < n_train else "C1", alpha=0.6
             )
         ax.plot(plan[:, 1], plan[:, 0], "k--o", ms=3, lw=0.8)
-        el = discretise(plan)
-        piece = table17_piece(plan)
-        ax.plot(el.mid_ne[piece, 1], el.mid_ne[piece, 0], "s", color="C3", ms=4)
+        mid = res.piece_mid_ne[name]
+        ax.plot(mid[:, 1], mid[:, 0], "s", color="C3", ms=4)
         ax.annotate(f"trajectory {name}", plan[1, ::-1], fontsize=8)
     ax.annotate(
         "",
@@ -64,38 +58,16 @@ def build(w: SectionWriter) -> None:
     w.figure(fig, "plans", "Figures 57, 58 and 63 analogue: the two simulated waypoint trajectories.")
 
     # Figures 59–62 analogue: the four training corner elements with the flown tracks.
-    from matplotlib.figure import Figure
-
     fig = Figure(figsize=(7.0, 6.0))
     axes = fig.subplots(2, 2)
-    rows = []
-    train = r.train
-    for ax_i, (th, tw, dv_thesis) in zip(axes.ravel(), THESIS_TRAINING, strict=True):
-        f = train.features
-        m = (np.abs(f.theta_deg - th) < 1.0) & (np.abs(f.theta_w_deg - tw) < 1.0) & (f.kind == 0)
-        rows.append(
-            (
-                th,
-                tw,
-                dv_thesis,
-                float(np.mean(train.dv_ms[m])),
-                float(np.mean(train.v_init_ms[m])),
-                float(np.mean(train.length_m[m] / train.t_real_s[m] - train.v_init_ms[m])),
-                int(m.sum()),
+    for ax_i, te in zip(axes.ravel(), res.training_elements, strict=True):
+        for v in te.views:
+            for track in v.tracks_ne:
+                ax_i.plot(track[:, 1], track[:, 0], ".", ms=1.5)
+            ax_i.plot(v.corner_ne[:, 1], v.corner_ne[:, 0], "k-", lw=1)
+            ax_i.set_title(
+                f"{v.trajectory}: θ = {te.theta_deg:.0f}°, θ_w = {te.theta_w_deg:.0f}°", fontsize=9
             )
-        )
-        for name, fl in r.flights.items():
-            el = discretise(fl[0].plan_ne)
-            for i in np.flatnonzero(el.kind == "corner"):
-                if abs(abs(el.turn_deg[i]) - th) < 1.0:
-                    pts = np.array([el.start_ne[i], el.mid_ne[i], el.end_ne[i]])
-                    lo = pts.min(axis=0) - 3
-                    hi = pts.max(axis=0) + 3
-                    for tel in fl[:n_train]:
-                        sel = np.all((tel.pos_ne >= lo) & (tel.pos_ne <= hi), axis=1)
-                        ax_i.plot(tel.pos_ne[sel, 1] - lo[1], tel.pos_ne[sel, 0] - lo[0], ".", ms=1.5)
-                    ax_i.plot(pts[:, 1] - lo[1], pts[:, 0] - lo[0], "k-", lw=1)
-                    ax_i.set_title(f"{name}: θ = {th:.0f}°, θ_w = {tw:.0f}°", fontsize=9)
         ax_i.set_aspect("equal")
     fig.tight_layout()
     w.figure(
@@ -106,7 +78,18 @@ def build(w: SectionWriter) -> None:
     )
     w.table(
         ["θ (°)", "θ_w (°)", "ΔV thesis (m/s)", "ΔV ours vs cruise", "V_init ours", "ΔV ours vs V_init", "n"],
-        rows,
+        [
+            (
+                e.theta_deg,
+                e.theta_w_deg,
+                e.dv_thesis_ms,
+                e.dv_vs_cruise_ms,
+                e.v_init_ms,
+                e.dv_vs_v_init_ms,
+                e.n,
+            )
+            for e in res.training_elements
+        ],
         caption="Training elements (§5.1.4.2). The thesis' ΔV is relative to the element's initial speed; "
         "we train on ΔV relative to the commanded speed (known for a new plan); both shown. Our simulated "
         "vehicle slows down in corners, so ΔV vs cruise is negative.",
@@ -114,19 +97,19 @@ def build(w: SectionWriter) -> None:
     )
 
     t17 = []
-    for (name, t_nn, reals), (th_nn, th_rows) in zip(r.table17, THESIS_TABLE17, strict=True):
-        e = percent_error(np.full(len(reals), t_nn), np.array(reals))
-        for k, (tr, ee) in enumerate(zip(reals, e, strict=True)):
+    for pc, (th_nn, th_rows) in zip(r.table17, TABLE17, strict=True):
+        for k, (tr, ee) in enumerate(zip(pc.t_real_s, pc.error_pct, strict=True)):
             th_real, th_e = th_rows[k] if k < len(th_rows) else (None, None)
+            first = k == 0
             t17.append(
                 (
-                    name if k == 0 else "",
-                    th_nn if k == 0 else None,
+                    pc.piece if first else "",
+                    th_nn if first else None,
                     th_real,
                     th_e,
-                    t_nn if k == 0 else None,
+                    pc.t_nn_s if first else None,
                     tr,
-                    float(ee),
+                    ee,
                 )
             )
     w.table(
@@ -146,12 +129,11 @@ def build(w: SectionWriter) -> None:
         "(sum of predicted element times).",
         fmt="{:.2f}",
     )
-    w.data["table17"] = [{"piece": n, "t_nn_s": t, "t_real_s": rr} for n, t, rr in r.table17]
-
-    mrows = [
-        (m.name, float(m.error_pct.mean()), float(np.median(m.error_pct)), float(m.error_pct.max()))
-        for m in r.methods
+    w.data["table17"] = [
+        {"piece": p.piece, "t_nn_s": p.t_nn_s, "t_real_s": list(p.t_real_s)} for p in r.table17
     ]
+
+    mrows = [(m.name, m.mean_pct, m.median_pct, m.max_pct) for m in res.methods]
     w.table(
         ["method", "mean e% per element", "median", "max"],
         mrows,
@@ -170,24 +152,20 @@ def build(w: SectionWriter) -> None:
         "methods",
         "LVQ against the distance ÷ speed baselines and other predictors (simulated test flights).",
     )
-    from uasnav.trajectory.experiment import cross_trajectory
 
-    cross = cross_trajectory(r, seed=w.seed)
-    names = [m.name for m in next(iter(cross.values()))]
-    crows = [
-        (n, *[float(next(m for m in res if m.name == n).error_pct.mean()) for res in cross.values()])
-        for n in names
-    ]
+    cross = res.cross
     w.table(
-        ["method", *[f"mean e% {k}" for k in cross]],
-        crows,
+        ["method", *[f"mean e% {k}" for k in cross.results]],
+        [(n, *v) for n, v in cross.mean_pct.items()],
         caption="Generalisation to a trajectory never flown in training (train on one trajectory's training "
         "flights, test on the other's test flights). The test set above shares every element with training, "
         "so there the network reduces to the per-cell table; here cells are missing and the network's "
         "nearest-prototype fallback is what it adds.",
         fmt="{:.2f}",
     )
-    w.data["cross_trajectory"] = {n: dict(zip(cross, v, strict=True)) for n, *v in crows}
+    w.data["cross_trajectory"] = {
+        n: dict(zip(cross.results, v, strict=True)) for n, v in cross.mean_pct.items()
+    }
     w.p(
         "Real flights are not embedded in the report (their licence forbids redistribution). On the "
         "ArduCopter telemetry of five runs of one straight 100 m leg at 5 m/s (no wind message), "

@@ -1,38 +1,22 @@
-"""Report section: mission selector (thesis §5.2, Tables 18–24, eqs. 60–61, Figure 74)."""
+"""Report section: mission selector (thesis §5.2, Tables 18–24, eqs. 60–61, Figure 74).
+
+Renders :func:`uasnav.experiments.mission.run`.
+"""
 
 from __future__ import annotations
-
-import numpy as np
 
 from uasnav.report import Section, SectionWriter
 
 _SYM = {"necessary": "●", "optional": "✓", "incompatible": ""}
-# Thesis Table 24 (precision agriculture): UAS, camera, Score_Total.
-TABLE24 = [
-    ("Phantom 4", "Micro ADC", 1.18),
-    ("Hexacopter Hawk", "Micro ADC", 1.34),
-    ("Phantom 4", "Snap ADC", 1.56),
-    ("Based 1", "Micro ADC", 1.64),
-    ("Phantom 3", "Micro ADC", 1.65),
-]
-# Thesis names → our database ids (None: not identifiable as a public product).
-_IDS = {
-    "Phantom 4": "dji-phantom-4",
-    "Phantom 3": "dji-phantom-3-professional",
-    "Hexacopter Hawk": None,
-    "Based 1": None,
-    "Micro ADC": "tetracam-adc-micro",
-    "Snap ADC": "tetracam-adc-snap",
-}
 
 
 def build(w: SectionWriter) -> None:
-    from uasnav.mission import Requirements, Targets, Weights, load_database, load_matrices, select
-    from uasnav.mission.scoring import transfer
+    from uasnav.experiments import mission
+    from uasnav.experiments.thesis import TABLE22, TABLE23, TABLE24
+    from uasnav.plotting import new_figure
 
-    mx = load_matrices()
-    db = load_database()
-    missions = list(mx.missions.values())
+    res = mission.run(seed=w.seed, quick=w.quick, progress=w.progress)
+    mx, db, missions = res.matrices, res.database, res.missions
     w.p(
         "Knowledge as data: the matrices, the UAS/camera database and the regulations are XML "
         "documents shipped in the package, validated against XSD schemas and parsed with a hardened "
@@ -40,10 +24,9 @@ def build(w: SectionWriter) -> None:
         "from an http(s) URL with a timeout, a size limit and a revalidated cache."
     )
     w.heading("Table 18 — missions × features (as encoded)")
-    feats = list(mx.features)
     w.table(
         ["feature", *[m.name for m in missions]],
-        [[mx.feature_names[f], *[" ".join(m.features.get(f, ())) for m in missions]] for f in feats],
+        [[mx.feature_names[f], *[" ".join(m.features.get(f, ())) for m in missions]] for f in mx.features],
         caption="Feature levels per mission (transcribed from Table 18).",
     )
     w.heading("Table 19 — features × equipment (reconstructed)")
@@ -72,39 +55,26 @@ def build(w: SectionWriter) -> None:
         "incompatible if every level of some feature excludes it, otherwise optional. Cells show "
         "ours/thesis (● necessary, ✓ optional, blank = not listed)."
     )
-    rows = []
-    for r in mx.table20:
-        if r.equipment is None:
-            rows.append([r.label + " (no Table 19 row)", *[f"–/{_SYM[r.status[m.id]]}" for m in missions]])
-            continue
-        rows.append(
-            [
-                r.label,
-                *[f"{_SYM[mx.equipment_status(m.id, r.equipment)]}/{_SYM[r.status[m.id]]}" for m in missions],
-            ]
-        )
-    w.table(["equipment", *[m.name for m in missions]], rows, caption="Derived / printed Table 20.")
-    diffs = mx.compare_table20()
-    n_cells = sum(len(r.status) for r in mx.table20 if r.equipment)
-    nec = [d for d in diffs if (d["derived"] == "necessary") != (d["table20"] == "necessary")]
-    kinds: dict[tuple[str, str], int] = {}
-    for d in diffs:
-        kinds[(d["derived"], d["table20"])] = kinds.get((d["derived"], d["table20"]), 0) + 1
+    t20 = res.table20
+    rows20 = [
+        [r.label + " (no Table 19 row)", *[f"–/{_SYM[p]}" for p in r.printed]]
+        if r.derived is None
+        else [r.label, *[f"{_SYM[d]}/{_SYM[p]}" for d, p in zip(r.derived, r.printed, strict=True)]]
+        for r in t20.rows
+    ]
+    w.table(["equipment", *[m.name for m in missions]], rows20, caption="Derived / printed Table 20.")
     w.table(
         ["derived (ours)", "Table 20 (thesis)", "cells"],
-        [[a, b, n] for (a, b), n in sorted(kinds.items(), key=lambda kv: -kv[1])],
+        [list(k) for k in t20.kinds],
         caption=(
-            f"Disagreements: {len(diffs)} of {n_cells} cells; {len(nec)} on necessary vs not. Most are "
+            f"Disagreements: {t20.cells - t20.agree} of {t20.cells} cells; {t20.cells - t20.agree_necessary} "
+            "on necessary vs not. Most are "
             "Table 20 leaving blank what Table 19 allows (Table 20 uses blank for 'not relevant'), and "
             "Table 20 requiring items that no feature rule asks for (RTK/differential GNSS for mapping, "
             "the advanced autopilot for mapping), which §5.2.2.4 motivates by mission objectives."
         ),
     )
-    w.data["table20"] = {
-        "cells": n_cells,
-        "agree": n_cells - len(diffs),
-        "agree_necessary": n_cells - len(nec),
-    }
+    w.data["table20"] = {"cells": t20.cells, "agree": t20.agree, "agree_necessary": t20.agree_necessary}
 
     w.heading("Table 21 — database")
     u, c = db.uas, db.cameras
@@ -154,42 +124,37 @@ def build(w: SectionWriter) -> None:
         fmt="{:.5g}",
     )
 
-    req = Requirements()
-    t = Targets()
-    wts = Weights()
+    req, t, wts = res.requirements, res.targets, res.weights
     w.heading("Tables 22–23 — precision agriculture: requirements, targets, weights")
+    ours22 = {
+        "range": f"{req.range_m:g} m",
+        "resolution": f"{req.resolution_m:g} m/px",
+        "image size": f"{req.image_size_m[0]:g} x {req.image_size_m[1]:g} m",
+        "altitude": f"{req.altitude_m:g} m",
+        "imagery": req.imagery,
+        "wind": f"{req.wind_ms:g} m/s",
+        "rain": "yes" if req.rain else "no",
+        "order by": "cost (weight 1.25, eq. 61)",
+        "regulations": f"{req.jurisdiction}/{req.category}: max 120 m",
+    }
     w.table(
         ["requirement", "thesis (Table 22)", "ours"],
-        [
-            ["range", "1500 m", f"{req.range_m:g} m"],
-            ["resolution", "0.05 m", f"{req.resolution_m:g} m/px"],
-            ["image size", "70 x 70 m", f"{req.image_size_m[0]:g} x {req.image_size_m[1]:g} m"],
-            ["altitude", "50 m", f"{req.altitude_m:g} m"],
-            ["imagery", "multispectral", req.imagery],
-            ["wind", "5 m/s", f"{req.wind_ms:g} m/s"],
-            ["rain", "no", "yes" if req.rain else "no"],
-            ["order by", "cost", "cost (weight 1.25, eq. 61)"],
-            ["regulations", "Italy (ENAC, 2016)", f"{req.jurisdiction}/{req.category}: max 120 m"],
-        ],
+        [[k, v, ours22[k]] for k, v in TABLE22.items()],
         caption="Table 22.",
     )
+    ours23 = {
+        "range": (f"{t.range_m[0]:g} → {t.range_m[1]:g} m", wts.range),
+        "weight": (f"{t.weight_g[0]:g} → {t.weight_g[1]:g} g", wts.weight),
+        "cost": (f"{t.cost_usd[0]:g} → {t.cost_usd[1]:g} $", wts.cost),
+        "angular resolution": (f"{t.resolution_deg[0]:g} → {t.resolution_deg[1]:g} deg/px", wts.resolution),
+    }
     w.table(
         ["parameter", "thesis (Table 23)", "ours: target → limit", "weight (eq. 61)"],
-        [
-            ["range", "min 1500 m, target 5000 m", f"{t.range_m[0]:g} → {t.range_m[1]:g} m", wts.range],
-            ["weight", "target 800 g, max 1600 g", f"{t.weight_g[0]:g} → {t.weight_g[1]:g} g", wts.weight],
-            ["cost", "target 4000 $, max 7000 $", f"{t.cost_usd[0]:g} → {t.cost_usd[1]:g} $", wts.cost],
-            [
-                "angular resolution",
-                "target 0.01°, max 0.06°",
-                f"{t.resolution_deg[0]:g} → {t.resolution_deg[1]:g} deg/px",
-                wts.resolution,
-            ],
-        ],
+        [[k, v, *ours23[k]] for k, v in TABLE23.items()],
         caption="Table 23 and eq. 61: Score = S_range + 0.75·S_weight + 1.25·S_cost + S_resolution.",
         fmt="{:.2f}",
     )
-    sel = select(req, database=db, matrices=mx, top=500)
+    sel = res.selection
     w.p(
         f"Required HFOV (eq. 60) at the 120 m regulatory height: α = 2·atan(70/240) = "
         f"{sel.required_hfov_deg:.2f}°. Feasible UAS: {len(sel.feasible_uas)}; feasible cameras: "
@@ -198,28 +163,19 @@ def build(w: SectionWriter) -> None:
         + "."
     )
     w.heading("Table 24 — best configurations (precision agriculture)")
-    by_pair = {(cf.uas_id, cf.camera_id): cf for cf in sel.ranking}
-    rej = {}
-    for r in sel.rejections:
-        rej.setdefault(r.item, []).append(r.message)
-    rows = []
-    for uas, cam, score in TABLE24:
-        ui, ci = _IDS[uas], _IDS[cam]
-        if ui is None:
-            rows.append([uas, cam, score, None, "not identifiable as a public product; not in our database"])
-            continue
-        cf = by_pair.get((ui, ci))
+    rows24: list[list[object]] = []
+    for r in res.table24:
+        cf = r.pair
+        why = r.reason
         if cf is not None:
             why = (
                 f"S_range {cf.score_range:.2f}, S_weight {cf.score_weight:.2f} ({cf.mass_g:.0f} g), "
                 f"S_cost {cf.score_cost:.2f} ({cf.cost_usd:.0f} $), S_res {cf.score_resolution:.2f}"
             )
-            rows.append([uas, cam, score, cf.score, why])
-        else:
-            rows.append([uas, cam, score, None, "; ".join(rej.get(ci, []) + rej.get(ui, [])) or "infeasible"])
+        rows24.append([r.uas, r.camera, r.thesis_score, r.score, why])
     w.table(
         ["UAS (thesis)", "camera (thesis)", "Score thesis", "Score ours", "our partial scores / reason"],
-        rows,
+        rows24,
         caption=(
             "Thesis pairs scored with our database. Differences come from the database values: the "
             "thesis' cost and angular resolution of the ADC cameras are not given; with the Phantom 4 at "
@@ -229,12 +185,11 @@ def build(w: SectionWriter) -> None:
         ),
         fmt="{:.2f}",
     )
-    top5 = sel.ranking[:5]
     w.table(
         ["#", "UAS (ours)", "camera (ours)", "Score", "mass g", "cost $", "open subcat."],
         [
             [k + 1, cf.uas, cf.camera, cf.score, cf.mass_g, cf.cost_usd, cf.open_subcategory]
-            for k, cf in enumerate(top5)
+            for k, cf in enumerate(res.top5)
         ],
         caption=(
             "Our top 5 over the whole database: a 400 $ MAPIR Survey3N scores near 0 on cost and "
@@ -244,21 +199,18 @@ def build(w: SectionWriter) -> None:
     )
     w.data["table24"] = {
         "thesis": [list(r) for r in TABLE24],
-        "ours_top5": [[cf.uas, cf.camera, cf.score] for cf in top5],
-        "ours_thesis_pairs": [[r[0], r[1], r[3]] for r in rows],
+        "ours_top5": [[cf.uas, cf.camera, cf.score] for cf in res.top5],
+        "ours_thesis_pairs": [[r.uas, r.camera, r.score] for r in res.table24],
         "n_feasible_uas": len(sel.feasible_uas),
         "n_feasible_cameras": len(sel.feasible_cameras),
     }
 
-    from uasnav.plotting import new_figure
-
+    f74 = res.figure74
     fig, ax = new_figure()
-    x = np.linspace(0, 2400, 400)
-    ax.plot(x, transfer(x, *t.weight_g), label="weight: target 800 g, limit 1600 g")
-    r = np.linspace(0, 7000, 400)
+    ax.plot(f74.weight_g, f74.weight_score, label="weight: target 800 g, limit 1600 g")
     ax.plot(
-        r * 2400 / 7000,
-        transfer(r, *t.range_m),
+        f74.range_m * 2400 / 7000,
+        f74.range_score,
         "--",
         label="range (x scaled 0–7000 m): target 5000, min 1500",
     )

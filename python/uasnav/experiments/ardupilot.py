@@ -1,5 +1,5 @@
-"""Fusion of the three IMUs of an ArduPilot DataFlash log, compared with each IMU and with
-ArduPilot's own pre-arm consistency gates.
+"""Real data: fusion of the three IMUs of an ArduPilot DataFlash log, compared with each IMU and
+with ArduPilot's own pre-arm consistency gates.
 
 ArduPilot (``AP_InertialSensor::gyros_consistent`` / ``accels_consistent``) calls its IMUs
 consistent when every pair of gyro vectors differs by at most 5 deg/s and every pair of
@@ -7,12 +7,19 @@ accelerometer vectors by at most 0.75 m/s². The ``IMU``, ``IMU2`` and ``IMU3`` 
 already rotated into the vehicle body frame, so the three sensors share one mounting
 (identity) and fusion is a weighted average whose weights come from each IMU's white noise in
 a static window.
+
+The log is read by :func:`uasnav.io.read_dataflash` (times in s). The report runs on simulated
+data only; this experiment is asserted by ``tests/test_redundancy.py::test_ardupilot_three_imus``
+and printed by ``python benches/bench_python.py redundancy_ardupilot``.
 """
 
 from __future__ import annotations
 
+import functools
 import os
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,73 +27,36 @@ from numpy.typing import NDArray
 from uasnav import redundancy as R
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog
+from uasnav.io import read_dataflash
 
+FloatArray = NDArray[np.float64]
+
+#: ArduPilot's gyro consistency gate (rad/s): 5 deg/s between any two IMUs.
 GYRO_GATE_RAD_S = np.radians(5.0)
+#: ArduPilot's accelerometer consistency gate (m/s²) between any two IMUs.
 ACCEL_GATE_M_S2 = 0.75
-
-
-def read_dataflash_imus(path: str | os.PathLike[str]) -> list[ImuLog]:
-    """The ``IMU``, ``IMU2``, ``IMU3`` streams of a DataFlash log on their common timestamps.
-
-    Raises
-    ------
-    DataFormatError
-        If the file is unreadable or has fewer than two IMU streams.
-    """
-    try:
-        from pymavlink import mavutil
-    except ImportError as e:  # pragma: no cover - a declared dependency
-        raise DataFormatError(f"pymavlink is required to read DataFlash logs ({e})", path=str(path)) from None
-    if not os.path.isfile(path):
-        raise DataFormatError("no such file", path=str(path))
-    conn = mavutil.mavlink_connection(str(path))
-    rows: dict[str, dict[int, list[float]]] = {"IMU": {}, "IMU2": {}, "IMU3": {}}
-    while True:
-        msg = conn.recv_match(type=list(rows))
-        if msg is None:
-            break
-        d = msg.to_dict()
-        t = d.get("TimeUS", None)
-        t_us = int(t) if t is not None else int(d["TimeMS"]) * 1000
-        rows[msg.get_type()][t_us] = [
-            d["GyrX"],
-            d["GyrY"],
-            d["GyrZ"],
-            d["AccX"],
-            d["AccY"],
-            d["AccZ"],
-            d.get("Temp", np.nan),
-        ]
-    streams = [r for r in rows.values() if r]
-    if len(streams) < 2:
-        raise DataFormatError("fewer than two IMU streams (IMU, IMU2, IMU3)", path=str(path))
-    common = sorted(set.intersection(*(set(r) for r in streams)))
-    if len(common) < 10:
-        raise DataFormatError("the IMU streams share fewer than 10 timestamps", path=str(path))
-    t = np.array(common, dtype=np.float64) * 1e-6
-    logs = []
-    for r in streams:
-        a = np.array([r[k] for k in common], dtype=np.float64)
-        logs.append(ImuLog(t=t, gyro=a[:, 0:3], accel=a[:, 3:6], temp=a[:, 6], meta={"source": str(path)}))
-    return logs
+#: The log of the shared reference data, relative to the data folder.
+SHARED_LOG = Path("logs") / "ardupilot_log171.bin"
 
 
 @dataclass(frozen=True)
-class ArduPilotFusion:
+class ArduPilotResult:
     """Result of :func:`analyse_log` (noise σ per sample per axis, in a static window).
 
     Attributes
     ----------
     n_samples : int
+        Samples common to every IMU.
     rate_hz : float
+        Sample rate (Hz).
     static_window_s : tuple of float
         Start and end (s, log time) of the window used for noise and weights.
     single_noise_gyro, single_noise_accel : ndarray, shape (n_imu, 3)
         White-noise σ of each IMU (rad/s, m/s²).
     fused_noise_gyro, fused_noise_accel : ndarray, shape (3,)
-        White-noise σ of the fused IMU.
+        White-noise σ of the fused IMU (rad/s, m/s²).
     predicted_noise_gyro, predicted_noise_accel : ndarray, shape (3,)
-        σ predicted by the LS covariance from the single-IMU noise.
+        σ predicted by the LS covariance from the single-IMU noise (rad/s, m/s²).
     average_noise_gyro, average_noise_accel : ndarray, shape (3,)
         White-noise σ of the plain (unweighted) average of the IMUs, for comparison.
     static_gates_ok : bool
@@ -94,7 +64,7 @@ class ArduPilotFusion:
     gyro_gate_ok_fraction, accel_gate_ok_fraction : float
         Fraction of samples passing ArduPilot's consistency gates.
     max_gyro_diff_rad_s, max_accel_diff_m_s2 : float
-        Largest pairwise vector difference.
+        Largest pairwise vector difference (rad/s, m/s²).
     fdi_alarm_fraction : float
         Fraction of samples on which the parity test (p_fa = 1e-6, σ from the static window)
         fired: vibration the IMUs see differently is not white noise.
@@ -104,19 +74,20 @@ class ArduPilotFusion:
     robust_alarm_gate_overlap : float
         Fraction of gyro-gate failures on which the robust parity test also fired.
     fused : FusionResult
+        The fusion of the whole log.
     """
 
     n_samples: int
     rate_hz: float
     static_window_s: tuple[float, float]
-    single_noise_gyro: NDArray[np.float64]
-    single_noise_accel: NDArray[np.float64]
-    fused_noise_gyro: NDArray[np.float64]
-    fused_noise_accel: NDArray[np.float64]
-    predicted_noise_gyro: NDArray[np.float64]
-    predicted_noise_accel: NDArray[np.float64]
-    average_noise_gyro: NDArray[np.float64]
-    average_noise_accel: NDArray[np.float64]
+    single_noise_gyro: FloatArray
+    single_noise_accel: FloatArray
+    fused_noise_gyro: FloatArray
+    fused_noise_accel: FloatArray
+    predicted_noise_gyro: FloatArray
+    predicted_noise_accel: FloatArray
+    average_noise_gyro: FloatArray
+    average_noise_accel: FloatArray
     static_gates_ok: bool
     gyro_gate_ok_fraction: float
     accel_gate_ok_fraction: float
@@ -126,6 +97,50 @@ class ArduPilotFusion:
     robust_fdi_alarm_fraction: float
     robust_alarm_gate_overlap: float
     fused: R.FusionResult
+
+
+def common_samples(logs: Sequence[ImuLog], min_samples: int = 10) -> list[ImuLog]:
+    """The logs restricted to the time stamps (s) they all share, in the given order.
+
+    Raises
+    ------
+    InputError
+        If fewer than ``min_samples`` time stamps are common to every log.
+    """
+    common = functools.reduce(np.intersect1d, [lg.t for lg in logs])
+    if common.size < min_samples:
+        raise InputError(f"the IMU streams share fewer than {min_samples} timestamps")
+    out = []
+    for lg in logs:
+        i = np.searchsorted(lg.t, common)
+        out.append(
+            ImuLog(
+                t=common,
+                gyro=lg.gyro[i],
+                accel=lg.accel[i],
+                temp=None if lg.temp is None else lg.temp[i],
+                meta=dict(lg.meta),
+            )
+        )
+    return out
+
+
+def read_imus(path: str | os.PathLike[str]) -> list[ImuLog]:
+    """The IMU streams of a DataFlash log (message-name order) on their common time stamps (s).
+
+    Raises
+    ------
+    DataFormatError
+        If the file is unreadable, has fewer than two IMU streams, or the streams share fewer
+        than 10 time stamps.
+    """
+    logs = read_dataflash(path)
+    if len(logs) < 2:
+        raise DataFormatError(f"fewer than two IMU streams ({', '.join(sorted(logs))})", path=str(path))
+    try:
+        return common_samples([logs[k] for k in sorted(logs)])
+    except InputError as e:
+        raise DataFormatError(str(e), path=str(path)) from None
 
 
 def _static_window(logs: list[ImuLog], window_s: float) -> slice:
@@ -143,7 +158,7 @@ def _static_window(logs: list[ImuLog], window_s: float) -> slice:
     return slice(best_k, best_k + w)
 
 
-def _max_pairwise(vs: list[NDArray[np.float64]]) -> NDArray[np.float64]:
+def _max_pairwise(vs: list[FloatArray]) -> FloatArray:
     out = np.zeros(vs[0].shape[0])
     for i in range(len(vs)):
         for j in range(i + 1, len(vs)):
@@ -151,9 +166,24 @@ def _max_pairwise(vs: list[NDArray[np.float64]]) -> NDArray[np.float64]:
     return out
 
 
-def analyse_log(path: str | os.PathLike[str], *, static_window_s: float = 10.0) -> ArduPilotFusion:
-    """Fuse a DataFlash log's IMUs and compare with each IMU and ArduPilot's gates."""
-    logs = read_dataflash_imus(path)
+def analyse_log(path: str | os.PathLike[str], *, static_window_s: float = 10.0) -> ArduPilotResult:
+    """Fuse a DataFlash log's IMUs and compare with each IMU and ArduPilot's gates.
+
+    Parameters
+    ----------
+    path : path-like
+        ArduPilot DataFlash log (``.bin``) with at least two IMUs.
+    static_window_s : float
+        Length (s) of the quietest window used for the noise σ and the fusion weights.
+
+    Raises
+    ------
+    DataFormatError
+        Unreadable log, fewer than two IMUs or too few common samples.
+    InputError
+        Log shorter than two static windows.
+    """
+    logs = read_imus(path)
     n_imu = len(logs)
     cfg = R.from_mountings(np.repeat(np.eye(3)[None], n_imu, axis=0))
     win = _static_window(logs, static_window_s)
@@ -167,7 +197,7 @@ def analyse_log(path: str | os.PathLike[str], *, static_window_s: float = 10.0) 
     dg = _max_pairwise([lg.gyro for lg in logs])
     da = _max_pairwise([lg.accel for lg in logs])
     t = logs[0].t
-    return ArduPilotFusion(
+    return ArduPilotResult(
         n_samples=int(t.size),
         rate_hz=float(logs[0].sample_rate),
         static_window_s=(float(t[win.start]), float(t[win.stop - 1])),
@@ -193,4 +223,44 @@ def analyse_log(path: str | os.PathLike[str], *, static_window_s: float = 10.0) 
     )
 
 
-__all__ = ["ACCEL_GATE_M_S2", "GYRO_GATE_RAD_S", "ArduPilotFusion", "analyse_log", "read_dataflash_imus"]
+def shared_log_path() -> Path:
+    """The shared reference log: ``$UASNAV_SHARED_DATA`` (or ``../shared/data`` beside the
+    repository) / ``logs/ardupilot_log171.bin``."""
+    root = os.environ.get("UASNAV_SHARED_DATA")
+    base = Path(root) if root else Path(__file__).resolve().parents[3] / ".." / "shared" / "data"
+    return (base / SHARED_LOG).resolve()
+
+
+def run(
+    *,
+    seed: int = 2024,
+    quick: bool = False,
+    progress: Callable[[str], None] | None = None,
+    path: str | os.PathLike[str] | None = None,
+) -> ArduPilotResult:
+    """:func:`analyse_log` of ``path`` (default :func:`shared_log_path`).
+
+    ``seed`` and ``quick`` are accepted for the common experiment signature; the analysis of a
+    recorded log draws no random numbers and has no reduced variant.
+
+    Raises
+    ------
+    DataFormatError
+        If the log is missing or unreadable (see :func:`analyse_log`).
+    """
+    p = Path(path) if path is not None else shared_log_path()
+    if progress is not None:
+        progress(f"ardupilot: fusing the IMUs of {p.name}")
+    return analyse_log(p)
+
+
+__all__ = [
+    "ACCEL_GATE_M_S2",
+    "GYRO_GATE_RAD_S",
+    "ArduPilotResult",
+    "analyse_log",
+    "common_samples",
+    "read_imus",
+    "run",
+    "shared_log_path",
+]

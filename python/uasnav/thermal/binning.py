@@ -1,0 +1,128 @@
+"""Binned means of calibration data: the one place that averages samples into bins.
+
+Two ways to form the bins, one way to average them:
+
+* :func:`bin_by_temperature` — bins of ``width_c`` °C over the temperature span (the data
+  derivative of the thesis' derivative networks, §4.2.6.1);
+* :func:`bin_by_time` — consecutive blocks of ``seconds`` s (``uasnav calibrate --average``:
+  a static log's gyro output averaged before fitting).
+
+Both return the mean temperature and the mean values of every non-empty bin, in bin order.
+
+>>> import numpy as np
+>>> temp = np.array([20.0, 20.4, 21.2, 21.6, 23.1])
+>>> values = np.array([[1.0], [3.0], [5.0], [7.0], [9.0]])
+>>> tm, vm = bin_by_temperature(temp, values, 1.0)
+>>> tm.round(2).tolist(), vm.ravel().tolist()
+([20.2, 21.4, 23.1], [2.0, 6.0, 9.0])
+>>> tm, vm = bin_by_time(np.array([0.0, 0.5, 1.0, 1.5, 2.0]), temp, values, 1.0)
+>>> vm.ravel().tolist()
+[2.0, 6.0, 9.0]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from uasnav.errors import InputError
+from uasnav.thermal._common import FloatArray
+
+
+def bin_means(
+    index: NDArray[np.integer], temp: FloatArray, values: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Mean temperature and mean values of the samples sharing a bin index.
+
+    Parameters
+    ----------
+    index : ndarray of int, shape (n,)
+        Bin of each sample (≥ 0).
+    temp : ndarray, shape (n,)
+        Temperatures (°C).
+    values : ndarray, shape (n, k)
+        Values to average (any unit, e.g. gyro output rad/s).
+
+    Returns
+    -------
+    temp_mean : ndarray, shape (m,)
+        Mean temperature of each non-empty bin (°C), in bin order.
+    values_mean : ndarray, shape (m, k)
+        Mean values of each non-empty bin (unit of ``values``).
+    """
+    counts = np.bincount(index)
+    ok = counts > 0
+    tm = np.bincount(index, temp, minlength=counts.size)[ok] / counts[ok]
+    vm = (
+        np.stack([np.bincount(index, col, minlength=counts.size)[ok] for col in values.T], 1)
+        / counts[ok][:, None]
+    )
+    return tm, vm
+
+
+def bin_by_temperature(temp: ArrayLike, values: ArrayLike, width_c: float) -> tuple[FloatArray, FloatArray]:
+    """Means over temperature bins of ``width_c`` °C.
+
+    The bins start at the lowest temperature: ``[T_min + i·width_c, T_min + (i+1)·width_c)``;
+    the highest temperature falls in the last bin.
+
+    Parameters
+    ----------
+    temp : array_like, shape (n,)
+        Temperatures (°C).
+    values : array_like, shape (n, k)
+        Values to average (e.g. gyro bias, rad/s).
+    width_c : float
+        Bin width (°C), > 0.
+
+    Returns
+    -------
+    temp_mean : ndarray, shape (m,)
+        Mean temperature of each non-empty bin (°C), increasing.
+    values_mean : ndarray, shape (m, k)
+        Mean values per bin.
+    """
+    if not width_c > 0:
+        raise InputError(f"width_c: expected a bin width > 0 °C, got {width_c}")
+    t = np.asarray(temp, dtype=np.float64)
+    v = np.asarray(values, dtype=np.float64)
+    edges = np.arange(t.min(), t.max() + width_c, width_c)
+    idx = np.clip(np.digitize(t, edges) - 1, 0, edges.size - 2)
+    return bin_means(idx, t, v)
+
+
+def bin_by_time(
+    t: ArrayLike, temp: ArrayLike, values: ArrayLike, seconds: float
+) -> tuple[FloatArray, FloatArray]:
+    """Means over consecutive time blocks of ``seconds`` s: ``[t₀ + i·seconds, t₀ + (i+1)·seconds)``.
+
+    ``seconds ≤ 0`` means no averaging: ``temp`` and ``values`` are returned as they are.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Sample times (s), increasing.
+    temp : array_like, shape (n,)
+        Temperatures (°C).
+    values : array_like, shape (n, k)
+        Values to average (e.g. gyro output, rad/s).
+    seconds : float
+        Block length (s).
+
+    Returns
+    -------
+    temp_mean : ndarray, shape (m,)
+        Mean temperature of each non-empty block (°C).
+    values_mean : ndarray, shape (m, k)
+        Mean values per block.
+    """
+    tt = np.asarray(t, dtype=np.float64)
+    te = np.asarray(temp, dtype=np.float64)
+    v = np.asarray(values, dtype=np.float64)
+    if seconds <= 0:
+        return te, v
+    idx = np.floor((tt - tt[0]) / seconds).astype(np.int64)
+    return bin_means(idx, te, v)
+
+
+__all__ = ["bin_by_temperature", "bin_by_time", "bin_means"]

@@ -1,0 +1,212 @@
+"""Thermal calibration of logged static tests: the pipeline behind ``uasnav calibrate``.
+
+* :func:`load_training_data` — a static log's gyro output (the bias target: a constant
+  Earth-rate term is absorbed by the model) averaged over time blocks, against temperature;
+* :func:`fit_polynomial`, :func:`fit_neural` — fit one model, its order / neurons given or
+  selected by Sr on held-out data (eqs. 32–33);
+* :func:`evaluate_model` — residual ``gyro − model(temp)`` of a model on a static log per axis
+  (mean, RMS, max |·|) and Sr, and the error against the log's true thermal bias if it has one.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from uasnav.errors import InputError
+from uasnav.imu import ImuLog
+from uasnav.io import read_log
+from uasnav.thermal._common import FloatArray, SelectionResult, TemperatureRangeWarning, sr
+from uasnav.thermal.base import BiasModel
+from uasnav.thermal.binning import bin_by_time
+from uasnav.thermal.neural import NeuralBiasModel, select_hidden_neurons
+from uasnav.thermal.polynomial import PolynomialBiasModel, select_polynomial_order
+
+#: Fewest averaged samples a model is fitted to.
+MIN_TRAINING_SAMPLES = 20
+
+#: Truth columns :func:`evaluate_model` compares against, in order of preference.
+TRUTH_KEYS = ("gyro_bias_thermal", "gyro_bias")
+
+
+def load_training_data(path: str | os.PathLike[str], average_s: float = 1.0) -> tuple[FloatArray, FloatArray]:
+    """Calibration data of a static log: block means of temperature and gyro output.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        Static IMU log with a ``temp`` column (any format :func:`uasnav.io.read_log` reads).
+    average_s : float
+        Block length (s) of the means (:func:`uasnav.thermal.binning.bin_by_time`); ≤ 0: no
+        averaging.
+
+    Returns
+    -------
+    temp : ndarray, shape (m,)
+        Mean die temperature per block (°C).
+    bias : ndarray, shape (m, 3)
+        Mean gyro output per block (rad/s): the bias target.
+
+    Raises
+    ------
+    InputError
+        The log has no temperature, or fewer than 20 blocks.
+    """
+    log = read_log(path)
+    if log.temp is None:
+        raise InputError(f"{path}: no temp column; thermal calibration needs the sensor temperature")
+    temp, bias = bin_by_time(log.t, log.temp, log.gyro, average_s)
+    if temp.size < MIN_TRAINING_SAMPLES:
+        raise InputError(
+            f"{path}: only {temp.size} samples after {average_s} s averaging; "
+            f"need at least {MIN_TRAINING_SAMPLES}"
+        )
+    return temp, bias
+
+
+@dataclass(frozen=True)
+class FittedModel:
+    """A fitted model, its size and the selection that chose it.
+
+    Attributes
+    ----------
+    model : BiasModel
+        The fitted model.
+    size : int
+        Polynomial order, or neurons per hidden layer.
+    selection : SelectionResult or None
+        Sr per candidate size when the size was selected (eqs. 32–33), else ``None``.
+    """
+
+    model: BiasModel
+    size: int
+    selection: SelectionResult | None
+
+
+def fit_polynomial(
+    temp: ArrayLike, bias: ArrayLike, *, order: int | None = None, select: bool = False, seed: int = 0
+) -> FittedModel:
+    """Fit a :class:`PolynomialBiasModel` to ``temp`` (n,) °C and ``bias`` (n, k) rad/s.
+
+    ``select``: the order is chosen by Sr_PF on held-out data (:func:`select_polynomial_order`,
+    eq. 32, split seed ``seed``); otherwise it is ``order`` (default 2).
+    """
+    m = order if order is not None else 2
+    sel = None
+    if select:
+        sel = select_polynomial_order(temp, bias, seed=seed)
+        m = sel.chosen
+    return FittedModel(PolynomialBiasModel(m).fit(temp, bias), m, sel)
+
+
+def fit_neural(
+    temp: ArrayLike, bias: ArrayLike, *, hidden: int | None = None, select: bool = False, seed: int = 0
+) -> FittedModel:
+    """Fit a :class:`NeuralBiasModel` (with derivative networks, eq. 37) to ``temp`` (n,) °C and
+    ``bias`` (n, k) rad/s.
+
+    ``select``: the neurons per hidden layer are chosen by Sr_NN on held-out data
+    (:func:`select_hidden_neurons`, eq. 33); otherwise ``hidden`` (default 2). ``seed`` seeds the
+    split and the initial weights.
+    """
+    n = hidden if hidden is not None else 2
+    sel = None
+    if select:
+        sel = select_hidden_neurons(temp, bias, seed=seed)
+        n = sel.chosen
+    return FittedModel(NeuralBiasModel(n, seed=seed, derivative_network=True).fit(temp, bias), n, sel)
+
+
+@dataclass(frozen=True)
+class ResidualStats:
+    """Per-axis statistics of residuals (rad/s).
+
+    Attributes
+    ----------
+    mean, rms, max_abs : ndarray, shape (k,)
+        Mean, RMS and maximum absolute residual per axis (rad/s).
+    sr : float
+        Sr of eqs. (32)–(33): √(Σ RMS²) over the axes (rad/s).
+    """
+
+    mean: FloatArray
+    rms: FloatArray
+    max_abs: FloatArray
+    sr: float
+
+    @classmethod
+    def of(cls, residuals: FloatArray) -> ResidualStats:
+        """Statistics of ``residuals`` (n, k) rad/s."""
+        return cls(
+            mean=residuals.mean(axis=0),
+            rms=np.sqrt(np.mean(residuals**2, axis=0)),
+            max_abs=np.abs(residuals).max(axis=0),
+            sr=sr(residuals),
+        )
+
+    def to_dict(self) -> dict[str, FloatArray | float]:
+        """``{"mean", "rms", "max_abs", "sr"}`` (the ``uasnav calibrate --test`` JSON keys)."""
+        return {"mean": self.mean, "rms": self.rms, "max_abs": self.max_abs, "sr": self.sr}
+
+
+@dataclass(frozen=True)
+class ModelEvaluation:
+    """A thermal model on a static log (see :func:`evaluate_model`).
+
+    Attributes
+    ----------
+    n_samples : int
+        Samples of the log.
+    clipped_samples : int
+        Samples whose temperature lay outside the calibrated range (clipped to it).
+    residual : ResidualStats
+        ``gyro − model(temp)`` (rad/s).
+    truth_key : str or None
+        The truth column compared against (``"gyro_bias_thermal"`` or ``"gyro_bias"``), if any.
+    error_vs_truth : ResidualStats or None
+        ``truth − model(temp)`` (rad/s), if the log has a truth column.
+    """
+
+    n_samples: int
+    clipped_samples: int
+    residual: ResidualStats
+    truth_key: str | None
+    error_vs_truth: ResidualStats | None
+
+
+def evaluate_model(model: BiasModel, log: ImuLog, source: str = "log") -> ModelEvaluation:
+    """Residuals of ``model`` on the static ``log``: its gyro output minus the model's bias at the
+    log's temperature, and the error against the true thermal bias (truth column
+    ``gyro_bias_thermal``, else ``gyro_bias``) if the log has one.
+
+    Temperatures outside the calibrated range are clipped (counted, no warning). ``source`` names
+    the log in errors. Raises :class:`InputError` if the log has no temperature.
+    """
+    if log.temp is None:
+        raise InputError(f"{source}: no temp column; cannot evaluate a thermal model")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TemperatureRangeWarning)
+        pred, clipped = model.predict(log.temp, return_clipped=True)
+    key = next((k for k in TRUTH_KEYS if k in log.truth), None)
+    return ModelEvaluation(
+        n_samples=log.n,
+        clipped_samples=int(clipped.sum()),
+        residual=ResidualStats.of(log.gyro - pred),
+        truth_key=key,
+        error_vs_truth=None if key is None else ResidualStats.of(log.truth[key] - pred),
+    )
+
+
+__all__ = [
+    "FittedModel",
+    "ModelEvaluation",
+    "ResidualStats",
+    "evaluate_model",
+    "fit_neural",
+    "fit_polynomial",
+    "load_training_data",
+]

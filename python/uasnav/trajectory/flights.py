@@ -1,0 +1,173 @@
+"""Element samples of real flight logs, and the leave-one-run-out evaluation on them.
+
+The pipeline behind ``uasnav trajectory train`` and ``uasnav trajectory evaluate FLIGHT…``:
+:func:`flight_samples` reads every log, cuts it into mission runs (or measures it against a
+given plan when the log has no mission) and numbers the runs across files;
+:func:`leave_one_run_out` predicts each run with every method trained on the other runs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from uasnav.errors import InputError
+from uasnav.trajectory.baselines import evaluate_methods, kinematic_times
+from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, discretise, geodetic_to_local
+from uasnav.trajectory.plans import read_plan
+from uasnav.trajectory.samples import ElementSamples, measure_elements
+from uasnav.trajectory.telemetry import FlownRun, read_flight, run_samples
+
+
+@dataclass(frozen=True)
+class FlightSamples:
+    """Measured elements of every mission run of some flight logs.
+
+    Attributes
+    ----------
+    runs : tuple of (str, FlownRun or None)
+        Per run, the log it comes from and the run (None for a log measured against a plan).
+    samples : tuple of ElementSamples
+        Per run, its elements; ``flight`` holds the run's index in ``samples``.
+    """
+
+    runs: tuple[tuple[str, FlownRun | None], ...]
+    samples: tuple[ElementSamples, ...]
+
+    def __len__(self) -> int:
+        return len(self.samples)
+
+    @property
+    def n_elements(self) -> int:
+        """Number of elements over all runs."""
+        return int(sum(len(s) for s in self.samples))
+
+    def concat(self) -> ElementSamples:
+        """All runs' elements as one sample set."""
+        return ElementSamples.concat(list(self.samples))
+
+
+def flight_samples(
+    paths: Sequence[str | Path],
+    plan: str | Path | None = None,
+    cruise_ms: float | None = None,
+    wind_ne: NDArray[np.float64] | None = None,
+    segment_m: float = DEFAULT_SEGMENT_M,
+    max_gap_s: float = 5.0,
+) -> FlightSamples:
+    """Element samples of every mission run of every flight log (run index across files).
+
+    Parameters
+    ----------
+    paths : sequence of path
+        Flight logs (.tlog, .bin, .ulg, .csv).
+    plan : path, optional
+        Geodetic plan CSV (lat,lon,alt) for logs without mission waypoints.
+    cruise_ms : float, optional
+        Commanded speed (m/s); default the log's (needed when the log has none).
+    wind_ne : ndarray, shape (2,), optional
+        Wind velocity north/east (m/s, toward); default the log's estimate, else calm.
+    segment_m : float
+        Segment length L (m).
+    max_gap_s : float
+        Largest telemetry gap inside a measured element (s).
+
+    Raises
+    ------
+    InputError
+        A log without a mission and no (geodetic) plan, or without a speed and no ``cruise_ms``.
+        The messages name the ``uasnav trajectory`` options (``--plan``, ``--speed``).
+    """
+    runs_all: list[tuple[str, FlownRun | None]] = []
+    samples_all: list[ElementSamples] = []
+    for path in paths:
+        log = read_flight(path)
+        runs: list[FlownRun] | list[None]
+        if log.waypoints:
+            runs, samples = run_samples(log, segment_m, cruise_ms, wind_ne, max_gap_s=max_gap_s)
+        else:
+            if plan is None:
+                raise InputError(f"{path}: no mission waypoints in the log; give --plan")
+            plan_ne, origin = read_plan(plan)
+            if origin is None:
+                raise InputError("--plan for telemetry must be geodetic (lat,lon,alt)")
+            if cruise_ms is None:
+                raise InputError(f"{path}: no waypoint speed in the log; give --speed")
+            pos = geodetic_to_local(log.lat, log.lon, log.alt, origin=origin)[:, :2]
+            w = wind_ne if wind_ne is not None else (log.wind_ne if log.wind_ne is not None else np.zeros(2))
+            _, s = measure_elements(
+                plan_ne, log.t, pos, log.vel_ned[:, :2], w, cruise_ms, segment_m, max_gap_s=max_gap_s
+            )
+            runs, samples = [None], [s]
+        for r, s in zip(runs, samples, strict=True):
+            k = len(samples_all)
+            s.flight[:] = k
+            runs_all.append((str(path), r))
+            samples_all.append(s)
+    return FlightSamples(tuple(runs_all), tuple(samples_all))
+
+
+@dataclass(frozen=True)
+class RunErrors:
+    """e% (eq. 59) of one method over the leave-one-run-out folds.
+
+    Attributes
+    ----------
+    name : str
+        Method name (see :func:`~uasnav.trajectory.baselines.evaluate_methods`).
+    element_pct : ndarray, shape (m,)
+        e% of every element of every run (%), runs in order.
+    run_pct : tuple of float
+        e% of each run's total time (%).
+    """
+
+    name: str
+    element_pct: NDArray[np.float64]
+    run_pct: tuple[float, ...]
+
+
+def leave_one_run_out(
+    flights: FlightSamples, segment_m: float = DEFAULT_SEGMENT_M, random_state: int = 0
+) -> list[RunErrors]:
+    """Predict each run with every method trained on the other runs.
+
+    The kinematic point mass is included for runs cut from a mission (it needs the plan).
+
+    Returns
+    -------
+    list of RunErrors
+        One per method, in the order :func:`evaluate_methods` first returns them.
+
+    Raises
+    ------
+    InputError
+        Fewer than two runs.
+    """
+    samples = flights.samples
+    if len(samples) < 2:
+        raise InputError("leave-one-run-out needs at least two mission runs")
+    per: dict[str, tuple[list[float], list[float]]] = {}
+    for k, test in enumerate(samples):
+        train = ElementSamples.concat([s for i, s in enumerate(samples) if i != k])
+        _, run = flights.runs[k]
+        kin = None
+        if run is not None:
+            el = discretise(run.plan_ne, segment_m)
+            kin = kinematic_times(
+                run.plan_ne,
+                el.s_start_m[test.element],
+                el.s_start_m[test.element] + test.length_m,
+                test.v_ref_ms[0],
+            )
+        for m in evaluate_methods(train, test, kinematic_s=kin, random_state=random_state):
+            element, whole = per.setdefault(m.name, ([], []))
+            element += m.error_pct.tolist()
+            whole.append(float(abs(m.time_s.sum() - test.t_real_s.sum()) / test.t_real_s.sum() * 100))
+    return [RunErrors(n, np.array(e, dtype=float), tuple(r)) for n, (e, r) in per.items()]
+
+
+__all__ = ["FlightSamples", "RunErrors", "flight_samples", "leave_one_run_out"]
