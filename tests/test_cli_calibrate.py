@@ -54,9 +54,9 @@ def test_fit_both_and_test(logs) -> None:
         assert r.exit_code == 0, r.output
         out = json.loads(r.output)
         assert out["clipped_samples"] == 0 and out["n_samples"] == 1200
-        rms[kind] = np.array(out["error_vs_truth"]["rms"])
+        rms[kind] = np.array(out["thermal_error_vs_truth"]["rms"])
         # residual vs the measured output = truth error + white noise 2e-5
-        assert out["residual"]["sr"] > out["error_vs_truth"]["sr"]
+        assert out["residual"]["sr"] > out["thermal_error_vs_truth"]["sr"]
     assert np.all(rms["nn"] < 1e-5)
     assert rms["nn"][0] < rms["poly"][0] / 5
 
@@ -71,7 +71,7 @@ def test_select_poly_and_text_output(logs) -> None:
     s = json.loads(r.output)
     assert s["poly_order"] == s["poly_selection"]["chosen"] >= 3
     r = CliRunner().invoke(main, ["calibrate", "--model", str(out), "--test", str(test)])
-    assert r.exit_code == 0 and "Sr" in r.output and "error_vs_truth" in r.output
+    assert r.exit_code == 0 and "Sr" in r.output and "thermal_error_vs_truth" in r.output
 
 
 def test_usage_and_domain_errors(logs, tmp_path) -> None:

@@ -2,6 +2,11 @@
 
 Private API: import :mod:`uasnav.allan`, :mod:`uasnav.attitude`, … instead. Units: SI;
 quaternions scalar first, body → NED.
+
+Errors: bad input raises :class:`uasnav.errors.InputError` naming the argument — wrong shapes,
+zero-width or mismatched arrays, non-contiguous arrays, NaN/inf, NaN tolerances, and integers
+out of range (negative or too large: ``InputError``, not ``OverflowError``); a non-integer where
+an integer is expected stays a ``TypeError``. No call lets a Rust panic cross into Python.
 """
 
 from collections.abc import Sequence

@@ -20,6 +20,7 @@ IEEE Std 952-1997, Annex C.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
@@ -29,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import stats
 
 from uasnav import _core
-from uasnav.errors import InputError
+from uasnav.errors import InputError, NumericalError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -40,6 +41,11 @@ TauSpec = Literal["octave", "decade", "all"] | Sequence[float] | NDArray[np.floa
 NoiseType = Literal["white", "flicker", "random-walk"]
 
 # Power-law exponent α of the frequency (rate) PSD for each noise name (NIST SP 1065 §5.2).
+#: Highest sample rate accepted (Hz): far beyond any inertial sensor; above, τ₀² underflows.
+_MAX_RATE_HZ = 1e12
+#: Data whose largest magnitude exceeds this are scaled by a power of two before squaring.
+_SCALE_ABOVE = 1e100
+
 _ALPHA = {"white": 0, "flicker": -1, "random-walk": -2}
 
 
@@ -135,13 +141,24 @@ def plot_adev(
     lo = res.ci_low if res.ci_low.ndim == 2 else res.ci_low[:, None]
     hi = res.ci_high if res.ci_high.ndim == 2 else res.ci_high[:, None]
     names = list(labels) if labels is not None else [f"axis {j}" for j in range(adev.shape[1])]
+    # σ = 0 (a noise-free axis, a skipped fit) has no place on a log axis: leave it out, and say
+    # so in the legend, rather than let matplotlib warn about non-positive values.
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    positive = lambda a: np.where(a > 0, a, np.nan)  # noqa: E731
     for j in range(adev.shape[1]):
-        (line,) = ax.loglog(res.taus, adev[:, j], "o-", ms=3, label=names[j])
+        if not np.any(adev[:, j] > 0):
+            ax.plot([], [], " ", label=f"{names[j]}: σ(τ) = 0 (no noise above resolution)")
+            continue
+        (line,) = ax.plot(res.taus, positive(adev[:, j]), "o-", ms=3, label=names[j])
         if errorbars:
-            ax.fill_between(res.taus, lo[:, j], hi[:, j], color=line.get_color(), alpha=0.2, lw=0)
-        if report is not None:
-            model = report.model_adev()[:, j]
-            ax.loglog(res.taus, model, "--", color=line.get_color(), lw=1)
+            ok = (lo[:, j] > 0) & (hi[:, j] > 0)
+            ax.fill_between(res.taus, lo[:, j], hi[:, j], where=ok, color=line.get_color(), alpha=0.2, lw=0)
+        if report is not None and np.any(report.model_adev()[:, j] > 0):
+            ax.plot(res.taus, positive(report.model_adev()[:, j]), "--", color=line.get_color(), lw=1)
+    if not np.any(adev > 0):
+        ax.set_xlim(float(res.taus[0]) / 2.0, float(res.taus[-1]) * 2.0)
+        ax.set_ylim(1e-3, 1.0)  # an empty panel: fixed limits instead of autoscaling no data
     if report is not None and adev.size:
         _slope_guides(ax, res, report)
     ax.set_xlabel("cluster time τ (s)")
@@ -154,9 +171,11 @@ def plot_adev(
 def _slope_guides(ax: Axes, res: AllanResult, report: NoiseReport) -> None:
     """Dotted lines of slope −½ through N at τ = 1 s and +½ through K at τ = 3 s (axis 0)."""
     t = res.taus
-    n = float(report.fit.random_walk[0])
-    k = float(report.fit.rate_random_walk[0])
-    b = float(report.fit.bias_instability[0])
+    # only terms the data identify (a guide through an unidentified value would suggest one)
+    ok = report.identifiable[:, 0] if report.identifiable.shape[1] else np.ones(5, dtype=bool)
+    n = float(report.fit.random_walk[0]) * ok[1]
+    k = float(report.fit.rate_random_walk[0]) * ok[3]
+    b = float(report.fit.bias_instability[0]) * ok[2]
     if n > 0:
         ax.loglog(t, n / np.sqrt(t), ":", color="grey", lw=1, label="slope −½ (N)")
     if k > 0:
@@ -255,9 +274,9 @@ def oadev(
     if arr.ndim not in (1, 2):
         raise InputError(f"data: expected shape (n,) or (n, c), got {arr.shape}")
     if not (np.isfinite(rate) and rate > 0):
-        raise InputError(f"rate: must be finite and > 0, got {rate!r}")
+        raise InputError(f"rate: must be finite and > 0, got {rate}")
     if not (0.0 < confidence < 1.0):
-        raise InputError(f"confidence: must be in (0, 1), got {confidence!r}")
+        raise InputError(f"confidence: must be in (0, 1), got {confidence}")
     if noise not in _ALPHA:
         raise InputError(f"noise: expected one of {sorted(_ALPHA)}, got {noise!r}")
     one_d = arr.ndim == 1
@@ -265,21 +284,44 @@ def oadev(
     n = mat.shape[0]
     if n < 3:
         raise InputError(f"data: too short ({n} samples, need at least 3)")
+    if rate > _MAX_RATE_HZ:
+        raise InputError(
+            f"rate: {rate:g} Hz is beyond any sensor's sample rate (at most {_MAX_RATE_HZ:g} Hz)"
+        )
     ms = cluster_sizes(n, rate, taus)
-    tau_arr, avar, n_terms, rel = _core.allan_oavar(mat, 1.0 / rate, [int(x) for x in ms])
-    adev = np.sqrt(avar)
+    # A constant column (a noise-free or quantisation-limited axis) has σ(τ) = 0 exactly; summed
+    # into the phase, its value would leave float rounding (~1e-25) instead: zero it (a copy).
+    const = np.all(mat == mat[:1], axis=0)
+    if np.any(const):
+        mat = mat.copy()
+        mat[:, const] = 0.0
+    # Squared differences of values near the float range overflow: compute on data scaled by a
+    # power of two (exact, so ordinary data give bit-identical results) and scale back.
+    peak = float(np.max(np.abs(mat))) if mat.size and np.all(np.isfinite(mat)) else 0.0
+    scale = 2.0 ** math.floor(math.log2(peak)) if peak > _SCALE_ABOVE else 1.0
+    tau_arr, avar, n_terms, rel = _core.allan_oavar(
+        mat / scale if scale != 1.0 else mat, 1.0 / rate, [int(x) for x in ms]
+    )
+    with np.errstate(over="ignore", invalid="ignore"):
+        adev = np.sqrt(avar) * scale
+        avar = np.asarray(avar) * scale * scale
     edf = _edf(n + 1, ms, _ALPHA[noise])
     edf_c = np.maximum(edf, 1e-3)[:, None]
     lo_q = stats.chi2.ppf(0.5 + confidence / 2.0, edf_c)
     hi_q = stats.chi2.ppf(0.5 - confidence / 2.0, edf_c)
     ci_low = adev * np.sqrt(edf_c / lo_q)
     ci_high = adev * np.sqrt(edf_c / hi_q)
+    if not all(np.all(np.isfinite(a)) for a in (avar, ci_low, ci_high)):
+        # Never a silent NaN/inf deviation: say why instead.
+        raise NumericalError(
+            "Allan variance: not representable as a float (data or rate at the edge of the float range)"
+        )
     squeeze = (lambda a: a[:, 0]) if one_d else (lambda a: a)
     return AllanResult(
         taus=np.asarray(tau_arr),
         m=ms,
         adev=squeeze(adev),
-        avar=squeeze(np.asarray(avar)),
+        avar=squeeze(avar),
         n_terms=np.asarray(n_terms, dtype=np.int64),
         rel_error=np.asarray(rel),
         edf=edf,

@@ -19,6 +19,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from uasnav.errors import InputError
+
 #: Earth rotation rate ω_ie (rad/s), WGS-84.
 OMEGA_IE = 7.292115e-5
 #: WGS-84 semi-major axis (m).
@@ -33,6 +35,19 @@ WGS84_B = WGS84_A * (1.0 - WGS84_F)
 WGS84_MU = 3.986004418e14
 #: Normal gravity at the equator (m/s²), WGS-84.
 GAMMA_EQUATOR = 9.7803253359
+#: Largest |height| (m) the free-air series is used for (the top of the atmosphere; far above,
+#: it returns a number that only looks like gravity). Same bound as nav_core::earth.
+MAX_HEIGHT_M = 100_000.0
+
+
+def _latitude(latitude_rad: float) -> float:
+    """A geodetic latitude (rad), finite and within ±π/2, or :class:`InputError`."""
+    lat = float(latitude_rad)
+    if not abs(lat) <= math.pi / 2:
+        raise InputError(f"latitude_rad: must be finite and within ±π/2 rad, got {latitude_rad!r}")
+    return lat
+
+
 #: Somigliana constant k = (b·γ_p)/(a·γ_e) − 1, WGS-84.
 SOMIGLIANA_K = 0.00193185265241
 
@@ -56,10 +71,13 @@ def normal_gravity(latitude_rad: float, height_m: float = 0.0) -> float:
     float
         |g| (m/s²); 9.780 m/s² at the equator, 9.832 m/s² at the poles (h = 0).
     """
-    s2 = math.sin(latitude_rad) ** 2
+    h = float(height_m)
+    # NaN compares false: test for the valid range, so NaN, inf and absurd heights all fail.
+    if not abs(h) <= MAX_HEIGHT_M:
+        raise InputError(f"height_m: must be within ±{MAX_HEIGHT_M:g} m of the ellipsoid, got {height_m!r}")
+    s2 = math.sin(_latitude(latitude_rad)) ** 2
     g0 = GAMMA_EQUATOR * (1.0 + SOMIGLIANA_K * s2) / math.sqrt(1.0 - WGS84_E2 * s2)
     m = OMEGA_IE**2 * WGS84_A**2 * WGS84_B / WGS84_MU
-    h = float(height_m)
     return g0 * (
         1.0 - 2.0 / WGS84_A * (1.0 + WGS84_F + m - 2.0 * WGS84_F * s2) * h + 3.0 * h * h / WGS84_A**2
     )
@@ -67,7 +85,8 @@ def normal_gravity(latitude_rad: float, height_m: float = 0.0) -> float:
 
 def earth_rate_ned(latitude_rad: float) -> NDArray[np.float64]:
     """Earth rotation ω_ie resolved in NED (rad/s): ``ω_ie · [cos φ, 0, −sin φ]``, shape (3,)."""
-    return OMEGA_IE * np.array([math.cos(latitude_rad), 0.0, -math.sin(latitude_rad)])
+    lat = _latitude(latitude_rad)
+    return OMEGA_IE * np.array([math.cos(lat), 0.0, -math.sin(lat)])
 
 
 def gravity_ned(latitude_rad: float, height_m: float = 0.0) -> NDArray[np.float64]:

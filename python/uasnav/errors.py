@@ -49,4 +49,29 @@ class NumericalError(UasnavError, ArithmeticError):
     """A computation became numerically invalid (e.g. a covariance lost positive definiteness)."""
 
 
-__all__ = ["DataFormatError", "InputError", "NumericalError", "UasnavError", "UnitError"]
+class ResourceLimitError(InputError):
+    """The input asks for more memory, work or bytes than a resource limit allows.
+
+    Raised up front (before allocating) by :mod:`uasnav.limits`; the message names the limit
+    and how to raise it (``UASNAV_MAX_MEMORY``, ``UASNAV_MAX_WORK`` or an option).
+    """
+
+
+class CorruptDataWarning(UserWarning):
+    """Part of a file was corrupt and was skipped; the data read are the valid rest.
+
+    Issued once per file read, as one line naming the file and how much was dropped (e.g. a
+    DataFlash log with flipped bits). Readers raise :class:`DataFormatError` instead when
+    nothing valid is left.
+    """
+
+
+__all__ = [
+    "CorruptDataWarning",
+    "DataFormatError",
+    "InputError",
+    "NumericalError",
+    "ResourceLimitError",
+    "UasnavError",
+    "UnitError",
+]

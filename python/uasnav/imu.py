@@ -30,6 +30,7 @@ flight telemetry type beside this one, :class:`uasnav.io.flight.FlightLog`.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,12 +38,24 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import InputError
+from uasnav.limits import check_count
 
 FloatArray = NDArray[np.float64]
 
 
+def _to_float(name: str, value: Any) -> FloatArray:
+    """``value`` as a float64 array; :class:`InputError` naming ``name`` if it is not numeric."""
+    if isinstance(value, str | bytes) or value is None:
+        raise InputError(f"{name}: expected an array of numbers, got {type(value).__name__}")
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        # ragged lists, strings, complex numbers, objects: say which field, not numpy's words only
+        raise InputError(f"{name}: expected an array of real numbers ({e})") from None
+
+
 def _as_float_array(name: str, value: Any, shape_tail: tuple[int, ...], n: int | None) -> FloatArray:
-    arr = np.asarray(value, dtype=np.float64)
+    arr = _to_float(name, value)
     if arr.ndim != 1 + len(shape_tail) or arr.shape[1:] != shape_tail:
         want = "(n" + "".join(f", {d}" for d in shape_tail) + ")"
         raise InputError(f"{name}: expected shape {want}, got {arr.shape}")
@@ -56,6 +69,34 @@ def _as_float_array(name: str, value: Any, shape_tail: tuple[int, ...], n: int |
     return arr
 
 
+def _number(name: str, value: Any) -> float:
+    """``value`` as a float; :class:`InputError` naming ``name`` if it is not a real number."""
+    if isinstance(value, bool | str | bytes) or value is None:
+        raise InputError(f"{name}: expected a number, got {value!r}")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected a number, got {type(value).__name__}") from None
+
+
+def require_log(obj: Any, name: str = "log") -> ImuLog:
+    """``obj`` if it is an :class:`ImuLog`, else :class:`InputError` naming ``name`` and what was
+    given (instead of an ``AttributeError`` deep inside a computation).
+
+    Examples
+    --------
+    >>> require_log("flight.csv")
+    Traceback (most recent call last):
+    ...
+    uasnav.errors.InputError: log: expected an ImuLog (read a file with uasnav.io.read_log), got str
+    """
+    if isinstance(obj, ImuLog):
+        return obj
+    raise InputError(
+        f"{name}: expected an ImuLog (read a file with uasnav.io.read_log), got {type(obj).__name__}"
+    )
+
+
 def check_time(t: FloatArray, name: str = "t") -> None:
     """Raise :class:`InputError` unless ``t`` is strictly increasing (names the first bad row)."""
     if t.size >= 2:
@@ -64,7 +105,9 @@ def check_time(t: FloatArray, name: str = "t") -> None:
         if bad.size:
             i = int(bad[0]) + 1
             kind = "duplicated" if d[bad[0]] == 0 else "decreasing"
-            raise InputError(f"{name}: {kind} time stamp at row {i} ({t[i - 1]!r} then {t[i]!r})")
+            raise InputError(
+                f"{name}: {kind} time stamp at row {i} ({float(t[i - 1])!r} then {float(t[i])!r})"
+            )
 
 
 @dataclass(frozen=True)
@@ -84,6 +127,13 @@ class ImuLog:
     meta: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.truth, Mapping):
+            raise InputError(f"truth: expected a mapping of name → array, got {type(self.truth).__name__}")
+        if not isinstance(self.meta, Mapping):
+            raise InputError(f"meta: expected a mapping of name → value, got {type(self.meta).__name__}")
+        for k in self.truth:
+            if not isinstance(k, str) or not k:
+                raise InputError(f"truth: channel names must be non-empty strings, got {k!r}")
         t = _as_float_array("t", self.t, (), None)
         if t.size < 2:
             raise InputError(f"t: need at least 2 samples, got {t.size}")
@@ -98,7 +148,7 @@ class ImuLog:
             object.__setattr__(self, "mag", _as_float_array("mag", self.mag, (3,), n))
         truth = {}
         for k, v in self.truth.items():
-            arr = np.asarray(v, dtype=np.float64)
+            arr = _to_float(f"truth[{k!r}]", v)
             truth[k] = _as_float_array(f"truth[{k!r}]", arr, arr.shape[1:], n)
         object.__setattr__(self, "truth", truth)
 
@@ -147,12 +197,13 @@ class ImuLog:
 
     def between(self, t_start: float, t_end: float) -> ImuLog:
         """Samples with ``t_start <= t <= t_end`` (s) as a new log (at least 2 samples)."""
+        t_start, t_end = _number("t_start", t_start), _number("t_end", t_end)
         i0 = int(np.searchsorted(self.t, t_start, side="left"))
         i1 = int(np.searchsorted(self.t, t_end, side="right"))
         if i1 - i0 < 2:
             raise InputError(
                 f"between({t_start!r}, {t_end!r}): fewer than 2 samples in the interval "
-                f"(log spans {self.t[0]!r} … {self.t[-1]!r} s)"
+                f"(log spans {float(self.t[0])!r} … {float(self.t[-1])!r} s)"
             )
         return self.slice(i0, i1)
 
@@ -182,9 +233,15 @@ class ImuLog:
         No anti-alias filter is applied: when down-sampling noisy data, low-pass first.
         Quaternion truth channels (4 columns named ``attitude``) are re-normalised.
         """
+        rate = _number("rate", rate)
         if not (np.isfinite(rate) and rate > 0):
             raise InputError(f"rate: must be a positive number of Hz, got {rate!r}")
-        t0 = float(self.t[0]) if t_start is None else float(t_start)
+        t0 = float(self.t[0]) if t_start is None else _number("t_start", t_start)
+        if not np.isfinite(t0):
+            raise InputError(f"t_start: must be a finite time in s, got {t0!r}")
+        # bytes per output sample: time, gyro, accel, temp, mag and every truth channel
+        per_sample = 8 * (11 + sum(v[0].size for v in self.truth.values()))
+        check_count(float((self.t[-1] - t0) * rate), per_sample, f"resample at {rate:g} Hz", option="rate")
         n = int(np.floor((self.t[-1] - t0) * rate + 1e-9)) + 1
         if n < 2 or t0 < self.t[0]:
             raise InputError(f"resample: no room for 2 samples at {rate} Hz from t = {t0}")
@@ -218,4 +275,4 @@ class ImuLog:
         )
 
 
-__all__ = ["ImuLog", "check_time"]
+__all__ = ["ImuLog", "check_time", "require_log"]

@@ -56,7 +56,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from uasnav import _core
 from uasnav.errors import InputError
-from uasnav.imu import ImuLog
+from uasnav.imu import ImuLog, require_log
 from uasnav.io import read_log
 
 SHAPES = ("tetrahedron", "cube", "octahedron", "dodecahedron", "icosahedron")
@@ -128,12 +128,20 @@ class SensorArray:
         return self.axes.reshape(-1, 3, 3).copy()
 
 
+#: Largest deviation from a rotation :func:`from_mountings` may be told to tolerate.
+_MAX_MOUNTING_TOL = 0.01
+#: Most sensors per face :func:`configuration` builds (Table 14 goes to 3).
+_MAX_PER_FACE = 1000
+
+
 def _face_counts(shape: str, per_face: float) -> list[int]:
     if shape not in FACES:
         raise InputError(f"shape: expected one of {', '.join(SHAPES)}, got {shape!r}")
     twice = per_face * 2
     if not (math.isfinite(per_face) and per_face > 0 and abs(twice - round(twice)) < 1e-9):
         raise InputError(f"per_face: expected a positive multiple of 0.5, got {per_face}")
+    if per_face > _MAX_PER_FACE:
+        raise InputError(f"per_face: at most {_MAX_PER_FACE} sensors per face, got {per_face:g}")
     f = FACES[shape]
     base = math.floor(per_face + 1e-9)
     # A half sensor per face: one more on the first half of the faces, which holds one face
@@ -176,6 +184,9 @@ def from_mountings(mountings: ArrayLike, tol: float = 1e-6) -> SensorArray:
         A mounting that is not a proper rotation within ``tol`` (names its index), or too
         few sensors to observe three axes.
     """
+    # NaN compares false with everything: a NaN (or negative, or huge) tol would accept any matrix.
+    if isinstance(tol, bool) or not (0.0 < float(tol) <= _MAX_MOUNTING_TOL):
+        raise InputError(f"tol: expected a number in (0, {_MAX_MOUNTING_TOL:g}], got {tol}")
     m = np.asarray(mountings, dtype=np.float64)
     if m.ndim != 3 or m.shape[1:] != (3, 3):
         raise InputError(f"mountings: expected shape (s, 3, 3), got {m.shape}")
@@ -360,6 +371,15 @@ def fuse_axes(
     return AxisFusion(value, var, chi2, valid, alarm, health, sg, b)
 
 
+def _check_logs(logs: Sequence[ImuLog]) -> None:
+    """Every element an :class:`ImuLog` (else an AttributeError deep inside, not a message)."""
+    if isinstance(logs, (str, bytes)) or not isinstance(logs, Sequence):
+        raise InputError(f"logs: expected a sequence of ImuLog, got {type(logs).__name__}")
+    for i, lg in enumerate(logs):
+        if not isinstance(lg, ImuLog):
+            raise InputError(f"logs[{i}]: expected an ImuLog, got {type(lg).__name__}")
+
+
 def stack_logs(
     logs: Sequence[ImuLog], *, time_tol_s: float = 1e-6
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -371,6 +391,9 @@ def stack_logs(
         Fewer than two logs, different lengths, or sample times differing by more than
         ``time_tol_s`` (names the log and row).
     """
+    if not (math.isfinite(time_tol_s) and time_tol_s >= 0):  # NaN would pass every comparison
+        raise InputError(f"time_tol_s: expected a finite number of seconds >= 0, got {time_tol_s}")
+    _check_logs(logs)
     if len(logs) < 2:
         raise InputError(f"logs: need at least 2 sensor logs, got {len(logs)}")
     t0 = logs[0].t
@@ -455,6 +478,7 @@ def fuse(
     parity_bias_s : float
         Seconds at the start used to learn the parity-space biases (0 = off).
     """
+    _check_logs(logs)
     if config is None:
         if not logs or any("mounting" not in lg.meta for lg in logs):
             raise InputError("config: not given and not every log has meta['mounting']")
@@ -464,6 +488,8 @@ def fuse(
             f"config: needs one triaxial sensor per log ({len(logs)} logs, "
             f"{config.n_sensors} sensors, triaxial={config.triaxial})"
         )
+    if not (math.isfinite(parity_bias_s) and parity_bias_s >= 0):
+        raise InputError(f"parity_bias_s: expected a finite number of seconds >= 0, got {parity_bias_s}")
     t, g, a = stack_logs(logs, time_tol_s=time_tol_s)
     n0 = 0
     if parity_bias_s > 0:
@@ -682,6 +708,7 @@ def array_for_logs(shape: str, logs: Sequence[ImuLog], *, names: Sequence[str] |
     >>> array_for_logs("aligned", logs[:3]).n_axes
     9
     """
+    logs = [require_log(lg, f"logs[{i}]") for i, lg in enumerate(logs)]
     n = len(logs)
     labels = list(names) if names is not None else [f"logs[{i}]" for i in range(n)]
     if shape == "aligned":
@@ -809,6 +836,11 @@ def fuse_files(
     time_tol_s : float
         Tolerance on the sensors' sample times (s).
     """
+    if not (math.isfinite(learn_bias_s) and learn_bias_s >= 0):
+        # a negative window silently meant "no learning" (and most samples dropped by the test)
+        raise InputError(f"learn_bias_s: expected a finite number of seconds >= 0, got {learn_bias_s}")
+    if not (isinstance(stuck_samples, int) and stuck_samples >= 0):
+        raise InputError(f"stuck_samples: expected an int >= 0 (0 = off), got {stuck_samples}")
     names = tuple(str(p) for p in paths)
     logs = load_logs(paths)
     cfg = array_for_logs(shape, logs, names=names)

@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from uasnav import _core
 from uasnav.errors import InputError
-from uasnav.imu import ImuLog
+from uasnav.imu import ImuLog, require_log
 
 FloatArray = NDArray[np.float64]
 
@@ -209,6 +209,7 @@ def detect_static(
         Unknown method, window longer than the log or than :data:`MAX_WINDOW_SAMPLES`,
         non-uniform sampling, bad parameters, non-finite data.
     """
+    log = require_log(log)
     if method not in ("glrt", "shoe"):
         raise InputError(f"method: expected 'glrt' (SHOE), got {method!r}")
     if window_samples is None:

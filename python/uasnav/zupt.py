@@ -29,6 +29,7 @@ to 1e-5 rad/s (Table 11) and the statistics over five consecutive 5-minute segme
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
@@ -39,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from uasnav import _core
 from uasnav.earth import OMEGA_IE
 from uasnav.errors import InputError
-from uasnav.imu import ImuLog
+from uasnav.imu import ImuLog, require_log
 from uasnav.noise import FilterNoise
 from uasnav.stationary import MAX_WINDOW_SAMPLES, StaticIntervals, detect_static
 from uasnav.units import STANDARD_GRAVITY
@@ -335,6 +336,8 @@ def run(
     NumericalError
         The covariance stopped being positive definite.
     """
+    if not isinstance(log, ImuLog):  # else an AttributeError deep inside, not a clear message
+        raise InputError(f"log: expected an ImuLog, got {type(log).__name__}")
     cfg = config or ZuptConfig()
     if mode not in ("zupt", "tczupt"):
         raise InputError(f"mode: expected 'zupt' or 'tczupt', got {mode!r}")
@@ -342,6 +345,12 @@ def run(
         raise InputError(f"config.decimation: expected an int >= 1, got {cfg.decimation!r}")
     if cfg.derivative not in ("analytic", "network"):
         raise InputError(f"config.derivative: expected 'analytic' or 'network', got {cfg.derivative!r}")
+    for name in ("levelling_s", "update_interval_s", "temp_slope_window_s"):
+        v = getattr(cfg, name)
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise InputError(f"config.{name}: expected a finite number of seconds > 0, got {v}")
+    if not (math.isfinite(cfg.latitude_deg) and abs(cfg.latitude_deg) <= 90.0):
+        raise InputError(f"config.latitude_deg: expected a latitude in [-90, 90] deg, got {cfg.latitude_deg}")
     rate = log.uniform_rate()
     dt = 1.0 / rate
     gyro = log.gyro
@@ -433,6 +442,8 @@ def detect_stationary(
     removed, and the window rounded to 1–256 samples (clamped, as the filter's detector is)
     at the median sample rate.
     """
+    if not isinstance(log, ImuLog):
+        raise InputError(f"log: expected an ImuLog, got {type(log).__name__}")
     w = max(1, min(MAX_WINDOW_SAMPLES, round(window_s * log.sample_rate), log.n))
     return detect_static(
         log,
@@ -496,6 +507,7 @@ def moving_average_reference(
     """The thesis' benchmark (Table 9): 30 s moving average of the (calibrated when ``model``
     is given) gyro output, minus the Earth rate resolved in the body frame at the given
     attitude, so that it is comparable with the filters' bias estimates. Shape (n, 3), rad/s."""
+    log = require_log(log)
     gyro = log.gyro if model is None or log.temp is None else log.gyro - model.predict(log.temp)
     w_b = _earth_rate_body(initial_attitude, latitude_deg)
     return moving_average(gyro, log.sample_rate, window_s) - w_b[None, :]
@@ -511,6 +523,7 @@ def reference_residual(
 ) -> FloatArray:
     """Table 9: absolute mean (3,) rad/s of the residuals ``gyro − C_nᵇ·ω_ie − reference`` of
     the moving-average reference (calibrated gyro when ``model`` is given)."""
+    log = require_log(log)
     gyro = log.gyro if model is None or log.temp is None else log.gyro - model.predict(log.temp)
     r = gyro - _earth_rate_body(initial_attitude, latitude_deg)[None, :] - np.asarray(reference)
     return np.asarray(np.abs(np.mean(r, axis=0)), dtype=np.float64)
@@ -556,6 +569,7 @@ def segment_rms(
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Tables 12–13: run the filter separately on ``segments`` consecutive ``segment_s``
     pieces of the log; returns (rms (segments, 3), mean (3,), std (3,)) in rad/s."""
+    log = require_log(log)
     rate = log.uniform_rate()
     per = round(segment_s * rate)
     if segments * per > log.n:

@@ -11,6 +11,8 @@
 //! The drift tools reproduce the thesis' free-inertial study (§4.2.5.3, eq. 35–36, Tables 7,
 //! 8 and 15): integrate a residual rate profile, report the rotation angle `θ(t)` of the
 //! attitude error and the first time it exceeds each threshold.
+// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use crate::error::check_finite;
@@ -84,6 +86,13 @@ pub fn quat_to_dcm<T: Real>(q: &UnitQuaternion<T>) -> Matrix3<T> {
 /// Quaternion of a DCM `C_b^n`. The matrix must be orthonormal with determinant +1 to within
 /// `tol` (Frobenius norm of `CᵀC − I`); otherwise an error is returned.
 pub fn dcm_to_quat<T: Real>(c: &Matrix3<T>, tol: T) -> Result<UnitQuaternion<T>, NavError> {
+    // A NaN tolerance would make `ortho > tol` false and accept any matrix.
+    if !(num_traits::Float::is_finite(tol) && tol >= T::zero()) {
+        return Err(NavError::InvalidParameter {
+            what: "tol",
+            reason: "must be finite and >= 0",
+        });
+    }
     check_finite("dcm", c.as_slice())?;
     let ortho = (c.transpose() * c - Matrix3::identity()).norm();
     if ortho > tol || c.determinant() <= T::zero() {
@@ -161,6 +170,18 @@ impl<T: Real> AttitudePropagator<T> {
         }
         check_finite("rate_rad_s", rate_rad_s.as_slice())?;
         let dtheta = rate_rad_s * dt_s;
+        // A finite rate times a finite period can still overflow (1 rad/s × 1e308 s), and the
+        // exponential of a non-finite angle is a NaN attitude. 1e6 rad per step is far beyond
+        // any sampled rotation (> π per step is already aliased) and keeps the coning cross
+        // product finite.
+        // Written as "within the bound" so that a NaN norm fails it too.
+        let within = dtheta.norm_squared() <= lit(1e12);
+        if !within {
+            return Err(NavError::InvalidParameter {
+                what: "rate_rad_s·dt_s",
+                reason: "rotation per step is larger than 1e6 rad (rate or dt_s absurdly large)",
+            });
+        }
         self.step_increment(&dtheta);
         Ok(())
     }

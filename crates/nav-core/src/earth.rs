@@ -6,6 +6,8 @@
 //! Groves (2013), *Principles of GNSS, Inertial, and Multisensor Integrated Navigation*,
 //! eqs. (2.134) and (2.139); the centrifugal part is included (it is "gravity", not
 //! "gravitation"), so a static accelerometer reads `−g` along the local down axis.
+// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use nalgebra::Vector3;
 
 use crate::scalar::lit;
@@ -27,6 +29,9 @@ pub const WGS84_MU: f64 = 3.986_004_418e14;
 pub const GAMMA_EQUATOR: f64 = 9.780_325_335_9;
 /// Somigliana constant `k = b·γ_p/(a·γ_e) − 1`, WGS-84.
 pub const SOMIGLIANA_K: f64 = 1.931_852_652_41e-3;
+/// Largest |height| (m) the second-order free-air correction is used for: 100 km, the top of
+/// the atmosphere; far above, the series returns a number that only looks like gravity.
+pub const MAX_HEIGHT_M: f64 = 100_000.0;
 
 /// WGS-84 normal gravity magnitude (m/s²) at geodetic latitude `latitude_rad` (rad) and height
 /// `height_m` (m above the ellipsoid).

@@ -1,4 +1,6 @@
 //! The crate's single error type.
+// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use core::fmt;
 
 /// Everything that can go wrong in nav-core. Small and `Copy` so that it can be returned from

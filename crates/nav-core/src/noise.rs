@@ -281,7 +281,11 @@ pub fn read_points<T: Real>(points: &[AllanPoint<T>]) -> Result<PointReadings<T>
         });
     }
     for (i, p) in points.iter().enumerate() {
-        if !(num_traits::Float::is_finite(p.adev) && p.adev > T::zero() && p.tau_s > T::zero()) {
+        if !(num_traits::Float::is_finite(p.adev)
+            && p.adev > T::zero()
+            && num_traits::Float::is_finite(p.tau_s)
+            && p.tau_s > T::zero())
+        {
             return Err(NavError::NonFinite {
                 what: "Allan curve (adev and tau must be finite and > 0)",
                 index: i,

@@ -8,6 +8,14 @@ use pyo3::prelude::*;
 
 use crate::convert::slice1;
 use crate::errors::{input_error, IntoPy};
+use crate::{uint_arg, uint_list_arg};
+
+uint_arg!(n_arg, "n", usize, usize_arg);
+uint_list_arg!(ms_arg, "ms");
+
+/// Most cluster sizes the "all" spacing may return (8 MB; each size is one O(N) pass, so a
+/// longer list is hours of work, not an analysis anyone runs).
+const MAX_ALL_SIZES: usize = 1 << 20;
 
 fn spacing(py: Python<'_>, s: &str) -> PyResult<TauSpacing> {
     match s {
@@ -23,12 +31,25 @@ fn spacing(py: Python<'_>, s: &str) -> PyResult<TauSpacing> {
 
 /// Cluster sizes m of a spacing for n samples.
 #[pyfunction]
-fn allan_cluster_sizes(py: Python<'_>, n: usize, spacing_name: &str) -> PyResult<Vec<usize>> {
+fn allan_cluster_sizes(
+    py: Python<'_>,
+    #[pyo3(from_py_with = n_arg)] n: usize,
+    spacing_name: &str,
+) -> PyResult<Vec<usize>> {
     let sp = spacing(py, spacing_name)?;
     let cap = match sp {
         TauSpacing::All => allan::max_cluster_size(n),
         _ => 192,
     };
+    if cap > MAX_ALL_SIZES {
+        return Err(input_error(
+            py,
+            format!(
+                "taus: 'all' spacing for {n} samples is {cap} cluster sizes (at most {MAX_ALL_SIZES}); \
+                 use 'octave' or 'decade'"
+            ),
+        ));
+    }
     let mut out = vec![0usize; cap];
     let k = allan::cluster_sizes(n, sp, &mut out);
     out.truncate(k);
@@ -55,12 +76,21 @@ fn allan_oavar<'py>(
     py: Python<'py>,
     data: PyReadonlyArray2<'py, f64>,
     tau0_s: f64,
-    ms: Vec<usize>,
+    #[pyo3(from_py_with = ms_arg)] ms: Vec<usize>,
 ) -> PyResult<OadevArrays<'py>> {
     let view = data.as_array();
     let k = view.ncols();
     if ms.is_empty() {
         return Err(input_error(py, "ms: no cluster sizes".into()));
+    }
+    if k == 0 {
+        return Err(input_error(
+            py,
+            format!(
+                "data: no columns (shape ({}, 0)); expected one column per axis",
+                view.nrows()
+            ),
+        ));
     }
     let result = py.detach(
         || -> Result<Vec<Vec<allan::AllanPoint<f64>>>, (usize, NavError)> {
@@ -82,11 +112,31 @@ fn allan_oavar<'py>(
         ),
         other => crate::errors::to_py(py, other),
     })?;
-    let first = &per_axis[0];
+    // Every column has one point per cluster size (k ≥ 1 was checked above).
+    let first = per_axis
+        .first()
+        .ok_or_else(|| input_error(py, "data: no columns".into()))?;
     let taus: Vec<f64> = first.iter().map(|p| p.tau_s).collect();
     let n_terms: Vec<u64> = first.iter().map(|p| p.n_terms as u64).collect();
     let rel: Vec<f64> = first.iter().map(|p| p.rel_error).collect();
-    let avar = Array2::from_shape_fn((ms.len(), k), |(i, j)| per_axis[j][i].avar);
+    let mut avar = Array2::zeros((ms.len(), k));
+    for (mut col, points) in avar.columns_mut().into_iter().zip(&per_axis) {
+        for (slot, p) in col.iter_mut().zip(points) {
+            *slot = p.avar;
+        }
+    }
+    // Finite data can still overflow f64 (values near 1e308, or a sample period so short
+    // that 1/τ² overflows): an infinite or NaN variance is an error, never a silent answer.
+    if let Some(((i, j), v)) = avar.indexed_iter().find(|(_, v)| !v.is_finite()) {
+        let tau = taus.get(i).copied().unwrap_or(f64::NAN);
+        return Err(input_error(
+            py,
+            format!(
+                "data: the Allan variance of column {j} at tau = {tau:e} s is {v} (overflow: \
+                 values or sample rate too large for float64); rescale the data"
+            ),
+        ));
+    }
     Ok((
         taus.into_pyarray(py),
         avar.into_pyarray(py),
@@ -122,7 +172,8 @@ fn oavar_parallel(
                 s.spawn(move || {
                     (t..ms.len())
                         .step_by(threads)
-                        .map(|i| (i, allan::oavar_from_phase(phase, tau0_s, ms[i])))
+                        .zip(ms.iter().skip(t).step_by(threads))
+                        .map(|(i, &m)| (i, allan::oavar_from_phase(phase, tau0_s, m)))
                         .collect::<Vec<_>>()
                 })
             })
@@ -134,7 +185,9 @@ fn oavar_parallel(
     });
     let mut out: Vec<Option<allan::AllanPoint<f64>>> = vec![None; ms.len()];
     for (i, r) in results.into_iter().flatten() {
-        out[i] = Some(r?);
+        if let Some(slot) = out.get_mut(i) {
+            *slot = Some(r?);
+        }
     }
     out.into_iter()
         .map(|p| {

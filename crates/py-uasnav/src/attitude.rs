@@ -3,13 +3,24 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use nav_core::attitude::{self as att, AttitudePropagator, PropagatorConfig};
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2,
-    PyReadonlyArray3, PyUntypedArrayMethods,
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
 };
 use pyo3::prelude::*;
 
 use crate::convert::{rows, slice1};
 use crate::errors::{input_error, IntoPy};
+use crate::floats_arg;
+
+floats_arg!(q0_arg, "q0", 4);
+
+/// Every (n, k) row of `out` filled from `vals` (same length by construction).
+fn fill_rows<const K: usize>(out: &mut Array2<f64>, vals: impl Iterator<Item = [f64; K]>) {
+    for (mut row, v) in out.rows_mut().into_iter().zip(vals) {
+        for (slot, x) in row.iter_mut().zip(v) {
+            *slot = x;
+        }
+    }
+}
 
 fn quats(py: Python<'_>, q: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<UnitQuaternion<f64>>> {
     rows::<4>(py, "q", q)?
@@ -25,7 +36,7 @@ fn quats(py: Python<'_>, q: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<UnitQuat
 #[pyo3(signature = (q0, rates, dt_s, coning=false))]
 fn attitude_propagate<'py>(
     py: Python<'py>,
-    q0: [f64; 4],
+    #[pyo3(from_py_with = q0_arg)] q0: [f64; 4],
     rates: PyReadonlyArray2<'py, f64>,
     dt_s: f64,
     coning: bool,
@@ -35,16 +46,15 @@ fn attitude_propagate<'py>(
     let out = py.detach(|| -> Result<Array2<f64>, nav_core::NavError> {
         let mut out = Array2::zeros((r.len(), 4));
         let mut p = AttitudePropagator::new(q0, PropagatorConfig { coning });
-        for (k, w) in r.iter().enumerate() {
+        for (k, (w, mut row)) in r.iter().zip(out.rows_mut()).enumerate() {
             p.step(&Vector3::from(*w), dt_s).map_err(|e| match e {
                 nav_core::NavError::NonFinite { what, .. } => {
                     nav_core::NavError::NonFinite { what, index: k }
                 }
                 other => other,
             })?;
-            let a = att::quat_to_array(p.attitude());
-            for (j, v) in a.iter().enumerate() {
-                out[(k, j)] = *v;
+            for (slot, v) in row.iter_mut().zip(att::quat_to_array(p.attitude())) {
+                *slot = v;
             }
         }
         Ok(out)
@@ -78,6 +88,25 @@ fn attitude_first_crossing_times(
     thresholds: Vec<f64>,
 ) -> PyResult<Vec<Option<f64>>> {
     let th = slice1(py, "theta", &theta)?;
+    // A NaN never compares ≥, so unchecked it would read as "never crossed" (None).
+    if !(dt_s.is_finite() && dt_s > 0.0) {
+        return Err(input_error(
+            py,
+            format!("dt_s: must be finite and > 0, got {dt_s:?}"),
+        ));
+    }
+    if let Some(i) = th.iter().position(|v| !v.is_finite()) {
+        return Err(input_error(
+            py,
+            format!("theta: non-finite value at index {i}"),
+        ));
+    }
+    if let Some(x) = thresholds.iter().find(|v| !v.is_finite()) {
+        return Err(input_error(
+            py,
+            format!("thresholds: must be finite, got {x:?}"),
+        ));
+    }
     Ok(thresholds
         .iter()
         .map(|&x| att::first_crossing_time(th, dt_s, x))
@@ -107,9 +136,12 @@ fn attitude_euler_to_quat<'py>(
             format!("euler: non-finite value at row {i}"),
         ));
     }
-    let out = Array2::from_shape_fn((e.len(), 4), |(i, j)| {
-        att::quat_to_array(&att::euler321_to_quat(e[i][0], e[i][1], e[i][2]))[j]
-    });
+    let mut out = Array2::zeros((e.len(), 4));
+    fill_rows(
+        &mut out,
+        e.iter()
+            .map(|&[r, p, y]| att::quat_to_array(&att::euler321_to_quat(r, p, y))),
+    );
     Ok(out.into_pyarray(py))
 }
 
@@ -120,10 +152,14 @@ fn attitude_quat_to_euler<'py>(
     q: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let qs = quats(py, &q)?;
-    let out = Array2::from_shape_fn((qs.len(), 3), |(i, j)| {
-        let (r, p, y) = att::quat_to_euler321(&qs[i]);
-        [r, p, y][j]
-    });
+    let mut out = Array2::zeros((qs.len(), 3));
+    fill_rows(
+        &mut out,
+        qs.iter().map(|q| {
+            let (r, p, y) = att::quat_to_euler321(q);
+            [r, p, y]
+        }),
+    );
     Ok(out.into_pyarray(py))
 }
 
@@ -134,9 +170,13 @@ fn attitude_quat_to_dcm<'py>(
     q: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let qs = quats(py, &q)?;
-    let out = Array3::from_shape_fn((qs.len(), 3, 3), |(i, r, c)| {
-        att::quat_to_dcm(&qs[i])[(r, c)]
-    });
+    let mut out = Array3::zeros((qs.len(), 3, 3));
+    for (mut m, q) in out.outer_iter_mut().zip(&qs) {
+        let c = att::quat_to_dcm(q);
+        for ((r, col), slot) in m.indexed_iter_mut() {
+            *slot = c.get((r, col)).copied().unwrap_or(f64::NAN);
+        }
+    }
     Ok(out.into_pyarray(py))
 }
 
@@ -148,20 +188,26 @@ fn attitude_dcm_to_quat<'py>(
     dcm: PyReadonlyArray3<'py, f64>,
     tol: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let shape = dcm.shape();
-    if shape[1] != 3 || shape[2] != 3 {
+    let v = dcm.as_array();
+    let (n, r, c) = v.dim();
+    if r != 3 || c != 3 {
         return Err(input_error(
             py,
-            format!("dcm: expected shape (n, 3, 3), got {shape:?}"),
+            format!("dcm: expected shape (n, 3, 3), got [{n}, {r}, {c}]"),
         ));
     }
-    let v = dcm.as_array();
-    let mut out = Array2::zeros((shape[0], 4));
-    for i in 0..shape[0] {
-        let m = Matrix3::from_fn(|r, c| v[(i, r, c)]);
-        let q = att::dcm_to_quat(&m, tol).map_err(|e| input_error(py, format!("dcm[{i}]: {e}")))?;
-        for (j, x) in att::quat_to_array(&q).iter().enumerate() {
-            out[(i, j)] = *x;
+    let mut out = Array2::zeros((n, 4));
+    for (i, (m, mut row)) in v.outer_iter().zip(out.rows_mut()).enumerate() {
+        let mut mat = Matrix3::zeros();
+        for ((r, c), x) in m.indexed_iter() {
+            if let Some(slot) = mat.get_mut((r, c)) {
+                *slot = *x;
+            }
+        }
+        let q =
+            att::dcm_to_quat(&mat, tol).map_err(|e| input_error(py, format!("dcm[{i}]: {e}")))?;
+        for (slot, x) in row.iter_mut().zip(att::quat_to_array(&q)) {
+            *slot = x;
         }
     }
     Ok(out.into_pyarray(py))

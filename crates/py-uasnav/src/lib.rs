@@ -2,6 +2,7 @@
 //!
 //! This crate only extracts, checks, converts, releases the GIL and maps errors; every
 //! number is computed in nav-core. One file per nav-core concept, registered below.
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 mod allan;
 mod attitude;
 mod convert;

@@ -41,12 +41,14 @@ fn mlp_evaluate_model<'py>(
         let mut deriv = Array2::zeros((x.len(), k));
         let mut clipped = Array1::from_elem(x.len(), false);
         let (mut v, mut d) = (vec![0.0; x.len()], vec![0.0; x.len()]);
-        for (a, net) in list.iter().enumerate() {
+        for ((net, mut vcol), mut dcol) in list
+            .iter()
+            .zip(value.columns_mut())
+            .zip(deriv.columns_mut())
+        {
             net.eval_batch(x, &mut v, &mut d, clip)?;
-            for i in 0..x.len() {
-                value[(i, a)] = v[i];
-                deriv[(i, a)] = d[i];
-            }
+            vcol.iter_mut().zip(&v).for_each(|(slot, y)| *slot = *y);
+            dcol.iter_mut().zip(&d).for_each(|(slot, y)| *slot = *y);
         }
         if clip {
             let (lo, hi) = nets.range_c;

@@ -10,12 +10,18 @@ use nav_core::NavError;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
-    PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 
 use crate::convert::{rows, slice1};
 use crate::errors::{input_error, IntoPy};
+use crate::{uint_arg, uint_list_arg};
+
+uint_list_arg!(counts_arg, "counts");
+uint_list_arg!(sensor_of_arg, "sensor_of");
+uint_arg!(dof_arg, "dof", usize, usize_arg);
+uint_arg!(stuck_arg, "stuck_samples", u32, u32_arg);
+uint_arg!(isolations_arg, "max_isolations", usize, usize_arg);
 
 /// Axes capacity of the binding (3 triaxial sensors on each of the icosahedron's 20 faces).
 const M: usize = 180;
@@ -27,7 +33,12 @@ type Axes<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>);
 
 fn export<'py>(py: Python<'py>, a: &Arr) -> Axes<'py> {
     let n = a.n_axes();
-    let axes = Array2::from_shape_fn((n, 3), |(i, j)| a.axis(i)[j]);
+    let mut axes = Array2::zeros((n, 3));
+    for (i, mut row) in axes.rows_mut().into_iter().enumerate() {
+        row.iter_mut()
+            .zip(a.axis(i).iter())
+            .for_each(|(s, v)| *s = *v);
+    }
     let sens = Array1::from_iter((0..n).map(|i| a.sensor_of(i) as i64));
     (axes.into_pyarray(py), sens.into_pyarray(py))
 }
@@ -50,7 +61,7 @@ fn matrix<'py>(
             format!("{name}: expected shape (3, 3), got ({}, 3)", r.len()),
         ));
     }
-    Ok(Matrix3::from_fn(|i, j| r[i][j]))
+    Ok(Matrix3::from_row_iterator(r.iter().flatten().copied()))
 }
 
 fn check_len(py: Python<'_>, name: &str, got: usize, n: usize) -> PyResult<()> {
@@ -61,6 +72,13 @@ fn check_len(py: Python<'_>, name: &str, got: usize, n: usize) -> PyResult<()> {
         ));
     }
     Ok(())
+}
+
+/// A 3×3 nalgebra matrix as a (3, 3) ndarray (row-major).
+fn mat3(py: Python<'_>, c: &Matrix3<f64>) -> PyResult<Array2<f64>> {
+    // nalgebra stores column-major: the transpose's storage is the row-major order.
+    Array2::from_shape_vec((3, 3), c.transpose().iter().copied().collect())
+        .map_err(|e| input_error(py, format!("internal: 3x3 result: {e}")))
 }
 
 /// A batch call's inputs: the configuration, the (m, n) samples as one C-contiguous slice
@@ -82,11 +100,13 @@ impl<'a> Batch<'a> {
     ) -> PyResult<Self> {
         let array = build(py, axes, sensor_of)?;
         let n = array.n_axes();
-        let shape = z.shape();
-        if shape[1] != n {
+        let (m, cols) = z.as_array().dim();
+        if cols != n {
             return Err(input_error(
                 py,
-                format!("z: expected shape (m, {n}) (one column per sensor axis), got {shape:?}"),
+                format!(
+                    "z: expected shape (m, {n}) (one column per sensor axis), got [{m}, {cols}]"
+                ),
             ));
         }
         let flat = z
@@ -97,15 +117,15 @@ impl<'a> Batch<'a> {
         Ok(Self {
             array,
             z: flat,
-            m: shape[0],
+            m,
             sigma: sg,
         })
     }
 
-    /// Sample k (one value per axis).
-    fn row(&self, k: usize) -> &'a [f64] {
-        let n = self.array.n_axes();
-        &self.z[k * n..(k + 1) * n]
+    /// The m samples in order (one value per axis each). A configuration has at least three
+    /// axes (checked when it was built); `max(1)` only keeps `chunks_exact` total.
+    fn samples(&self) -> std::slice::ChunksExact<'a, f64> {
+        self.z.chunks_exact(self.array.n_axes().max(1))
     }
 }
 
@@ -114,7 +134,7 @@ impl<'a> Batch<'a> {
 fn redundancy_face_config<'py>(
     py: Python<'py>,
     shape: &str,
-    counts: Vec<usize>,
+    #[pyo3(from_py_with = counts_arg)] counts: Vec<usize>,
     triaxial: bool,
 ) -> PyResult<Axes<'py>> {
     let p = Polyhedron::from_name(shape).py_err(py)?;
@@ -135,16 +155,18 @@ fn redundancy_mountings_config<'py>(
     mountings: PyReadonlyArray3<'py, f64>,
     tol: f64,
 ) -> PyResult<Axes<'py>> {
-    let shape = mountings.shape();
-    if shape[1] != 3 || shape[2] != 3 {
+    let v = mountings.as_array();
+    let (ns, r, c) = v.dim();
+    if r != 3 || c != 3 {
         return Err(input_error(
             py,
-            format!("mountings: expected shape (s, 3, 3), got {shape:?}"),
+            format!("mountings: expected shape (s, 3, 3), got [{ns}, {r}, {c}]"),
         ));
     }
-    let v = mountings.as_array();
-    let ms: Vec<Matrix3<f64>> = (0..shape[0])
-        .map(|s| Matrix3::from_fn(|i, j| v[(s, i, j)]))
+    // Row-major (3, 3) blocks: fill the matrix row by row.
+    let ms: Vec<Matrix3<f64>> = v
+        .outer_iter()
+        .map(|m| Matrix3::from_row_iterator(m.iter().copied()))
         .collect();
     let mut a = Arr::empty();
     for (s, c) in ms.iter().enumerate() {
@@ -163,11 +185,9 @@ fn redundancy_face_normals<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let p = Polyhedron::from_name(shape).py_err(py)?;
     let mut out = Array2::zeros((p.faces(), 3));
-    for f in 0..p.faces() {
+    for (f, mut row) in out.rows_mut().into_iter().enumerate() {
         let n: Vector3<f64> = p.face_normal(f).py_err(py)?;
-        for j in 0..3 {
-            out[(f, j)] = n[j];
-        }
+        row.iter_mut().zip(n.iter()).for_each(|(s, v)| *s = *v);
     }
     Ok(out.into_pyarray(py))
 }
@@ -177,11 +197,11 @@ fn redundancy_face_normals<'py>(
 fn redundancy_kr(
     py: Python<'_>,
     axes: PyReadonlyArray2<'_, f64>,
-    sensor_of: Vec<usize>,
+    #[pyo3(from_py_with = sensor_of_arg)] sensor_of: Vec<usize>,
 ) -> PyResult<[f64; 3]> {
     let a = build(py, &axes, &sensor_of)?;
     let k = a.k_r().py_err(py)?;
-    Ok([k[0], k[1], k[2]])
+    Ok([k.x, k.y, k.z])
 }
 
 /// Least-squares covariance (HᵀWH)⁻¹ (3, 3) for per-axis noise sigma (n,).
@@ -189,19 +209,23 @@ fn redundancy_kr(
 fn redundancy_ls_covariance<'py>(
     py: Python<'py>,
     axes: PyReadonlyArray2<'py, f64>,
-    sensor_of: Vec<usize>,
+    #[pyo3(from_py_with = sensor_of_arg)] sensor_of: Vec<usize>,
     sigma: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let a = build(py, &axes, &sensor_of)?;
     let s = slice1(py, "sigma", &sigma)?;
     check_len(py, "sigma", s.len(), a.n_axes())?;
     let c = a.ls_covariance(s).py_err(py)?;
-    Ok(Array2::from_shape_fn((3, 3), |(i, j)| c[(i, j)]).into_pyarray(py))
+    Ok(mat3(py, &c)?.into_pyarray(py))
 }
 
 /// Upper χ² quantile for dof and false-alarm probability p_fa.
 #[pyfunction]
-fn redundancy_chi2_threshold(py: Python<'_>, dof: usize, p_fa: f64) -> PyResult<f64> {
+fn redundancy_chi2_threshold(
+    py: Python<'_>,
+    #[pyo3(from_py_with = dof_arg)] dof: usize,
+    p_fa: f64,
+) -> PyResult<f64> {
     chi2::chi2_threshold(dof, p_fa).py_err(py)
 }
 
@@ -223,15 +247,15 @@ type FuseOut<'py> = (
 fn redundancy_fuse<'py>(
     py: Python<'py>,
     axes: PyReadonlyArray2<'py, f64>,
-    sensor_of: Vec<usize>,
+    #[pyo3(from_py_with = sensor_of_arg)] sensor_of: Vec<usize>,
     z: PyReadonlyArray2<'py, f64>,
     sigma: PyReadonlyArray1<'py, f64>,
     bias: PyReadonlyArray1<'py, f64>,
     fdi: bool,
     p_fa: f64,
     saturation: f64,
-    stuck_samples: u32,
-    max_isolations: usize,
+    #[pyo3(from_py_with = stuck_arg)] stuck_samples: u32,
+    #[pyo3(from_py_with = isolations_arg)] max_isolations: usize,
 ) -> PyResult<FuseOut<'py>> {
     let b = Batch::new(py, &axes, &sensor_of, &z, &sigma)?;
     let (n, ns, m) = (b.array.n_axes(), b.array.n_sensors(), b.m);
@@ -258,23 +282,32 @@ fn redundancy_fuse<'py>(
         let mut valid = Array1::from_elem(m, false);
         let mut alarm = Array1::from_elem(m, false);
         let mut health = Array2::<u8>::zeros((m, ns));
-        for k in 0..m {
+        let slots = fused
+            .rows_mut()
+            .into_iter()
+            .zip(var.rows_mut())
+            .zip(chi.iter_mut())
+            .zip(valid.iter_mut())
+            .zip(alarm.iter_mut())
+            .zip(health.rows_mut());
+        for (zk, (((((mut fk, mut vk), ck), vd), al), mut hk)) in b.samples().zip(slots) {
             let out = if fdi {
-                fuser.step(b.row(k))?
+                fuser.step(zk)?
             } else {
-                fuser.fuse_finite(b.row(k))?
+                fuser.fuse_finite(zk)?
             };
-            valid[k] = out.valid;
-            alarm[k] = out.alarm;
-            for s in 0..ns {
-                health[(k, s)] = out.health[s].0;
-            }
+            *vd = out.valid;
+            *al = out.alarm;
+            hk.iter_mut()
+                .zip(out.health.iter())
+                .for_each(|(s, h)| *s = h.0);
             if out.valid {
-                for j in 0..3 {
-                    fused[(k, j)] = out.fused.value[j];
-                    var[(k, j)] = out.fused.covariance[(j, j)];
-                }
-                chi[k] = out.fused.chi2;
+                let diag = out.fused.covariance.diagonal();
+                fk.iter_mut()
+                    .zip(out.fused.value.iter())
+                    .for_each(|(s, v)| *s = *v);
+                vk.iter_mut().zip(diag.iter()).for_each(|(s, v)| *s = *v);
+                *ck = out.fused.chi2;
             }
         }
         Ok((fused, var, chi, valid, alarm, health))
@@ -296,7 +329,7 @@ fn redundancy_fuse<'py>(
 fn redundancy_parity_residuals<'py>(
     py: Python<'py>,
     axes: PyReadonlyArray2<'py, f64>,
-    sensor_of: Vec<usize>,
+    #[pyo3(from_py_with = sensor_of_arg)] sensor_of: Vec<usize>,
     z: PyReadonlyArray2<'py, f64>,
     sigma: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
@@ -304,13 +337,11 @@ fn redundancy_parity_residuals<'py>(
     let n = b.array.n_axes();
     let res = py.detach(|| -> Result<_, NavError> {
         let mut out = Array2::from_elem((b.m, n), f64::NAN);
-        let mut r = [0.0; M];
-        for k in 0..b.m {
-            let zk = b.row(k);
+        let mut r = vec![0.0; n];
+        for (zk, mut row) in b.samples().zip(out.rows_mut()) {
             if zk.iter().all(|v| v.is_finite()) {
-                parity_residuals(&b.array, zk, b.sigma, &mut r[..n])?;
-                out.row_mut(k)
-                    .assign(&numpy::ndarray::ArrayView1::from(&r[..n]));
+                parity_residuals(&b.array, zk, b.sigma, &mut r)?;
+                row.assign(&numpy::ndarray::ArrayView1::from(r.as_slice()));
             }
         }
         Ok(out)
@@ -342,27 +373,33 @@ fn kalman_run<const K: usize>(
     let mut bias = Array2::zeros((m, n));
     let mut bias_sd = Array2::zeros((m, n));
     let mut use_axis = vec![true; n];
-    for k in 0..m {
-        let zk = b.row(k);
-        for i in 0..n {
-            use_axis[i] = zk[i].is_finite();
-        }
+    let slots = rate
+        .rows_mut()
+        .into_iter()
+        .zip(rate_sd.rows_mut())
+        .zip(bias.rows_mut())
+        .zip(bias_sd.rows_mut());
+    for (k, (zk, (((mut rk, mut rsk), mut bk), mut bsk))) in b.samples().zip(slots).enumerate() {
+        use_axis
+            .iter_mut()
+            .zip(zk)
+            .for_each(|(u, v)| *u = v.is_finite());
         if k > 0 {
             kf.predict(dt_s)?;
         }
         kf.update(zk, &use_axis)?;
-        if zero_rate.is_some_and(|z| z[k]) {
+        if zero_rate.is_some_and(|z| z.get(k).copied().unwrap_or(false)) {
             kf.update_rate(&Vector3::zeros(), zero_rate_sigma)?;
         }
-        let r = kf.rate();
-        let rs = kf.rate_sigma();
-        for j in 0..3 {
-            rate[(k, j)] = r[j];
-            rate_sd[(k, j)] = rs[j];
-        }
-        for i in 0..n {
-            bias[(k, i)] = kf.axis_bias(i);
-            bias_sd[(k, i)] = kf.axis_bias_sigma(i);
+        rk.iter_mut()
+            .zip(kf.rate().iter())
+            .for_each(|(s, v)| *s = *v);
+        rsk.iter_mut()
+            .zip(kf.rate_sigma().iter())
+            .for_each(|(s, v)| *s = *v);
+        for (i, (bs, bss)) in bk.iter_mut().zip(bsk.iter_mut()).enumerate() {
+            *bs = kf.axis_bias(i);
+            *bss = kf.axis_bias_sigma(i);
         }
     }
     Ok((rate, rate_sd, bias, bias_sd))
@@ -377,7 +414,7 @@ fn kalman_run<const K: usize>(
 fn redundancy_kalman<'py>(
     py: Python<'py>,
     axes: PyReadonlyArray2<'py, f64>,
-    sensor_of: Vec<usize>,
+    #[pyo3(from_py_with = sensor_of_arg)] sensor_of: Vec<usize>,
     z: PyReadonlyArray2<'py, f64>,
     sigma: PyReadonlyArray1<'py, f64>,
     dt_s: f64,
@@ -434,11 +471,10 @@ fn redundancy_level<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let r = rows::<3>(py, "f", &f)?;
     let mut out = Array2::zeros((r.len(), 2));
-    for (k, v) in r.iter().enumerate() {
+    for (k, (v, mut row)) in r.iter().zip(out.rows_mut()).enumerate() {
         let (roll, pitch) = alignment::level(&Vector3::from(*v))
             .map_err(|e| input_error(py, format!("f[{k}]: {e}")))?;
-        out[(k, 0)] = roll;
-        out[(k, 1)] = pitch;
+        row.assign(&numpy::ndarray::ArrayView1::from(&[roll, pitch]));
     }
     Ok(out.into_pyarray(py))
 }
@@ -452,8 +488,21 @@ fn redundancy_relative_rotation<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let a = matrix(py, &c_bi_n, "c_bi_n")?;
     let b = matrix(py, &c_br_n, "c_br_n")?;
+    for (name, m) in [("c_bi_n", &a), ("c_br_n", &b)] {
+        // NaN in, NaN out would be a silent wrong answer; a DCM must at least be finite.
+        if let Some(i) = m.transpose().iter().position(|v| !v.is_finite()) {
+            return Err(input_error(
+                py,
+                format!(
+                    "{name}: non-finite value at row {}, column {}",
+                    i / 3,
+                    i % 3
+                ),
+            ));
+        }
+    }
     let c = alignment::relative_rotation(&a, &b);
-    Ok(Array2::from_shape_fn((3, 3), |(i, j)| c[(i, j)]).into_pyarray(py))
+    Ok(mat3(py, &c)?.into_pyarray(py))
 }
 
 /// Rotation C (3, 3), reference → sensor, with v_sensor ≈ C·v_ref (Wahba, SVD).
@@ -474,7 +523,7 @@ fn redundancy_wahba<'py>(
         .collect();
     let w = slice1(py, "weights", &weights)?;
     let c = alignment::wahba(&r, &s, w).py_err(py)?;
-    Ok(Array2::from_shape_fn((3, 3), |(i, j)| c[(i, j)]).into_pyarray(py))
+    Ok(mat3(py, &c)?.into_pyarray(py))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

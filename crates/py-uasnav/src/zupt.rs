@@ -8,8 +8,15 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{rows, slice1};
+use crate::convert::{repr, rows, slice1};
 use crate::errors::{input_error, IntoPy};
+use crate::{floats_arg, uint_arg};
+
+uint_arg!(levelling_arg, "levelling_samples", usize, usize_arg);
+uint_arg!(decimation_arg, "decimation", usize, usize_arg);
+uint_arg!(window_arg, "window_samples", usize, usize_arg);
+floats_arg!(accel_bias0_arg, "accel_bias0", 3);
+floats_arg!(gyro_bias0_arg, "gyro_bias0", 3);
 
 /// Builds a `ZuptConfig` from `mode`, `discretisation` and a dict of SI floats named exactly
 /// as the nav-core fields; an unknown key is an error (a typo must not pass silently).
@@ -46,10 +53,15 @@ fn config(
     };
     if let Some(d) = values {
         for (k, v) in d.iter() {
-            let key: String = k.extract()?;
-            let x: f64 = v
-                .extract()
-                .map_err(|_| input_error(py, format!("config[{key:?}]: expected a float")))?;
+            let key: String = k.extract().map_err(|_| {
+                input_error(py, format!("config: keys must be str, got {}", repr(&k)))
+            })?;
+            let x: f64 = v.extract().map_err(|_| {
+                input_error(
+                    py,
+                    format!("config[{key:?}]: expected a float, got {}", repr(&v)),
+                )
+            })?;
             let slot = match key.as_str() {
                 "sigma_vrw_m_s_sqrt_s" => &mut c.noise.sigma_vrw_m_s_sqrt_s,
                 "sigma_arw_rad_sqrt_s" => &mut c.noise.sigma_arw_rad_sqrt_s,
@@ -96,13 +108,13 @@ fn zupt_run<'py>(
     dbias_dtemp: Option<PyReadonlyArray2<'py, f64>>,
     mag: Option<PyReadonlyArray2<'py, f64>>,
     stationary: Option<PyReadonlyArray1<'py, bool>>,
-    levelling_samples: usize,
+    #[pyo3(from_py_with = levelling_arg)] levelling_samples: usize,
     heading_rad: Option<f64>,
     declination_rad: Option<f64>,
-    accel_bias0: [f64; 3],
-    gyro_bias0: [f64; 3],
+    #[pyo3(from_py_with = accel_bias0_arg)] accel_bias0: [f64; 3],
+    #[pyo3(from_py_with = gyro_bias0_arg)] gyro_bias0: [f64; 3],
     zero_gyro_bias: bool,
-    decimation: usize,
+    #[pyo3(from_py_with = decimation_arg)] decimation: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cfg = config_or_default(py, mode, discretisation, config.as_ref())?;
     let g = rows::<3>(py, "gyro", &gyro)?;
@@ -205,7 +217,11 @@ fn zupt_run<'py>(
 }
 
 fn to2<const K: usize>(v: &[[f64; K]]) -> Array2<f64> {
-    Array2::from_shape_fn((v.len(), K), |(i, j)| v[i][j])
+    let mut out = Array2::zeros((v.len(), K));
+    for (mut row, r) in out.rows_mut().into_iter().zip(v) {
+        row.iter_mut().zip(r).for_each(|(s, x)| *s = *x);
+    }
+    out
 }
 
 fn config_or_default(
@@ -230,7 +246,7 @@ fn zupt_detect_static<'py>(
     gyro: PyReadonlyArray2<'py, f64>,
     sigma_accel_m_s2: f64,
     sigma_gyro_rad_s: f64,
-    window_samples: usize,
+    #[pyo3(from_py_with = window_arg)] window_samples: usize,
     threshold: f64,
     gravity_m_s2: f64,
 ) -> PyResult<StaticArrays<'py>> {

@@ -5,15 +5,18 @@ Each module in this package that defines a module-level ``command`` (a ``click.C
 file here and nothing else.
 
 Exit codes: 0 success; 1 a domain error (bad input file, invalid data, numerical failure) with a
-one-line ``error: …`` message on stderr; 2 a usage error (unknown option, missing argument),
-as click does.
+one-line ``error: …`` message on stderr; 2 a usage error (unknown option, missing argument, an
+option value outside its domain), as click does. An unexpected exception (a bug) is also one line,
+``error: internal error: …, please report it``, exit code 1; ``UASNAV_DEBUG=1`` shows its traceback.
 """
 
 from __future__ import annotations
 
 import importlib
+import os
 import pkgutil
 import sys
+import warnings
 from typing import Any
 
 import click
@@ -21,19 +24,79 @@ import click
 from uasnav import __version__
 from uasnav.errors import UasnavError
 
+#: Longest error line printed (characters); longer messages are cut in the middle.
+_MAX_MESSAGE = 2000
+#: Set to 1 to let unexpected exceptions through with their traceback (for bug reports).
+DEBUG_ENV = "UASNAV_DEBUG"
+
+# click's own control flow (usage errors → exit 2, --help, ctx.exit) and the interpreter's
+# (Ctrl-C, sys.exit) pass through the handler untouched.
+_PASS_THROUGH = (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort)
+
+
+def _one_line(text: str) -> str:
+    """A message as one stderr line: the contract is exactly one ``error: …`` line."""
+    line = " ".join(str(text).split()) or "(no message)"
+    # a message quoting a hostile input (a 128 KB CSV cell) stays readable
+    if len(line) > _MAX_MESSAGE:
+        half = _MAX_MESSAGE // 2
+        line = f"{line[:half]} … [{len(line) - 2 * half} characters] … {line[-half:]}"
+    return line
+
+
+def _os_error_message(e: OSError) -> str:
+    """``strerror: filename`` once (``str(e)`` repeats the path, ``[Errno n]`` is noise)."""
+    if not e.strerror:
+        return str(e)
+    names = [str(f) for f in (e.filename, e.filename2) if f is not None]
+    return f"{e.strerror}: {' -> '.join(names)}" if names else e.strerror
+
+
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    click.echo(f"warning: {_one_line(str(message))}", err=True)
+
+
+def _is_debug() -> bool:
+    return os.environ.get(DEBUG_ENV, "").strip() not in ("", "0")
+
 
 class _Group(click.Group):
-    """Turns uasnav's domain errors into one line on stderr and exit code 1."""
+    """Turns every error into one ``error: …`` line on stderr and exit code 1: uasnav's domain
+    errors and OS errors as they are, anything else as an internal error to report (with the
+    traceback only when ``UASNAV_DEBUG=1``)."""
 
     def invoke(self, ctx: click.Context) -> Any:
+        # A warning (ours, e.g. CorruptDataWarning, or a library's that we let through on
+        # purpose) is one ``warning: …`` line, like errors: never a file path and source line.
+        warnings.showwarning = _show_warning
         try:
             return super().invoke(ctx)
+        except _PASS_THROUGH:
+            raise
         except UasnavError as e:
-            click.echo(f"error: {e}", err=True)
-            ctx.exit(1)
+            message = str(e)
         except OSError as e:
-            click.echo(f"error: {e.strerror or e}: {e.filename or ''}".rstrip(": "), err=True)
-            ctx.exit(1)
+            message = _os_error_message(e)
+        except MemoryError:
+            message = "out of memory (the input or the options ask for more than this machine has)"
+        except (KeyboardInterrupt, SystemExit, GeneratorExit):
+            raise
+        except BaseException as e:  # also a Rust panic: PanicException is a BaseException
+            if _is_debug():
+                raise
+            message = (
+                f"internal error: {type(e).__name__}: {e} - please report it "
+                f"(run again with {DEBUG_ENV}=1 for the traceback)"
+            )
+        click.echo(f"error: {_one_line(message)}", err=True)
+        ctx.exit(1)
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -43,6 +106,10 @@ def main() -> None:
 
     Units are SI (s, rad/s, m/s², °C) and frames NED / body (x fwd, y right, z down) unless an
     option says otherwise. Every subcommand takes --help; most take --json.
+
+    Exit codes: 0 success; 1 an error, reported as one "error: …" line on stderr; 2 a usage
+    error (unknown option, bad option value). An "internal error" is a bug: please report it,
+    with the traceback that UASNAV_DEBUG=1 shows.
     """
 
 

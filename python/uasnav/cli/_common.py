@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from typing import Any
 
 import click
@@ -25,7 +26,112 @@ def parse_float_list(text: str, what: str) -> list[float]:
         raise click.BadParameter(f"{what}: expected comma-separated numbers, got {text!r}") from None
     if not vals:
         raise click.BadParameter(f"{what}: empty list")
+    if not all(math.isfinite(v) for v in vals):
+        raise click.BadParameter(f"{what}: expected finite numbers, got {text!r}")
     return vals
+
+
+class Real(click.ParamType):
+    """A click option type for a finite float, optionally within bounds.
+
+    ``nan``, ``inf`` and values outside ``[lo, hi]`` (open at an end with ``lo_open`` /
+    ``hi_open``) are usage errors (exit code 2) naming the option and the value as typed, e.g.
+    ``@click.option("--rate", type=POSITIVE)`` rejects ``--rate 0`` with
+    ``Invalid value for '--rate': 0 is not > 0``.
+    """
+
+    name = "float"
+
+    def __init__(
+        self,
+        lo: float | None = None,
+        hi: float | None = None,
+        *,
+        lo_open: bool = False,
+        hi_open: bool = False,
+    ) -> None:
+        self.lo, self.hi, self.lo_open, self.hi_open = lo, hi, lo_open, hi_open
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> float:
+        text = value if isinstance(value, str) else repr(value)
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"{text!r} is not a number", param, ctx)
+        if not math.isfinite(x):
+            self.fail(f"{text} is not a finite number", param, ctx)
+        if self.lo is not None and (x <= self.lo if self.lo_open else x < self.lo):
+            self.fail(f"{text} is not {'>' if self.lo_open else '>='} {self.lo:g}", param, ctx)
+        if self.hi is not None and (x >= self.hi if self.hi_open else x > self.hi):
+            self.fail(f"{text} is not {'<' if self.hi_open else '<='} {self.hi:g}", param, ctx)
+        return x
+
+    def __repr__(self) -> str:
+        return f"Real({self.lo!r}, {self.hi!r}, lo_open={self.lo_open}, hi_open={self.hi_open})"
+
+
+#: Any finite float.
+FINITE = Real()
+#: A finite float > 0 (rates, durations, lengths, speeds that divide).
+POSITIVE = Real(0.0, lo_open=True)
+#: A finite float >= 0.
+NON_NEGATIVE = Real(0.0)
+#: Geodetic latitude (deg).
+LATITUDE = Real(-90.0, 90.0)
+#: A probability strictly between 0 and 1.
+PROBABILITY = Real(0.0, 1.0, lo_open=True, hi_open=True)
+#: A random seed: what every generator of the package (numpy, Rust) accepts.
+SEED = click.IntRange(0, 2**32 - 1)
+
+
+class OutputPath(click.Path):
+    """``click.Path(dir_okay=False)`` for a file to write, refusing an empty name (``--out ''``),
+    which would otherwise fail later with a confusing message or write a hidden file."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        kwargs.setdefault("dir_okay", False)
+        super().__init__(**kwargs)
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if isinstance(value, str) and not value.strip():
+            self.fail("an empty file name", param, ctx)
+        return super().convert(value, param, ctx)
+
+
+def check_outputs(inputs: Any, outputs: dict[str, Any]) -> None:
+    """Refuse, before any work, outputs that would overwrite an input or each other.
+
+    ``inputs``: the paths the command reads (``None`` entries skipped); ``outputs``: what the
+    command writes, by option name (``{"--out": path, "--plot": path}``; a value may also be a
+    list of paths, e.g. one file per sensor). Files are compared by (device, inode), so a hard
+    link, a symbolic link or another spelling of an input is caught; devices and pipes
+    (``/dev/null``) may take any number of outputs.
+    """
+    import os
+
+    from uasnav.atomicfile import same_file
+
+    ins = [str(p) for p in inputs if p is not None]
+    outs = [
+        (opt, str(p))
+        for opt, v in outputs.items()
+        if v is not None
+        for p in (v if isinstance(v, list | tuple) else [v])
+    ]
+    for opt, out in outs:
+        for inp in ins:
+            if same_file(out, inp):
+                what = "the input" if os.path.abspath(out) == os.path.abspath(inp) else f"the input {inp}"
+                raise InputError(f"{opt} {out} is {what}; refusing to overwrite an input file")
+    seen: dict[str, tuple[str, str]] = {}
+    for opt, out in outs:
+        if os.path.exists(out) and not os.path.isfile(out):
+            continue  # /dev/null, a pipe: the writer decides (several outputs are fine there)
+        key = os.path.realpath(out)
+        if key in seen or any(same_file(out, o) for _, o in seen.values()):
+            other_opt, other = seen.get(key) or next(v for v in seen.values() if same_file(out, v[1]))
+            raise InputError(f"{opt} {out} and {other_opt} {other} are the same file")
+        seen[key] = (opt, out)
 
 
 class Quantity(click.ParamType):
@@ -46,9 +152,12 @@ class Quantity(click.ParamType):
         if isinstance(value, float):  # already converted (a default given as a number)
             return value
         try:
-            return parse_quantity(value, self.unit)
+            x = parse_quantity(value, self.unit)
         except InputError as e:
             self.fail(str(e), param, ctx)
+        if not math.isfinite(x):  # e.g. 1e400 rad/s overflows to inf
+            self.fail(f"{value} is not a finite quantity", param, ctx)
+        return x
 
     def __repr__(self) -> str:
         return f"Quantity({self.unit!r})"

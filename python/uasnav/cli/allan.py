@@ -2,14 +2,22 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import click
 
-from uasnav.cli._common import echo_json, parse_float_list
+from uasnav.cli._common import POSITIVE, OutputPath, check_outputs, echo_json, parse_float_list
+
+if TYPE_CHECKING:
+    from uasnav.noise import NoiseReport
+
+# the five IEEE 952 terms, in the order of uasnav.noise.TERMS (not imported at start-up)
+TERMS = ("quantization", "random_walk", "bias_instability", "rate_random_walk", "rate_ramp")
 
 
 @click.command("allan")
 @click.argument("log", type=click.Path(dir_okay=False))
-@click.option("--rate", type=float, default=None, help="Sample rate (Hz); default: from t.")
+@click.option("--rate", type=POSITIVE, default=None, help="Sample rate (Hz); default: from t.")
 @click.option(
     "--taus",
     default="octave",
@@ -17,7 +25,7 @@ from uasnav.cli._common import echo_json, parse_float_list
     help="octave | decade | all | comma-separated cluster times in seconds (T1,T2,…).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write a PNG plot.")
+@click.option("--plot", "plot_path", type=OutputPath(), help="Write a PNG plot.")
 def command(log: str, rate: float | None, taus: str, as_json: bool, plot_path: str | None) -> None:
     """Allan deviation of the gyro and accelerometer axes of LOG, and their noise terms.
 
@@ -29,6 +37,7 @@ def command(log: str, rate: float | None, taus: str, as_json: bool, plot_path: s
     from uasnav.io import read_log
 
     spec = taus if taus in ("octave", "decade", "all") else parse_float_list(taus, "--taus")
+    check_outputs([log], {"--plot": plot_path})
     data = read_log(log)
     if rate is None:
         rate = data.uniform_rate()
@@ -52,6 +61,9 @@ def command(log: str, rate: float | None, taus: str, as_json: bool, plot_path: s
                         "ci_high": r.curve.ci_high.T,
                         "n_terms": r.curve.n_terms,
                         "noise": r.table(),
+                        "noise_ci_level": r.confidence,
+                        # per axis: null if the five-term fit was made, else why not
+                        "fit_skipped": [why or None for why in r.fit_skipped],
                         "fit_rms_rel_residual": r.fit_rms_rel_residual,
                     }
                     for kind, r in reports.items()
@@ -61,18 +73,52 @@ def command(log: str, rate: float | None, taus: str, as_json: bool, plot_path: s
         return
     click.echo(f"{log}: {data.n} samples at {rate:g} Hz ({data.duration:.1f} s)")
     for kind, r in reports.items():
-        click.echo(
-            f"\n{kind} (fit rms rel. residual per axis: "
-            + ", ".join(f"{x:.3f}" for x in r.fit_rms_rel_residual)
-            + ")"
+        _echo_report(kind, r)
+
+
+def _echo_report(kind: str, r: NoiseReport) -> None:
+    """Text output of one sensor: the Allan deviations with their intervals, then the noise
+    terms with 95 % intervals, or why the fit or a term could not be made."""
+    c = r.curve
+    adev = c.adev if c.adev.ndim == 2 else c.adev[:, None]
+    lo = c.ci_low if c.ci_low.ndim == 2 else c.ci_low[:, None]
+    hi = c.ci_high if c.ci_high.ndim == 2 else c.ci_high[:, None]
+    names = "xyz" if adev.shape[1] == 3 else [str(j) for j in range(adev.shape[1])]
+    click.echo(f"\n{kind}: Allan deviation σ(τ) ({c.unit}) [{c.confidence:.0%} interval]")
+    click.echo(f"  {'τ (s)':>10}" + "".join(f"{n:>34}" for n in names))
+    for i, tau in enumerate(c.taus):
+        cells = "".join(
+            f"{f'{adev[i, j]:.4g} [{lo[i, j]:.3g}, {hi[i, j]:.3g}]':>34}" for j in range(adev.shape[1])
         )
-        click.echo(f"  {'term':<18}{'unit':<12}{'x':>12}{'y':>12}{'z':>12}   point readings x/y/z")
-        rows = r.table()
-        for term in ("quantization", "random_walk", "bias_instability", "rate_random_walk", "rate_ramp"):
-            sel = [row for row in rows if row["term"] == term]
-            vals = "".join(f"{row['fit_field']:>12.4g}" for row in sel)
-            pts = "/".join("-" if row["point_field"] is None else f"{row['point_field']:.3g}" for row in sel)
-            click.echo(f"  {term:<18}{sel[0]['field_unit']:<12}{vals}   {pts}")
+        click.echo(f"  {tau:>10.4g}{cells}")
+    for j, why in enumerate(r.fit_skipped):
+        if why:
+            click.echo(f"  {kind} {names[j]}: noise-term fit skipped: {why}")
+    if all(r.fit_skipped):
+        return
+    click.echo(
+        f"  noise terms, IEEE 952 fit [{r.confidence:.0%} interval] (fit rms rel. residual per axis: "
+        + ", ".join(f"{x:.3f}" for x in r.fit_rms_rel_residual)
+        + ")"
+    )
+    click.echo(f"  {'term':<18}{'unit':<12}" + "".join(f"{n:>26}" for n in names) + "   point readings")
+    rows = r.table()
+    for term in TERMS:
+        sel = [row for row in rows if row["term"] == term]
+        vals = "".join(f"{_fit_cell(row, bool(r.fit_skipped[row['axis']])):>26}" for row in sel)
+        pts = "/".join("-" if row["point_field"] is None else f"{row['point_field']:.3g}" for row in sel)
+        click.echo(f"  {term:<18}{sel[0]['field_unit']:<12}{vals}   {pts}")
+    for row in rows:
+        if row["not_identifiable_reason"] and not r.fit_skipped[row["axis"]]:
+            click.echo(
+                f"  not identifiable: {names[row['axis']]} {row['term']}: {row['not_identifiable_reason']}"
+            )
+
+
+def _fit_cell(row: dict, skipped: bool) -> str:
+    if skipped:
+        return "-"
+    return f"{row['fit_field']:.4g} [{row['ci_low_field']:.3g}, {row['ci_high_field']:.3g}]"
 
 
 def _plot(reports: dict, path: str) -> None:

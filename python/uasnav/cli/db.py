@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from uasnav.cli._common import echo_json
+from uasnav.cli._common import POSITIVE, echo_json
 
 
 @click.group("db")
@@ -14,8 +14,20 @@ def command() -> None:
 
 @command.command("validate")
 @click.argument("source")
-@click.option("--timeout", type=float, default=10.0, show_default=True, help="Network timeout (s) for URLs.")
-@click.option("--max-bytes", type=int, default=8 * 1024 * 1024, show_default=True, help="Size limit (bytes).")
+@click.option(
+    "--timeout",
+    type=POSITIVE,
+    default=10.0,
+    show_default=True,
+    help="Time limit (s) for a URL, in total: connect, headers, body.",
+)
+@click.option(
+    "--max-bytes",
+    type=click.IntRange(1),
+    default=8 * 1024 * 1024,
+    show_default=True,
+    help="Size limit (bytes).",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def validate_cmd(source: str, timeout: float, max_bytes: int, as_json: bool) -> None:
     """Parse SOURCE (path or http(s) URL) safely and validate it against its shipped schema.

@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from uasnav.cli._common import echo_json
+from uasnav.cli._common import NON_NEGATIVE, PROBABILITY, OutputPath, Real, check_outputs, echo_json
 
 _SHAPES = ["tetrahedron", "cube", "octahedron", "dodecahedron", "icosahedron"]
 
@@ -19,7 +19,7 @@ def command() -> None:
 @click.option("--shape", type=click.Choice(_SHAPES), default="cube", show_default=True)
 @click.option(
     "--per-face",
-    type=float,
+    type=Real(0.0, 1000.0, lo_open=True),
     default=1.0,
     show_default=True,
     help="Sensors per face, a multiple of 0.5 (Table 14's 'gyros per face').",
@@ -74,25 +74,23 @@ def kr_command(shape: str, per_face: float, triaxial: bool, as_json: bool) -> No
 )
 @click.option("--fdi", is_flag=True, help="Parity-space fault detection, isolation and re-fusion.")
 @click.option(
-    "--p-fa", type=float, default=1e-6, show_default=True, help="False-alarm probability per sample."
+    "--p-fa", type=PROBABILITY, default=1e-6, show_default=True, help="False-alarm probability per sample."
 )
 @click.option(
     "--learn-bias",
-    type=float,
+    type=NON_NEGATIVE,
     default=10.0,
     show_default=True,
-    help="Seconds at the start used to learn the parity-space biases (with --fdi).",
+    help="Seconds at the start used to learn the parity-space biases (with --fdi; 0 = off).",
 )
 @click.option(
     "--stuck",
-    type=int,
+    type=click.IntRange(0),
     default=20,
     show_default=True,
     help="Repeated samples flagging a stuck output (0 = off).",
 )
-@click.option(
-    "--out", "out_path", required=True, type=click.Path(dir_okay=False), help="Fused CSV (log format v1)."
-)
+@click.option("--out", "out_path", required=True, type=OutputPath(), help="Fused CSV (log format v1).")
 @click.option("--json", "as_json", is_flag=True, help="Print a JSON summary.")
 def fuse_command(
     logs: tuple[str, ...],
@@ -111,12 +109,20 @@ def fuse_command(
     2 saturated, 4 stuck, 8 isolated by the parity test). Samples where no valid fusion is
     possible are left out and counted.
     """
+    from uasnav.errors import NumericalError
     from uasnav.io.csv_v1 import write_csv_v1
     from uasnav.redundancy import fuse_files
 
+    check_outputs(logs, {"--out": out_path})
     fused = fuse_files(
         logs, shape, fdi=fdi, p_fa=p_fa, learn_bias_s=learn_bias, stuck_samples=stuck, time_tol_s=1e-6
     )
+    if not fused.result.valid.any():
+        # An empty fused log with exit 0 would pass for a result; nothing is written.
+        raise NumericalError(
+            f"no sample could be fused ({fused.result.t.size} samples, all dropped); nothing written to "
+            f"{out_path}" + ("" if not fdi else " (check --p-fa and --learn-bias)")
+        )
     # CSV v1 whatever the extension (as always); the fused log's metadata become the
     # `# key: value` lines, the χ² and health flags extra columns.
     write_csv_v1(fused.fused_log(), out_path, extra_columns=fused.extra_columns())

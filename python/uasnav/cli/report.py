@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from uasnav.cli._common import echo_json
+from uasnav.cli._common import SEED, OutputPath, echo_json
 
 
 @click.command("report")
@@ -13,10 +13,10 @@ from uasnav.cli._common import echo_json
     "out_dir",
     default="build/report",
     show_default=True,
-    type=click.Path(file_okay=False),
+    type=OutputPath(file_okay=False, dir_okay=True),
     help="Output folder.",
 )
-@click.option("--seed", default=2024, show_default=True, help="Seed of every simulation.")
+@click.option("--seed", type=SEED, default=2024, show_default=True, help="Seed of every simulation.")
 @click.option("--quick", is_flag=True, help="Smaller experiments (seconds instead of minutes).")
 @click.option("--only", default=None, help="Comma-separated section keys to run.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report's numbers as JSON.")
@@ -25,7 +25,9 @@ def command(out_dir: str, seed: int, quick: bool, only: str | None, as_json: boo
     OUT/report.html (self-contained, with figures) and OUT/report.json."""
     from uasnav.report import build_report
 
-    keys = [k.strip() for k in only.split(",") if k.strip()] if only else None
+    keys = [k.strip() for k in only.split(",") if k.strip()] if only is not None else None
+    if keys == []:  # `--only ""` or `--only ,` would silently run every section
+        raise click.BadParameter("no section key given", param_hint="'--only'")
     res = build_report(out_dir, seed=seed, quick=quick, only=keys, progress=lambda m: click.echo(m, err=True))
     if as_json:
         echo_json({"html": str(res.html_path), "json": str(res.json_path), "sections": res.data})

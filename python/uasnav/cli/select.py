@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import math
+
 import click
 
-from uasnav.cli._common import echo_json
+from uasnav.cli._common import NON_NEGATIVE, POSITIVE, echo_json
 
 _PARAMS = ("range", "weight", "cost", "resolution")
 
@@ -16,7 +18,13 @@ def _parse_size(text: str) -> tuple[float, float]:
             raise ValueError
         size = (float(parts[0]), float(parts[1]))
     except ValueError:
-        raise click.BadParameter(f"expected LENGTHxWIDTH in metres (e.g. 70x70), got {text!r}") from None
+        raise click.BadParameter(
+            f"expected LENGTHxWIDTH in metres (e.g. 70x70), got {text!r}", param_hint="'--image-size'"
+        ) from None
+    if not all(math.isfinite(v) and v > 0 for v in size):
+        raise click.BadParameter(
+            f"expected a finite LENGTHxWIDTH > 0 in metres, got {text!r}", param_hint="'--image-size'"
+        )
     return size
 
 
@@ -37,14 +45,20 @@ def _parse_pairs(text: str, what: str, allowed: tuple[str, ...]) -> dict[str, st
 
 @click.command("select")
 @click.option("--mission", default="precision-agriculture", show_default=True, help="Mission id (Table 18).")
-@click.option("--range", "range_m", type=float, default=1500.0, show_default=True, help="Mission range (m).")
-@click.option("--resolution", type=float, default=0.05, show_default=True, help="Ground resolution (m/px).")
+@click.option(
+    "--range", "range_m", type=POSITIVE, default=1500.0, show_default=True, help="Mission range (m)."
+)
+@click.option(
+    "--resolution", type=POSITIVE, default=0.05, show_default=True, help="Ground resolution (m/px)."
+)
 @click.option("--image-size", default="70x70", show_default=True, help="Target size LENGTHxWIDTH (m).")
-@click.option("--altitude", type=float, default=50.0, show_default=True, help="Flight altitude AGL (m).")
+@click.option("--altitude", type=POSITIVE, default=50.0, show_default=True, help="Flight altitude AGL (m).")
 @click.option("--imagery", default="multispectral", show_default=True, help="Camera type, or 'any'.")
-@click.option("--wind", type=float, default=5.0, show_default=True, help="Wind speed (m/s).")
+@click.option("--wind", type=NON_NEGATIVE, default=5.0, show_default=True, help="Wind speed (m/s).")
 @click.option("--rain", is_flag=True, help="The flight must be possible in rain.")
-@click.option("--speed", type=float, default=None, help="Required ground speed against the wind (m/s).")
+@click.option(
+    "--speed", type=NON_NEGATIVE, default=None, help="Required ground speed against the wind (m/s)."
+)
 @click.option(
     "--order-by",
     type=click.Choice(_PARAMS),
@@ -118,6 +132,13 @@ def command(
             w = Weights(**{**Weights.order_by(order_by).__dict__, **{k: float(v) for k, v in vals.items()}})
         except ValueError:
             raise click.BadParameter(f"--weights: not numbers in {weights!r}") from None
+        ws = [w.range, w.weight, w.cost, w.resolution]
+        # Negative or all-zero weights would rank every configuration the same (or backwards)
+        # and still print a ranking.
+        if not all(math.isfinite(x) and x >= 0 for x in ws) or not any(x > 0 for x in ws):
+            raise click.BadParameter(
+                f"--weights: expected finite weights >= 0, at least one > 0, got {weights!r}"
+            )
     else:
         w = Weights.order_by(order_by)
     t = Targets()
@@ -130,7 +151,7 @@ def command(
                 kw[names[k]] = (float(a), float(b))
             except ValueError:
                 raise click.BadParameter(f"--targets: {k}={v!r} is not TARGET:LIMIT") from None
-            if not sep:
+            if not sep or not all(math.isfinite(x) for x in kw[names[k]]) or a.strip() == b.strip():
                 raise click.BadParameter(f"--targets: {k}={v!r} is not TARGET:LIMIT")
         t = Targets(**{**t.__dict__, **kw})
     if category is None:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from uasnav.cli._common import echo_json
+from uasnav.cli._common import LATITUDE, POSITIVE, SEED, OutputPath, Real, check_outputs, echo_json
 
 _SENSORS = {
     "single": None,
@@ -39,13 +39,19 @@ def _outputs(out: Path, count: int) -> list[Path]:
     show_default=True,
     help="Temperature profile (thesis §4.2.4: soak = Fig. 29, ramp = Fig. 30; cycles = repeated ramps).",
 )
-@click.option("--duration", type=float, default=None, help="Seconds; default: the profile's natural length.")
-@click.option("--rate", type=float, default=100.0, show_default=True, help="Output sample rate (Hz).")
-@click.option("--seed", type=int, default=0, show_default=True, help="Random seed (output is deterministic).")
 @click.option(
-    "--latitude", "latitude_deg", type=float, default=45.0, show_default=True, help="Latitude (deg)."
+    "--duration", type=POSITIVE, default=None, help="Seconds; default: the profile's natural length."
 )
-@click.option("--height", "height_m", type=float, default=0.0, show_default=True, help="Height (m, WGS-84).")
+@click.option("--rate", type=POSITIVE, default=100.0, show_default=True, help="Output sample rate (Hz).")
+@click.option(
+    "--seed", type=SEED, default=0, show_default=True, help="Random seed (output is deterministic)."
+)
+@click.option(
+    "--latitude", "latitude_deg", type=LATITUDE, default=45.0, show_default=True, help="Latitude (deg)."
+)
+@click.option(
+    "--height", "height_m", type=Real(-1e4, 1e5), default=0.0, show_default=True, help="Height (m, WGS-84)."
+)
 @click.option(
     "--sensors",
     type=click.Choice(sorted(_SENSORS)),
@@ -58,14 +64,12 @@ def _outputs(out: Path, count: int) -> list[Path]:
 @click.option(
     "--table-rate",
     "table_rate_dps",
-    type=float,
+    type=Real(-1e4, 1e4),
     default=0.0,
     show_default=True,
     help="Slow motion: rate table turning about the vertical at this rate (deg/s).",
 )
-@click.option(
-    "--out", "out", type=click.Path(dir_okay=False), required=True, help="Output log (.csv or .npz)."
-)
+@click.option("--out", "out", type=OutputPath(), required=True, help="Output log (.csv or .npz).")
 @click.option("--json", "as_json", is_flag=True, help="Print a JSON summary.")
 def command(
     preset: str,
@@ -86,12 +90,16 @@ def command(
     columns (true rate, true specific force, gyro/accel bias, thermal bias, attitude, die and
     chamber temperature). Progress goes to stderr for long runs.
     """
+    from uasnav.atomicfile import output_set
     from uasnav.io import WRITE_EXTENSIONS, write_log
     from uasnav.sim import load_preset, simulate, simulate_array
 
     out_path = Path(out)
     if out_path.suffix.lower() not in WRITE_EXTENSIONS:
         raise click.UsageError(f"--out: extension must be one of {', '.join(WRITE_EXTENSIONS)}")
+    # one file per sensor: the count ends each multi-sensor name (cube6 → 6)
+    n_files = 1 if _SENSORS[sensors] is None else int(sensors.lstrip("abcdefghijklmnopqrstuvwxyz"))
+    check_outputs([preset], {"--out": _outputs(out_path, n_files)})
     model = load_preset(preset)
     last = [-1]
 
@@ -118,8 +126,9 @@ def command(
     else:
         logs = simulate_array(model, shape=arr[0], per_face=arr[1], progress=cb, **kwargs)  # type: ignore[arg-type]
     paths = _outputs(out_path, len(logs))
-    for log, p in zip(logs, paths, strict=True):
-        write_log(log, p)
+    with output_set():  # all sensors' files, or none
+        for log, p in zip(logs, paths, strict=True):
+            write_log(log, p)
     if cb is not None:
         sys.stderr.flush()
     summary = {

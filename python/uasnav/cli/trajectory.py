@@ -2,10 +2,20 @@
 
 from __future__ import annotations
 
+import math
+
 import click
 import numpy as np
 
-from uasnav.cli._common import echo_json, parse_float_list
+from uasnav.cli._common import (
+    NON_NEGATIVE,
+    POSITIVE,
+    SEED,
+    OutputPath,
+    check_outputs,
+    echo_json,
+    parse_float_list,
+)
 from uasnav.errors import InputError
 
 
@@ -19,6 +29,11 @@ def parse_wind(text: str) -> np.ndarray:
         raise InputError(
             f"--wind must be SPEED@DIR (m/s @ deg from north, wind from), got {text!r}"
         ) from None
+    # 100 m/s is beyond any wind a small UAS flies in: larger values are typos (or overflow).
+    if not (math.isfinite(speed) and math.isfinite(direction) and 0.0 <= speed <= 100.0):
+        raise InputError(
+            f"--wind: SPEED must be in [0, 100] m/s and DIR finite (deg from north), got {text!r}"
+        )
     return wind_vector(speed, direction)
 
 
@@ -31,14 +46,16 @@ _common_opts = [
     click.option(
         "--plan", type=click.Path(dir_okay=False), help="Plan CSV (lat,lon,alt) for logs without a mission."
     ),
-    click.option("--speed", type=float, help="Commanded speed (m/s); default from the log (WPNAV_SPEED …)."),
+    click.option(
+        "--speed", type=POSITIVE, help="Commanded speed (m/s); default from the log (WPNAV_SPEED …)."
+    ),
     click.option(
         "--wind", "wind_text", help="Wind SPEED@DIR (m/s, deg wind comes from); default the log's or calm."
     ),
-    click.option("--segment", type=float, default=10.0, show_default=True, help="Segment length L (m)."),
+    click.option("--segment", type=POSITIVE, default=10.0, show_default=True, help="Segment length L (m)."),
     click.option(
         "--max-gap",
-        type=float,
+        type=POSITIVE,
         default=5.0,
         show_default=True,
         help="Largest telemetry gap in an element (s).",
@@ -57,21 +74,35 @@ def _apply(opts):  # type: ignore[no-untyped-def]
 
 @command.command("train")
 @click.argument("flights", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Model JSON to write.")
+@click.option("--out", "out", required=True, type=OutputPath(), help="Model JSON to write.")
 @_apply(_common_opts)
 @click.option("--algorithm", type=click.Choice(["lvq1", "lvq2.1", "glvq"]), default="lvq1", show_default=True)
-@click.option("--prototypes", type=int, default=256, show_default=True, help="Competitive neurons S¹.")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option(
+    "--prototypes", type=click.IntRange(1), default=256, show_default=True, help="Competitive neurons S¹."
+)
+@click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, prototypes, seed, as_json):  # type: ignore[no-untyped-def]
     """Train a model on the flown elements of FLIGHT... (.tlog, .bin, .ulg, .csv) and write it."""
     from uasnav.trajectory.flights import flight_samples
     from uasnav.trajectory.predictor import TrajectoryPredictor
 
+    check_outputs([*flights, plan], {"--out": out})
     wind = parse_wind(wind_text) if wind_text else None
     fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
     all_s = fs.concat()
-    model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
+    import warnings
+
+    from uasnav.trajectory.baselines import class_method_reason
+
+    why = class_method_reason(all_s.cell, "populated feature cells")
+    if why is not None:
+        # Say it once, in our words (the same rule `evaluate` reports as "not applicable"),
+        # instead of scikit-learn's "number of unique classes is greater than 50%" UserWarning.
+        click.echo(f"warning: {why}", err=True)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="The number of unique classes", category=UserWarning)
+        model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
     model.save(out)
     info = {
         "model": out,
@@ -93,9 +124,9 @@ def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, pro
 @click.option("--model", "model_path", required=True, type=click.Path(dir_okay=False))
 @click.option("--plan", "plan_path", required=True, type=click.Path(dir_okay=False))
 @click.option("--wind", "wind_text", required=True, help="SPEED@DIR: m/s @ degrees the wind comes from.")
-@click.option("--speed", type=float, help="Commanded speed (m/s); default the model's.")
+@click.option("--speed", type=POSITIVE, help="Commanded speed (m/s); default the model's.")
 @click.option("--required", help="4D plan: required time (s from start) at each waypoint, T0,T1,….")
-@click.option("--tolerance", type=float, default=5.0, show_default=True, help="4D time tolerance (s).")
+@click.option("--tolerance", type=NON_NEGATIVE, default=5.0, show_default=True, help="4D time tolerance (s).")
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_json):  # type: ignore[no-untyped-def]
     """Per-element times, ETA and 4D waypoint times of PLAN (CSV lat,lon,alt or north,east).
@@ -106,13 +137,15 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
     from uasnav.trajectory.plans import read_plan
     from uasnav.trajectory.predictor import TrajectoryPredictor
 
+    # options first, files second: a typo in an option is reported before any file is read
+    wind = parse_wind(wind_text)
+    req = parse_float_list(required, "--required") if required else None
     model = TrajectoryPredictor.load(model_path)
     plan_ne, _ = read_plan(plan_path)
-    p = model.predict(plan_ne, parse_wind(wind_text), speed)
+    p = model.predict(plan_ne, wind, speed)
     feas = None
-    if required:
-        req = parse_float_list(required, "--required")
-        feas = model.feasibility(plan_ne, np.array(req), parse_wind(wind_text), tolerance, speed)
+    if req is not None:
+        feas = model.feasibility(plan_ne, np.array(req), wind, tolerance, speed)
     el, f = p.elements, p.features
     rows = [
         {
@@ -153,7 +186,7 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
 @click.argument("flights", nargs=-1, type=click.Path(dir_okay=False))
 @_apply(_common_opts)
 @click.option("--simulated", is_flag=True, help="Run the simulated Phantom-4 experiment (Table 17) instead.")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed, as_json):  # type: ignore[no-untyped-def]
     """e% (eq. 59) per element and per run of LVQ vs the baselines.
@@ -167,9 +200,12 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         r = run_phantom4(seed=seed)
         table = {
             m.name: {
+                "applicable": True,
                 "element_e_pct_mean": float(m.error_pct.mean()),
                 "element_e_pct_max": float(m.error_pct.max()),
             }
+            if m.applicable
+            else {"applicable": False, "reason": m.reason}
             for m in r.methods
         }
         t17 = [{"piece": p.piece, "t_nn_s": p.t_nn_s, "t_real_s": list(p.t_real_s)} for p in r.table17]
@@ -183,11 +219,14 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
         table = {
             e.name: {
+                "applicable": True,
                 "element_e_pct_mean": float(np.mean(e.element_pct)),
                 "element_e_pct_median": float(np.median(e.element_pct)),
                 "run_e_pct_mean": float(np.mean(e.run_pct)),
                 "run_e_pct": list(e.run_pct),
             }
+            if e.applicable
+            else {"applicable": False, "reason": e.reason}
             for e in leave_one_run_out(fs, segment, random_state=seed)
         }
         out = {"methods": table, "n_runs": len(fs), "n_elements": fs.n_elements}
@@ -195,6 +234,9 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         echo_json(out)
         return
     for name, d in out["methods"].items():
+        if not d["applicable"]:
+            click.echo(f"{name:24s} not applicable: {d['reason']}")
+            continue
         extra = f"  run e% {d['run_e_pct_mean']:6.2f}" if "run_e_pct_mean" in d else ""
         click.echo(f"{name:24s} element e% mean {d['element_e_pct_mean']:6.2f}{extra}")
     for row in out.get("table17", []):

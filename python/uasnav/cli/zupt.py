@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Literal
 
 import click
 
-from uasnav.cli._common import Quantity, echo_json
+from uasnav.cli._common import FINITE, LATITUDE, POSITIVE, OutputPath, Quantity, check_outputs, echo_json
 
 if TYPE_CHECKING:
     from uasnav.zupt import ZuptResult
@@ -35,12 +35,12 @@ if TYPE_CHECKING:
     show_default=True,
     help="Error added to the initial gyro-bias estimate on every axis, e.g. 15deg/h.",
 )
-@click.option("--latitude-deg", type=float, default=45.0, show_default=True, help="Latitude of the unit.")
-@click.option("--heading-deg", type=float, default=0.0, show_default=True, help="True heading of the unit.")
-@click.option("--levelling-s", type=float, default=60.0, show_default=True, help="Zeroing window (s).")
-@click.option("--out", "out_path", type=click.Path(dir_okay=False), help="Write EST.csv (t,bgx,…,baz,…).")
+@click.option("--latitude-deg", type=LATITUDE, default=45.0, show_default=True, help="Latitude of the unit.")
+@click.option("--heading-deg", type=FINITE, default=0.0, show_default=True, help="True heading of the unit.")
+@click.option("--levelling-s", type=POSITIVE, default=60.0, show_default=True, help="Zeroing window (s).")
+@click.option("--out", "out_path", type=OutputPath(), help="Write EST.csv (t,bgx,…,baz,…).")
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write a PNG of the gyro bias.")
+@click.option("--plot", "plot_path", type=OutputPath(), help="Write a PNG of the gyro bias.")
 def command(
     log: str,
     mode: Literal["zupt", "tczupt"],
@@ -64,11 +64,14 @@ def command(
     import math
 
     from uasnav import zupt
+    from uasnav.atomicfile import output_set
+    from uasnav.errors import InputError
     from uasnav.io import read_log
     from uasnav.thermal import load_model
 
     if mode == "tczupt" and model_path is None:
         raise click.UsageError("--model is required for --mode tczupt")
+    check_outputs([log, model_path], {"--out": out_path, "--plot": plot_path})
     data = read_log(log)
     model = load_model(model_path) if model_path else None
     cfg = zupt.ZuptConfig(
@@ -79,10 +82,18 @@ def command(
         derivative=derivative,
     )
     res = zupt.run(data, mode, model, cfg)
-    if out_path:
-        res.to_csv(out_path)
-    if plot_path:
-        _plot(res, plot_path)
+    if res.updates == 0:
+        # Without a single update the "estimates" are the initial guesses (the API allows
+        # that deliberately, labelled by `updates`; a CLI user would take them for a result).
+        raise InputError(
+            f"{log}: no ZUPT update in {data.n} samples ({data.duration:g} s; one update every "
+            f"{cfg.update_interval_s:g} s): too short to estimate anything"
+        )
+    with output_set():  # EST.csv and the plot together, or neither
+        if out_path:
+            res.to_csv(out_path)
+        if plot_path:
+            _plot(res, plot_path)
     summary = {
         "log": log,
         "mode": mode,

@@ -17,8 +17,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.allan import AllanResult, oadev
+from uasnav.errors import InputError
 from uasnav.experiments.thesis import TABLE3
-from uasnav.noise import NoiseReport
+from uasnav.noise import TERMS, NoiseReport
 from uasnav.units import convert
 
 #: NIST SP 1065 §12 (p. 107): published overlapping ADEV of the 1000-point NBS-14 test set,
@@ -134,6 +135,9 @@ class GyroIdentification:
         ARW per axis from the five-term fit and read at τ = 1 s (deg/√h).
     rrw_fit_deg_h_sqrt_h : ndarray, shape (3,)
         RRW per axis from the fit (deg/h/√h; 0 where the fit does not support the term).
+    terms : tuple of TermRecovery
+        Every term configured in the simulation (ARW, bias instability = 0, RRW) against the
+        fit's 95 % confidence interval, per axis.
     """
 
     hours: float
@@ -145,6 +149,80 @@ class GyroIdentification:
     arw_fit_deg_sqrt_h: NDArray[np.float64]
     arw_points_deg_sqrt_h: NDArray[np.float64]
     rrw_fit_deg_h_sqrt_h: NDArray[np.float64]
+    terms: tuple[TermRecovery, ...] = ()
+
+    @property
+    def all_recovered(self) -> bool:
+        """Every configured term inside its 95 % interval on every axis."""
+        return all(bool(np.all(t.inside)) for t in self.terms)
+
+
+@dataclass(frozen=True)
+class TermRecovery:
+    """One configured noise term beside the fit's confidence interval, per axis.
+
+    Attributes
+    ----------
+    term : str
+        IEEE 952 term (:data:`uasnav.noise.TERMS`).
+    unit : str
+        Field unit of the values (deg/√h, deg/h, deg/h/√h).
+    configured : float
+        Value configured in the simulation (``unit``; 0 for a term not simulated).
+    fit, ci_low, ci_high : ndarray, shape (3,)
+        Fitted value and its 95 % profile-likelihood interval per axis (``unit``).
+    inside : ndarray of bool, shape (3,)
+        ``ci_low ≤ configured ≤ ci_high`` per axis: the term is recovered.
+    identifiable : ndarray of bool, shape (3,)
+        The interval excludes 0 (the data demand the term).
+    reasons : tuple of str
+        Per axis: why the term is not identifiable (``""`` where it is).
+    """
+
+    term: str
+    unit: str
+    configured: float
+    fit: NDArray[np.float64]
+    ci_low: NDArray[np.float64]
+    ci_high: NDArray[np.float64]
+    inside: NDArray[np.bool_]
+    identifiable: NDArray[np.bool_]
+    reasons: tuple[str, ...]
+
+
+def term_recovery(report: NoiseReport, term: str, configured: float, unit: str) -> TermRecovery:
+    """Compare a configured value (``unit``) with the fit of ``term`` in ``report``.
+
+    Parameters
+    ----------
+    report : NoiseReport
+        Noise identification with confidence intervals.
+    term : str
+        IEEE 952 term.
+    configured : float
+        Truth of the simulation, in ``unit``.
+    unit : str
+        Unit of ``configured`` and of the returned values (dimension-checked).
+    """
+    if report.ci_low is None or report.ci_high is None:
+        raise InputError("term_recovery: the noise report carries no confidence intervals")
+    fit = report.fit.to(term, unit)
+    lo = report.ci_low.to(term, unit)
+    hi = report.ci_high.to(term, unit)
+    i = TERMS.index(term)
+    # a relative 1e-9 slack: the interval ends come from a bisection, not a closed form
+    tol = 1e-9 * max(abs(configured), 1e-300)
+    return TermRecovery(
+        term=term,
+        unit=unit,
+        configured=float(configured),
+        fit=fit,
+        ci_low=lo,
+        ci_high=hi,
+        inside=(lo - tol <= configured) & (configured <= hi + tol),
+        identifiable=report.identifiable[i].copy(),
+        reasons=tuple(report.reason(j, term) or "" for j in range(fit.size)),
+    )
 
 
 def gyro_identification(
@@ -165,6 +243,12 @@ def gyro_identification(
     arw_fit, _ = rep.fit.field("random_walk")
     rrw_fit, _ = rep.fit.field("rate_random_walk")
     arw_pt, _ = rep.points.field("random_walk")
+    terms = (
+        term_recovery(rep, "random_walk", arw_cfg, "deg/√h"),
+        # not simulated: the interval must contain 0
+        term_recovery(rep, "bias_instability", 0.0, "deg/h"),
+        term_recovery(rep, "rate_random_walk", RRW_CONFIGURED_DEG_H_SQRT_H, "deg/h/√h"),
+    )
     return GyroIdentification(
         hours=hours,
         rate_hz=rate,
@@ -175,6 +259,7 @@ def gyro_identification(
         arw_fit_deg_sqrt_h=arw_fit,
         arw_points_deg_sqrt_h=arw_pt,
         rrw_fit_deg_h_sqrt_h=rrw_fit,
+        terms=terms,
     )
 
 
@@ -211,8 +296,10 @@ __all__ = [
     "AllanExperimentResult",
     "GyroIdentification",
     "NistCheck",
+    "TermRecovery",
     "gyro_identification",
     "nbs14_series",
     "nist_check",
     "run",
+    "term_recovery",
 ]

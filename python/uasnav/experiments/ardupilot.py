@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from uasnav import redundancy as R
 from uasnav.errors import DataFormatError, InputError
-from uasnav.imu import ImuLog
+from uasnav.imu import ImuLog, require_log
 from uasnav.io import read_dataflash
 
 FloatArray = NDArray[np.float64]
@@ -107,6 +107,7 @@ def common_samples(logs: Sequence[ImuLog], min_samples: int = 10) -> list[ImuLog
     InputError
         If fewer than ``min_samples`` time stamps are common to every log.
     """
+    logs = [require_log(lg, f"logs[{i}]") for i, lg in enumerate(logs)]
     common = functools.reduce(np.intersect1d, [lg.t for lg in logs])
     if common.size < min_samples:
         raise InputError(f"the IMU streams share fewer than {min_samples} timestamps")

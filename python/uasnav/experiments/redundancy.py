@@ -248,6 +248,10 @@ class Table15Result:
         Face 1's triaxial gyro output (rad/s), Figure 50.
     variants : tuple of Table15Variant
         Raw outputs, then after a 10 s ZUPT initialisation of each sensor's bias.
+    mc_dt_percent : tuple of tuple of float
+        Per threshold of Table 15 (in its order), the raw-output Δt% of every face of every
+        Monte Carlo cube that reached it (%): the spread the thesis' one-face values are judged
+        against (:func:`uasnav.experiments.verdicts.within_spread`).
     """
 
     duration_s: float
@@ -255,6 +259,7 @@ class Table15Result:
     t: FloatArray
     face1_gyro: FloatArray
     variants: tuple[Table15Variant, ...]
+    mc_dt_percent: tuple[tuple[float, ...], ...] = ()
 
 
 def table15(
@@ -306,7 +311,7 @@ def table15(
             med = float(np.median(mc[j])) if (mc[j] and name.startswith("raw")) else None
             rows.append(Table15Row(th, ref[0], t_red, ref[1], t_one, ref[2], dtp, med))
         out.append(Table15Variant(name, tuple(rows), d_single, d_fused))
-    return Table15Result(duration, n_mc, logs[0].t, logs[0].gyro, tuple(out))
+    return Table15Result(duration, n_mc, logs[0].t, logs[0].gyro, tuple(out), tuple(tuple(m) for m in mc))
 
 
 # --- improvement against theory -----------------------------------------------------------------

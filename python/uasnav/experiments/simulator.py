@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.allan import AllanResult, oadev
+from uasnav.experiments.allan import TermRecovery, term_recovery
 from uasnav.noise import NoiseReport
 from uasnav.sim import load_preset, simulate, thermal_bias
 from uasnav.sim.lab import block_average
@@ -226,7 +227,10 @@ class TermCheck:
         floor, N²/τ = (0.664·B)² (inf if B = 0); None for other terms.
     resolvable : bool
         False if the floor is reached only beyond a tenth of the record (then the fit cannot
-        see it and ``fit`` is not comparable with ``spec``).
+        see it and ``fit`` is not comparable with ``spec``); a prior from the specification.
+    recovery : TermRecovery or None
+        What the data say: the fit's 95 % interval per axis, whether it contains ``spec``,
+        whether the term is identifiable and why not.
     """
 
     preset: str
@@ -238,6 +242,7 @@ class TermCheck:
     points: FloatArray
     tau_cross_s: float | None
     resolvable: bool
+    recovery: TermRecovery | None = None
 
 
 @dataclass(frozen=True)
@@ -298,17 +303,19 @@ def static_allan(
                     n_si, b_si = tri.white, tri.bias_instability
                     tau_cross = (n_si / (0.664 * b_si)) ** 2 if b_si > 0 else math.inf
                     resolvable = not tau_cross > record_s / 10.0
+                spec = float(convert(getattr(tri, attr), _SI[kind][attr], unit))
                 terms.append(
                     TermCheck(
                         preset=preset,
                         sensor=kind,
                         term=term,
                         unit=unit,
-                        spec=float(convert(getattr(tri, attr), _SI[kind][attr], unit)),
+                        spec=spec,
                         fit=rep.fit.to(term, unit),
                         points=rep.points.to(term, unit),
                         tau_cross_s=tau_cross,
                         resolvable=resolvable,
+                        recovery=term_recovery(rep, term, spec, unit),
                     )
                 )
         out.append(

@@ -135,12 +135,25 @@ class TrainingElement:
 
 @dataclass(frozen=True)
 class MethodSummary:
-    """e% per test element of one method (%, eq. 59): mean, median and maximum."""
+    """e% per test element of one method (%, eq. 59): mean, median and maximum.
+
+    ``reason`` is None for a fitted method; otherwise why the method is not applicable to the
+    training data (the three e% are then NaN and must not be shown as numbers).
+    """
 
     name: str
     mean_pct: float
     median_pct: float
     max_pct: float
+    reason: str | None = None
+
+    @classmethod
+    def of(cls, m: MethodResult) -> MethodSummary:
+        """Summary of one :class:`MethodResult` (NaN e% and its reason if not applicable)."""
+        if not m.applicable:
+            return cls(m.name, float("nan"), float("nan"), float("nan"), m.reason)
+        e = m.error_pct
+        return cls(m.name, float(e.mean()), float(np.median(e)), float(e.max()))
 
 
 @dataclass(frozen=True)
@@ -357,16 +370,15 @@ def run(
         name: discretise(fl[0].plan_ne).mid_ne[table17_piece(fl[0].plan_ne)] for name, fl in r.flights.items()
     }
     elements = training_elements(r, n_train)
-    methods = tuple(
-        MethodSummary(
-            m.name, float(m.error_pct.mean()), float(np.median(m.error_pct)), float(m.error_pct.max())
-        )
-        for m in r.methods
-    )
+    methods = tuple(MethodSummary.of(m) for m in r.methods)
     cross = cross_trajectory(r, seed=seed)
     names = [m.name for m in next(iter(cross.values()))]
+    # NaN where a method is not applicable in that direction (its MethodResult says why).
     means = {
-        n: tuple(float(next(m for m in res if m.name == n).error_pct.mean()) for res in cross.values())
+        n: tuple(
+            float(m.error_pct.mean()) if m.applicable else float("nan")
+            for m in (next(m for m in res if m.name == n) for res in cross.values())
+        )
         for n in names
     }
     return TrajectoryResult(

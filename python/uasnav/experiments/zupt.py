@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav import sim, zupt
+from uasnav.experiments.verdicts import CONFIRMED, Verdict, tczupt_claim
 from uasnav.imu import ImuLog
 from uasnav.sim.lab import soak_calibration_data
 from uasnav.thermal import NeuralBiasModel, branch_from_temperature
@@ -181,8 +182,10 @@ class ClaimCheck:
         ZUPT given σ'_GBI over TCZUPT (with hysteresis).
     ratio_tczupt_sgbi : float
         TCZUPT given σ_GBI over ZUPT (with hysteresis).
-    confirmed : bool
-        ``faster_axes >= 2`` and ``ratio_with_hysteresis <= 1.1``.
+    verdict : Verdict
+        :func:`uasnav.experiments.verdicts.tczupt_claim` on the per-axis convergence and the
+        per-run, per-axis Monte-Carlo RMS with hysteresis: confirmed only if the claim holds on
+        every axis beyond the Monte-Carlo spread.
     """
 
     faster_axes: int
@@ -190,7 +193,12 @@ class ClaimCheck:
     ratio_without_hysteresis: float
     ratio_zupt_sgbi_prime: float
     ratio_tczupt_sgbi: float
-    confirmed: bool
+    verdict: Verdict
+
+    @property
+    def confirmed(self) -> bool:
+        """Whether the verdict is "confirmed" (on every axis)."""
+        return self.verdict.verdict == CONFIRMED
 
 
 @dataclass(frozen=True)
@@ -408,10 +416,11 @@ def run(
     mc = monte_carlo(log, model, base, duration=duration, seed=seed, quick=quick)
 
     # Claim check, from the numbers above.
-    faster = 0
+    faster_axis = []
     for j in range(3):
         tz_, tt_ = conv_exact["zupt"][j], conv_exact["tczupt"][j]
-        faster += int(tt_ is not None and (tz_ is None or tt_ < tz_))
+        faster_axis.append(tt_ is not None and (tz_ is None or tt_ < tz_))
+    faster = sum(faster_axis)
     mean_rms = {k: {v: float(np.mean(mc.rms[k][v])) for v in VARIANTS} for k in MC_KEYS}
     hy, nh = mean_rms["with hysteresis"], mean_rms["without hysteresis"]
     ratio_h = hy[TCZUPT_THESIS] / hy[ZUPT_THESIS]
@@ -421,7 +430,7 @@ def run(
         ratio_without_hysteresis=nh[TCZUPT_THESIS] / nh[ZUPT_THESIS],
         ratio_zupt_sgbi_prime=hy["ZUPT with σ'_GBI"] / hy[TCZUPT_THESIS],
         ratio_tczupt_sgbi=hy["TCZUPT with σ_GBI"] / hy[ZUPT_THESIS],
-        confirmed=faster >= 2 and ratio_h <= 1.1,
+        verdict=tczupt_claim(faster_axis, mc.rms[MC_KEYS[0]][TCZUPT_THESIS], mc.rms[MC_KEYS[0]][ZUPT_THESIS]),
     )
 
     # Hysteresis study, per branch (the thesis' first future development).

@@ -22,8 +22,18 @@ Writers are atomic: :func:`write_log` by extension (``.csv`` → CSV v1, ``.npz`
 One module per format: :mod:`~uasnav.io.csv_v1`, :mod:`~uasnav.io.npz`, :mod:`~uasnav.io.px4`
 (ULog), :mod:`~uasnav.io.dataflash`, :mod:`~uasnav.io.tlog`, :mod:`~uasnav.io.xio`,
 :mod:`~uasnav.io.flight` (flight CSV), :mod:`~uasnav.io.table`. Nothing here imports from the
-rest of uasnav except :mod:`uasnav.imu`, :mod:`uasnav.errors`, :mod:`uasnav.units` and
-:mod:`uasnav.atomicfile`.
+rest of uasnav except :mod:`uasnav.imu`, :mod:`uasnav.errors`, :mod:`uasnav.units`,
+:mod:`uasnav.limits` and :mod:`uasnav.atomicfile`.
+
+Hostile files: every reader gives one :class:`~uasnav.errors.DataFormatError` naming the file
+(and for text the line and column) for malformed content: a stray ``"``, an over-long cell, NUL
+bytes, text that is not UTF-8 (a UTF-8 byte-order mark is accepted), npz object arrays (never
+unpickled) or arrays whose declared size exceeds the memory limit (checked before inflating).
+Text is read bounded (:mod:`uasnav.limits`, ``UASNAV_MAX_MEMORY``). Corrupt binary logs
+(DataFlash, ULog without checksums; ``.tlog`` checksum failures) are read as far as they are
+valid: the decoders' own output is silenced, corrupt records are dropped and counted, one
+:class:`~uasnav.errors.CorruptDataWarning` gives the counts, and a reader fails only when nothing
+valid is left.
 """
 
 from __future__ import annotations
@@ -32,7 +42,7 @@ import os
 from pathlib import Path
 
 from uasnav.errors import DataFormatError, InputError
-from uasnav.imu import ImuLog
+from uasnav.imu import ImuLog, require_log
 from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.io.dataflash import read_dataflash, read_dataflash_flight, read_dataflash_messages
 from uasnav.io.flight import FlightLog, read_flight_csv
@@ -53,12 +63,15 @@ def read_log(path: str | os.PathLike[str]) -> ImuLog:
     suffix = p.suffix.lower()
     if suffix in (".csv", ".txt"):
         try:
-            with open(p, encoding="utf-8-sig") as fh:
-                first = fh.readline()
+            with open(p, "rb") as fh:
+                # the layout is told by the header's start: a bounded peek, whatever the file
+                first = fh.readline(4096).decode("utf-8", errors="replace")
         except FileNotFoundError:
             raise DataFormatError("no such file", path=str(p)) from None
-        except UnicodeDecodeError:
-            return read_csv_v1(p)  # reports the decoding error with its position
+        except IsADirectoryError:
+            raise DataFormatError("is a directory, not a file", path=str(p)) from None
+        except OSError as e:
+            raise DataFormatError(f"cannot read ({e.strerror or e})", path=str(p)) from None
         return read_xio_csv(p) if is_xio_csv(first) else read_csv_v1(p)
     if suffix == ".npz":
         return read_npz(p)
@@ -79,13 +92,15 @@ def read_flight(path: str | os.PathLike[str]) -> FlightLog:
     Raises
     ------
     InputError
-        If ``path`` is not a file or has another extension.
+        If ``path`` does not exist, is not a regular file or has another extension.
     DataFormatError
         If the file is malformed (names the file, and the line and column for CSV).
     """
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise InputError(f"no such telemetry file: {p}")
+    if not p.is_file():
+        raise InputError(f"{p}: not a regular file (a directory, device or FIFO)")
     ext = p.suffix.lower()
     if ext == ".csv":
         return read_flight_csv(p)
@@ -100,6 +115,7 @@ def read_flight(path: str | os.PathLike[str]) -> FlightLog:
 
 def write_log(log: ImuLog, path: str | os.PathLike[str]) -> None:
     """Write ``log`` atomically; ``.csv`` → CSV v1 (with truth columns), ``.npz``."""
+    require_log(log)
     p = Path(path)
     suffix = p.suffix.lower()
     if suffix == ".csv":

@@ -2,15 +2,19 @@
 
 One error handling for both formats: a missing file, a file pymavlink cannot open and a
 message it cannot decode are each a :class:`~uasnav.errors.DataFormatError` naming the file.
+What pymavlink prints about a corrupt log (one line per bad byte of a DataFlash log) is
+silenced (:mod:`uasnav.io._quiet`); the readers report its statistics in one line.
 """
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 from uasnav.errors import DataFormatError
+from uasnav.io._quiet import LibraryOutput, library_output_captured
 
 
 def connect(p: Path, **kw: Any) -> Any:
@@ -19,16 +23,57 @@ def connect(p: Path, **kw: Any) -> Any:
     Raises
     ------
     DataFormatError
-        If ``p`` is not a file or pymavlink cannot open it.
+        If ``p`` is not a regular file or pymavlink cannot open it.
     """
     from pymavlink import mavutil
 
-    if not p.is_file():
+    if not p.exists():
         raise DataFormatError("no such file", path=str(p))
+    if not p.is_file():
+        # a device or FIFO: pymavlink would map or block on it
+        raise DataFormatError("not a regular file", path=str(p))
     try:
         return mavutil.mavlink_connection(str(p), **kw)
     except Exception as e:  # pymavlink raises many exception types on bad input
         raise DataFormatError(f"not readable by pymavlink ({type(e).__name__}: {e})", path=str(p)) from None
+
+
+@contextlib.contextmanager
+def reading(p: Path, **kw: Any) -> Iterator[tuple[Any, LibraryOutput]]:
+    """``(connection, decoder output)`` for reading ``p``, with pymavlink's printing captured.
+
+    The :class:`LibraryOutput` is complete only after the block: report it (and issue any
+    warning) *after* leaving the block, since output inside it is swallowed. The connection
+    is closed on exit; pymavlink's statistics of a corrupt log are noted (:func:`_note_corruption`).
+    """
+    conn = None
+    with library_output_captured() as out:
+        try:
+            conn = connect(p, **kw)
+            yield conn, out
+        finally:
+            if conn is not None:
+                _note_corruption(conn, out)
+                with contextlib.suppress(Exception):  # closing a half-read log cannot fail usefully
+                    conn.close()
+
+
+def _note_corruption(conn: Any, out: LibraryOutput) -> None:
+    """Add pymavlink's own statistics of a corrupt log to ``out``: checksum failures of a
+    ``.tlog``; for a DataFlash log, the bytes its index did not cover (bad bytes, and all bytes
+    after a record of unknown type, where pymavlink stops indexing)."""
+    mav = getattr(conn, "mav", None)
+    errors = int(getattr(mav, "total_receive_errors", 0) or 0)
+    if errors:
+        out.note(f"{errors} MAVLink message(s) failed their checksum")
+    counts, formats = getattr(conn, "counts", None), getattr(conn, "formats", None)
+    size = getattr(conn, "data_len", None)
+    if counts is not None and formats is not None and size:
+        with contextlib.suppress(Exception):  # statistics only: never fail a read over them
+            decoded = sum(c * formats[t].len for t, c in enumerate(counts) if c and t in formats)
+            bad = int(size) - int(decoded)
+            if bad > 0:
+                out.note(f"{bad} of {size} bytes could not be decoded ({100.0 * bad / size:.1f} %)")
 
 
 def messages(conn: Any, types: Sequence[str], p: Path, what: str) -> Iterator[Any]:
@@ -52,4 +97,4 @@ def messages(conn: Any, types: Sequence[str], p: Path, what: str) -> Iterator[An
         yield msg
 
 
-__all__ = ["connect", "messages"]
+__all__ = ["connect", "messages", "reading"]

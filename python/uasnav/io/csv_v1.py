@@ -24,8 +24,6 @@ column. Numbers are written with 17 significant digits, so write → read round-
 
 from __future__ import annotations
 
-import csv
-import io
 import os
 import re
 from collections.abc import Mapping
@@ -36,7 +34,8 @@ from numpy.typing import ArrayLike
 
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
-from uasnav.imu import ImuLog
+from uasnav.imu import ImuLog, require_log
+from uasnav.io._text import csv_rows, read_text, show_cell, split_lines
 from uasnav.io.table import as_column, write_rows
 
 REQUIRED = ("t", "gx", "gy", "gz", "ax", "ay", "az")
@@ -49,22 +48,22 @@ def read_csv_v1(path: str | os.PathLike[str]) -> ImuLog:
     Raises
     ------
     DataFormatError
-        On a missing file or required column, a non-numeric or non-finite cell, or
-        non-increasing time; the message names the file, line and column.
+        On a missing file or required column, a non-numeric or non-finite cell,
+        non-increasing time, malformed CSV (a stray ``"``, a cell over 128 KiB) or text that is
+        not UTF-8 or holds NUL bytes; the message names the file, line and column. A UTF-8
+        byte-order mark is accepted.
+    ResourceLimitError
+        If the file is larger than the memory limit allows (see :mod:`uasnav.io._text`).
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DataFormatError("no such file", path=str(p)) from None
-    except UnicodeDecodeError as e:
-        raise DataFormatError(f"not a UTF-8 text file ({e.reason})", path=str(p)) from None
-    return parse_csv_v1(text, source=str(p))
+    return parse_csv_v1(read_text(p), source=str(p))
 
 
 def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
     """Parse CSV v1 text (see :func:`read_csv_v1`)."""
-    lines = text.splitlines()
+    if not isinstance(text, str):
+        raise InputError(f"text: expected the CSV text as str, got {type(text).__name__}")
+    lines = split_lines(text.removeprefix("\ufeff"))
     meta: dict[str, str] = {}
     i = 0
     while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
@@ -74,9 +73,11 @@ def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
         i += 1
     if i >= len(lines):
         raise DataFormatError("empty file (no header row)", path=source)
-    header_line = i + 1
-    reader = csv.reader(io.StringIO("\n".join(lines[i:])))
-    header = [h.strip() for h in next(reader)]
+    first = next(csv_rows(lines, i, source), None)
+    if first is None:
+        raise DataFormatError("empty file (no header row)", path=source)
+    header_line = first[0]
+    header = [h.strip() for h in first[1]]
     missing = [c for c in REQUIRED if c not in header]
     if missing:
         raise DataFormatError(
@@ -92,10 +93,8 @@ def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
     wanted = list(REQUIRED) + optional + truth_cols
     idx = [header.index(c) for c in wanted]
     rows: list[list[float]] = []
-    for k, row in enumerate(reader):
-        line_no = header_line + 1 + k
-        if not row or all(not c.strip() for c in row):
-            continue
+    row_lines: list[int] = []
+    for line_no, row in csv_rows(lines, header_line, source, header):
         if len(row) != len(header):
             raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=source, line=line_no)
         vals = []
@@ -105,12 +104,15 @@ def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
                 v = float(cell)
             except ValueError:
                 raise DataFormatError(
-                    f"not a number: {cell!r}", path=source, line=line_no, column=c
+                    f"not a number: {show_cell(cell)}", path=source, line=line_no, column=c
                 ) from None
             if not np.isfinite(v):
-                raise DataFormatError(f"non-finite value {cell!r}", path=source, line=line_no, column=c)
+                raise DataFormatError(
+                    f"non-finite value {show_cell(cell)}", path=source, line=line_no, column=c
+                )
             vals.append(v)
         rows.append(vals)
+        row_lines.append(line_no)
     if len(rows) < 2:
         raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
     data = np.array(rows, dtype=np.float64)
@@ -122,9 +124,9 @@ def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
         r = int(bad[0]) + 1
         kind = "duplicated" if d[bad[0]] == 0 else "decreasing"
         raise DataFormatError(
-            f"{kind} time stamp ({t[r - 1]!r} then {t[r]!r}); t must be strictly increasing",
+            f"{kind} time stamp ({float(t[r - 1])!r} then {float(t[r])!r}); t must be strictly increasing",
             path=source,
-            line=_data_line(lines, header_line, r),
+            line=row_lines[r],
             column="t",
         )
     truth = _group_truth(truth_cols, col)
@@ -137,17 +139,6 @@ def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
         truth=truth,
         meta={**meta, "source": source, "format": "csv-v1"},
     )
-
-
-def _data_line(lines: list[str], header_line: int, row: int) -> int:
-    """File line number of data row ``row`` (0-based), skipping blank lines."""
-    count = -1
-    for ln in range(header_line, len(lines)):
-        if lines[ln].strip():
-            count += 1
-            if count == row:
-                return ln + 1
-    return header_line + 1 + row
 
 
 def _group_truth(cols: list[str], col: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -202,6 +193,7 @@ def write_csv_v1(
         An extra column that is not 1-D numeric with one value per sample, is infinite, or
         whose name is already a column.
     """
+    require_log(log)
     cols: list[tuple[str, np.ndarray]] = [("t", log.t)]
     cols += [(f"g{a}", log.gyro[:, j]) for j, a in enumerate(_AXES)]
     cols += [(f"a{a}", log.accel[:, j]) for j, a in enumerate(_AXES)]

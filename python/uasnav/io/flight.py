@@ -15,19 +15,23 @@ extension reader                                      messages
 ========= =========================================== =============================================
 
 This module imports no format reader (they import it), so it cannot close an import circle.
+The flight readers of binary logs salvage what is valid from a corrupt log (see
+:func:`valid_fixes`).
 """
 
 from __future__ import annotations
 
-import csv
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import DataFormatError, InputError
+from uasnav.io._common import nothing_valid, report_corruption, salvage
+from uasnav.io._quiet import LibraryOutput
+from uasnav.io._text import csv_rows, read_text, show_cell, split_lines
 
 FloatArray = NDArray[np.float64]
 
@@ -41,8 +45,9 @@ _SAMPLE_FIELDS = ("t", "lat", "lon", "alt", "vel_ned")
 class FlightLog:
     """Telemetry of one log.
 
-    The constructor sorts the samples by time and drops repeated time stamps (the first sample
-    of each time stamp is kept), so ``t`` is strictly increasing.
+    The constructor checks shapes and finiteness (:class:`~uasnav.errors.InputError` naming the
+    field and sample), sorts the samples by time and drops repeated time stamps (the first
+    sample of each time stamp is kept), so ``t`` is strictly increasing.
 
     Attributes
     ----------
@@ -76,14 +81,52 @@ class FlightLog:
     source: str = ""
 
     def __post_init__(self) -> None:
-        n = np.asarray(self.t).size
+        src = self.source or "flight log"
+        arrays: dict[str, FloatArray] = {}
+        for k in _SAMPLE_FIELDS:
+            try:
+                arrays[k] = np.asarray(getattr(self, k), dtype=np.float64)
+            except (TypeError, ValueError):
+                raise InputError(f"{src}: {k} is not numeric ({type(getattr(self, k)).__name__})") from None
+        n = arrays["t"].size
         if n < 2:
-            raise InputError(f"{self.source}: fewer than 2 position samples")
-        order = np.argsort(self.t, kind="stable")
-        arrays = {k: np.asarray(getattr(self, k), dtype=float)[order] for k in _SAMPLE_FIELDS}
+            raise InputError(f"{src}: fewer than 2 position samples")
+        for k, a in arrays.items():
+            want = (n, 3) if k == "vel_ned" else (n,)
+            if a.shape != want:
+                raise InputError(f"{src}: {k} has shape {a.shape}, expected {want}")
+            bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(n, -1)), axis=1))
+            if bad.size:
+                raise InputError(f"{src}: non-finite {k} at sample {int(bad[0])}")
+        order = np.argsort(arrays["t"], kind="stable")
+        arrays = {k: a[order] for k, a in arrays.items()}
         keep = np.concatenate([[True], np.diff(arrays["t"]) > 0])
         for k, a in arrays.items():
             object.__setattr__(self, k, a[keep])
+        if not isinstance(self.waypoints, Mapping):
+            raise InputError(
+                f"{src}: waypoints must map seq → (lat, lon, alt), got {type(self.waypoints).__name__}"
+            )
+        for seq, wp in self.waypoints.items():
+            try:
+                wpa = np.asarray(wp, dtype=np.float64)
+            except (TypeError, ValueError):
+                wpa = np.full(1, np.nan)
+            if wpa.shape != (3,) or not np.all(np.isfinite(wpa)):
+                raise InputError(f"{src}: waypoint {seq} is not a finite (lat, lon, alt): {wp}")
+        if self.wind_ne is not None:
+            try:
+                w = np.asarray(self.wind_ne, dtype=np.float64)
+            except (TypeError, ValueError):
+                w = np.full(1, np.nan)
+            if w.shape != (2,) or not np.all(np.isfinite(w)):
+                raise InputError(f"{src}: wind_ne must be a finite (north, east) pair, got {self.wind_ne!r}")
+            object.__setattr__(self, "wind_ne", w)
+        if self.cruise_ms is not None:
+            ok = isinstance(self.cruise_ms, int | float | np.number) and not isinstance(self.cruise_ms, bool)
+            if not (ok and np.isfinite(self.cruise_ms) and self.cruise_ms >= 0):
+                shown = float(self.cruise_ms) if ok else self.cruise_ms
+                raise InputError(f"{src}: cruise speed must be a finite number ≥ 0 m/s, got {shown!r}")
 
 
 def wind_from(speed_ms: float, from_deg: float) -> FloatArray:
@@ -108,39 +151,67 @@ def wind_from(speed_ms: float, from_deg: float) -> FloatArray:
     return np.array([speed_ms * np.cos(to), speed_ms * np.sin(to)])
 
 
+#: Bounds of a plausible position fix (deg, deg, m, m/s); a fix outside is a corrupt record.
+FIX_LIMITS = {"lat": (-90.0, 90.0), "lon": (-180.0, 180.0), "alt": (-1e3, 1e5), "vel": (-1e3, 1e3)}
+
+
+def valid_fixes(a: FloatArray) -> NDArray[np.bool_]:
+    """Mask of the valid rows of fixes ``(t, lat, lon, alt, v_N, v_E, v_D)`` (k, 7) of a log
+    without checksums: finite, within :data:`FIX_LIMITS`, and in time order (the longest run
+    of rows in time order is kept; see :func:`uasnav.io._common.salvage`)."""
+    return salvage(
+        a[:, 0],
+        {"lat": a[:, 1], "lon": a[:, 2], "alt": a[:, 3], "vel": a[:, 4:7]},
+        FIX_LIMITS,
+    )
+
+
 def flight_from_fixes(
-    fixes: Sequence[tuple[float, ...]],
+    fixes: Sequence[tuple[float, ...]] | FloatArray,
     path: str | os.PathLike[str],
     *,
     waypoints: dict[int, tuple[float, float, float]],
     reached: list[tuple[float, int]],
     wind: Sequence[FloatArray | tuple[float, float]],
     cruise_ms: float | None = None,
+    decoder: LibraryOutput | None = None,
 ) -> FlightLog:
-    """A :class:`FlightLog` from position fixes ``(t, lat, lon, alt, v_N, v_E, v_D)`` and events.
+    """A :class:`FlightLog` from position fixes ``(t, lat, lon, alt, v_N, v_E, v_D)`` (rows of a
+    sequence or an array (k, 7)) and events.
 
     ``wind`` holds the log's wind estimates (north, east; m/s): their mean becomes ``wind_ne``.
+    Corrupt fixes (:func:`valid_fixes`) are dropped; if any were, or the ``decoder`` reported
+    problems, one :class:`~uasnav.errors.CorruptDataWarning` says so.
 
     Raises
     ------
     DataFormatError
-        If there is no fix.
+        If there is no fix, or fewer than 2 valid ones.
     """
-    if not fixes:
-        raise DataFormatError("no position fixes", path=str(path))
+    src = str(path)
+    if len(fixes) == 0:
+        raise DataFormatError("no position fixes", path=src)
     a = np.array(fixes, dtype=np.float64)
-    return FlightLog(
-        t=a[:, 0],
-        lat=a[:, 1],
-        lon=a[:, 2],
-        alt=a[:, 3],
-        vel_ned=a[:, 4:7],
-        waypoints=waypoints,
-        reached=sorted(reached),
-        wind_ne=np.mean(np.asarray(wind, dtype=np.float64), axis=0) if wind else None,
-        cruise_ms=cruise_ms,
-        source=str(path),
-    )
+    keep = valid_fixes(a)
+    if keep.sum() < 2:
+        raise nothing_valid(src, "position fix", a.shape[0], decoder)
+    report_corruption(src, decoder, int((~keep).sum()), a.shape[0], "position fix")
+    a = a[keep]
+    try:
+        return FlightLog(
+            t=a[:, 0],
+            lat=a[:, 1],
+            lon=a[:, 2],
+            alt=a[:, 3],
+            vel_ned=a[:, 4:7],
+            waypoints=waypoints,
+            reached=sorted(reached),
+            wind_ne=np.mean(np.asarray(wind, dtype=np.float64), axis=0) if wind else None,
+            cruise_ms=cruise_ms,
+            source=src,
+        )
+    except InputError as e:
+        raise DataFormatError(str(e).removeprefix(f"{src}: "), path=src) from None
 
 
 def read_flight_csv(path: str | os.PathLike[str]) -> FlightLog:
@@ -151,35 +222,65 @@ def read_flight_csv(path: str | os.PathLike[str]) -> FlightLog:
     Raises
     ------
     DataFormatError
-        Empty file, missing column, a non-numeric or non-finite cell (names line and column).
+        Empty file, missing column, fewer than 2 rows, a non-numeric, missing or non-finite
+        cell, a latitude/longitude/altitude outside :data:`FIX_LIMITS`, malformed CSV or text
+        that is not UTF-8 (names line and column).
     """
-    with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
-    if not rows:
-        raise DataFormatError("empty file", path=str(path))
-    head = [h.strip() for h in rows[0]]
+    source = str(path)
+    lines = split_lines(read_text(path))
+    first = next(csv_rows(lines, 0, source), None)
+    if first is None:
+        raise DataFormatError("empty file", path=source)
+    header_line, cells = first
+    head = [h.strip() for h in cells]
     missing = [c for c in FLIGHT_CSV_COLUMNS if c not in head]
     if missing:
         raise DataFormatError(
-            f"missing column(s) {missing}; need {FLIGHT_CSV_COLUMNS}", path=str(path), line=1
+            f"missing column(s) {missing}; need {FLIGHT_CSV_COLUMNS}", path=source, line=header_line
         )
     idx = [head.index(c) for c in FLIGHT_CSV_COLUMNS]
-    data = np.empty((len(rows) - 1, len(FLIGHT_CSV_COLUMNS)))
-    for i, r in enumerate(rows[1:]):
-        for j, k in enumerate(idx):
+    rows: list[list[float]] = []
+    row_lines: list[int] = []
+    for line, r in csv_rows(lines, header_line, source, head):
+        vals = []
+        for name, k in zip(FLIGHT_CSV_COLUMNS, idx, strict=True):
+            if k >= len(r):
+                raise DataFormatError(f"missing cell (row has {len(r)})", path=source, line=line, column=name)
             try:
-                data[i, j] = float(r[k])
-            except (ValueError, IndexError):
+                v = float(r[k])
+            except ValueError:
                 raise DataFormatError(
-                    "not a number", path=str(path), line=i + 2, column=FLIGHT_CSV_COLUMNS[j]
+                    f"not a number: {show_cell(r[k])}", path=source, line=line, column=name
                 ) from None
-    bad = ~np.isfinite(data)
-    if bad.any():
-        i, j = np.argwhere(bad)[0]
-        raise DataFormatError("NaN/inf", path=str(path), line=int(i) + 2, column=FLIGHT_CSV_COLUMNS[j])
+            if not np.isfinite(v):
+                raise DataFormatError(f"NaN/inf: {show_cell(r[k])}", path=source, line=line, column=name)
+            vals.append(v)
+        rows.append(vals)
+        row_lines.append(line)
+    if len(rows) < 2:
+        raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
+    data = np.array(rows, dtype=np.float64)
+    for j, name in enumerate(FLIGHT_CSV_COLUMNS[1:4], start=1):
+        lo, hi = FIX_LIMITS[name]
+        out = np.flatnonzero((data[:, j] < lo) | (data[:, j] > hi))
+        if out.size:
+            raise DataFormatError(
+                f"{float(data[out[0], j])!r} is outside [{lo:g}, {hi:g}]",
+                path=source,
+                line=row_lines[out[0]],
+                column=name,
+            )
     return FlightLog(
         t=data[:, 0], lat=data[:, 1], lon=data[:, 2], alt=data[:, 3], vel_ned=data[:, 4:7], source=str(path)
     )
 
 
-__all__ = ["FLIGHT_CSV_COLUMNS", "FlightLog", "flight_from_fixes", "read_flight_csv", "wind_from"]
+__all__ = [
+    "FIX_LIMITS",
+    "FLIGHT_CSV_COLUMNS",
+    "FlightLog",
+    "flight_from_fixes",
+    "read_flight_csv",
+    "valid_fixes",
+    "wind_from",
+]

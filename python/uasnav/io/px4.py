@@ -13,7 +13,9 @@ the ``mission_result`` reached sequence numbers and ``wind_estimate``. PX4 logs 
 waypoint coordinates (the mission lives in dataman), so ``waypoints`` stays empty.
 
 Errors: a missing file or one pyulog cannot parse is a :class:`~uasnav.errors.DataFormatError`
-naming the file.
+naming the file. ULog records carry no checksum: the readers drop corrupt records (time out of
+order, non-finite or implausible values), silence pyulog's notices (it prints them to stdout)
+and warn once with the counts (:class:`~uasnav.errors.CorruptDataWarning`).
 """
 
 from __future__ import annotations
@@ -26,8 +28,22 @@ import numpy as np
 
 from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
-from uasnav.io._common import build_log
-from uasnav.io.flight import FlightLog
+from uasnav.io._common import (
+    TEMP_RANGE_C,
+    build_log,
+    corruption_meta,
+    imu_limits,
+    nothing_valid,
+    report_corruption,
+    salvage,
+)
+from uasnav.io._quiet import LibraryOutput, library_output_captured
+from uasnav.io.flight import FlightLog, flight_from_fixes
+
+#: |magnetic field| above which a record is corrupt, µT (sensors saturate near ±5000 µT).
+MAX_MAG_UT = 10_000.0
+#: Wind estimates above this (m/s) are corrupt records.
+MAX_WIND_M_S = 100.0
 
 
 def _dataset(ulog: Any, name: str, multi: int = 0) -> Any | None:
@@ -46,29 +62,77 @@ def _cols(d: Any, stem: str, path: str) -> np.ndarray:
         ) from None
 
 
-def _open(p: Path) -> Any:
-    """The parsed ULog ``p`` (one error handling for both readers)."""
+def _open(p: Path) -> tuple[Any, LibraryOutput]:
+    """The parsed ULog ``p`` and what pyulog printed meanwhile (one error handling for both
+    readers; pyulog prints its corruption notices to stdout, which must stay clean for
+    ``--json``)."""
     from pyulog import ULog
 
-    if not p.is_file():
+    if not p.exists():
         raise DataFormatError("no such file", path=str(p))
-    try:
-        return ULog(str(p))
-    except Exception as e:  # pyulog raises bare exceptions on corrupt headers
-        raise DataFormatError(f"not a readable ULog ({type(e).__name__}: {e})", path=str(p)) from None
+    if not p.is_file():
+        raise DataFormatError("not a regular file", path=str(p))  # a device or FIFO
+    ulog = None
+    failure: Exception | None = None
+    with library_output_captured() as decoder:
+        try:
+            ulog = ULog(str(p))
+        except Exception as e:  # pyulog raises bare exceptions on corrupt headers
+            failure = e
+    if ulog is None:
+        raise DataFormatError(
+            f"not a readable ULog ({type(failure).__name__}: {failure})", path=str(p)
+        ) from None
+    if getattr(ulog, "file_corruption", False) and not decoder.lines:
+        decoder.note("pyulog detected file corruption")
+    return ulog, decoder
+
+
+def _no_topic(ulog: Any, decoder: LibraryOutput, what: str, sp: str) -> DataFormatError:
+    names = sorted({d.name for d in ulog.data_list})
+    if not names and decoder.problems:
+        return DataFormatError(f"corrupt ULog: no topic could be read ({decoder.summary()})", path=sp)
+    return DataFormatError(f"no {what} topic (topics: {', '.join(names) or 'none'})", path=sp)
+
+
+def _temperature(
+    ulog: Any, sc: Any | None, t: np.ndarray, meta: dict[str, Any]
+) -> tuple[np.ndarray | None, int]:
+    """Temperature (°C) on the IMU time stamps ``t`` (see the module docs), and the number of
+    corrupt temperature records dropped."""
+    lo, hi = TEMP_RANGE_C
+    for name, field in (("sensor_gyro", "temperature"), ("sensor_accel", "temperature")):
+        d = _dataset(ulog, name)
+        if d is not None and field in d.data:
+            temp_t = np.asarray(d.data["timestamp"], dtype=np.float64) * 1e-6
+            temp = np.asarray(d.data[field], dtype=np.float64)
+            keep = salvage(temp_t, {"temp": temp}, {"temp": (lo, hi)})
+            if keep.sum() < 2:
+                continue  # nothing valid: try the next source
+            meta["temperature_source"] = f"{name}.{field}"
+            return np.interp(t, temp_t[keep], temp[keep]), int((~keep).sum())
+    if sc is not None and np.any(np.asarray(sc.data.get("baro_temp_celcius", [0.0])) != 0):
+        # logged as exactly 0 when the barometer did not report: treat as absent
+        meta["temperature_source"] = "sensor_combined.baro_temp_celcius"
+        return np.asarray(sc.data["baro_temp_celcius"], dtype=np.float64), 0
+    return None, 0
 
 
 def read_ulog(path: str | os.PathLike[str]) -> ImuLog:
     """Read the primary IMU of a PX4 ULog (see the module docs for topics and units).
 
+    A corrupt log (ULog records carry no checksum) is read as far as it is valid: records with
+    time out of order, non-finite or implausible values are dropped, pyulog's notices are
+    silenced, and one :class:`~uasnav.errors.CorruptDataWarning` gives the counts (also in
+    ``meta["corrupt_records_dropped"]``, ``meta["corruption"]``).
+
     Raises
     ------
     DataFormatError
-        Missing/unreadable file, no IMU topic, a missing field, a non-finite value or time
-        going backwards.
+        Missing/unreadable file, no IMU topic, a missing field, or fewer than 2 valid records.
     """
     p = Path(path)
-    ulog = _open(p)
+    ulog, decoder = _open(p)
     sp = str(p)
     meta: dict[str, Any] = {"source": sp, "format": "px4-ulog", "frame": "FRD"}
     sc = _dataset(ulog, "sensor_combined")
@@ -83,46 +147,51 @@ def read_ulog(path: str | os.PathLike[str]) -> ImuLog:
     else:
         vi = _dataset(ulog, "vehicle_imu")
         if vi is None:
-            names = sorted({d.name for d in ulog.data_list})
-            raise DataFormatError(
-                f"no sensor_combined or vehicle_imu topic (topics: {', '.join(names)})", path=sp
-            )
+            raise _no_topic(ulog, decoder, "sensor_combined or vehicle_imu", sp)
         t = np.asarray(vi.data["timestamp"], dtype=np.float64) * 1e-6
         dt_a = np.asarray(vi.data["delta_angle_dt"], dtype=np.float64) * 1e-6
         dt_v = np.asarray(vi.data["delta_velocity_dt"], dtype=np.float64) * 1e-6
-        if np.any(dt_a <= 0) or np.any(dt_v <= 0):
-            raise DataFormatError(
-                "vehicle_imu: non-positive integration interval", path=sp, column="vehicle_imu"
-            )
-        gyro = _cols(vi, "delta_angle", sp) / dt_a[:, None]
-        accel = _cols(vi, "delta_velocity", sp) / dt_v[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # a non-positive integration interval is a corrupt record: NaN, dropped below
+            gyro = _cols(vi, "delta_angle", sp) / np.where(dt_a > 0, dt_a, np.nan)[:, None]
+            accel = _cols(vi, "delta_velocity", sp) / np.where(dt_v > 0, dt_v, np.nan)[:, None]
         topic = "vehicle_imu"
-    temp = None
-    for name, field in (("sensor_gyro", "temperature"), ("sensor_accel", "temperature")):
-        d = _dataset(ulog, name)
-        if d is not None and field in d.data:
-            temp_t = np.asarray(d.data["timestamp"], dtype=np.float64) * 1e-6
-            temp = np.interp(t, temp_t, np.asarray(d.data[field], dtype=np.float64))
-            meta["temperature_source"] = f"{name}.{field}"
-            break
-    if temp is None and sc is not None and np.any(np.asarray(sc.data.get("baro_temp_celcius", [0.0])) != 0):
-        # logged as exactly 0 when the barometer did not report: treat as absent
-        temp = np.asarray(sc.data["baro_temp_celcius"], dtype=np.float64)
-        meta["temperature_source"] = "sensor_combined.baro_temp_celcius"
+    values = {"gyro": gyro, "accel": accel}
+    limits = imu_limits(False)
+    if mag is not None:
+        values["mag"] = mag
+        limits["mag"] = (-MAX_MAG_UT, MAX_MAG_UT)
+    keep = salvage(t, values, limits)
+    if keep.sum() < 2:
+        raise nothing_valid(sp, topic, t.size, decoder)
+    dropped = int((~keep).sum())
+    t, gyro, accel = t[keep], gyro[keep], accel[keep]
+    mag = None if mag is None else mag[keep]
+    temp, temp_dropped = _temperature(ulog, sc, t, meta)
+    if temp is not None and temp.shape != t.shape:  # baro_temp_celcius: one per IMU record
+        temp = temp[keep]
+    if temp is not None and not np.all(np.isfinite(temp)):
+        temp, _ = None, meta.pop("temperature_source", None)
+    report_corruption(sp, decoder, dropped + temp_dropped, keep.size, topic)
     meta["topic"] = topic
+    meta.update(corruption_meta(decoder, dropped + temp_dropped))
     return build_log(sp, topic, t, gyro, accel, temp, meta, mag=mag)
 
 
 def read_ulog_flight(path: str | os.PathLike[str]) -> FlightLog:
     """The flight telemetry of a PX4 ULog (see the module docs for the topics).
 
+    Corrupt position records are dropped (:func:`uasnav.io.flight.valid_fixes`; one
+    :class:`~uasnav.errors.CorruptDataWarning` gives the counts).
+
     Raises
     ------
     DataFormatError
-        Missing/unreadable file, or neither vehicle_global_position nor vehicle_gps_position.
+        Missing/unreadable file, neither vehicle_global_position nor vehicle_gps_position, or
+        fewer than 2 valid position records.
     """
     p = Path(path)
-    ulog = _open(p)
+    ulog, decoder = _open(p)
 
     def topic(name: str) -> dict[str, np.ndarray] | None:
         d = _dataset(ulog, name)
@@ -136,7 +205,7 @@ def read_ulog_flight(path: str | os.PathLike[str]) -> FlightLog:
     else:
         g = topic("vehicle_gps_position")
         if g is None:
-            raise DataFormatError("no vehicle_global_position / vehicle_gps_position topic", path=str(p))
+            raise _no_topic(ulog, decoder, "vehicle_global_position / vehicle_gps_position", str(p))
         t = g["timestamp"] * 1e-6
         lat, lon, alt = g["lat"] * 1e-7, g["lon"] * 1e-7, g["alt"] * 1e-3
         vel = np.column_stack([g["vel_n_m_s"], g["vel_e_m_s"], g["vel_d_m_s"]])
@@ -149,10 +218,15 @@ def read_ulog_flight(path: str | os.PathLike[str]) -> FlightLog:
                 reached.append((ts * 1e-6, int(s)))
             last = s
     w = topic("wind_estimate")
-    wind = np.array([w["windspeed_north"].mean(), w["windspeed_east"].mean()]) if w is not None else None
-    return FlightLog(
-        t=t, lat=lat, lon=lon, alt=alt, vel_ned=vel, reached=reached, wind_ne=wind, source=str(p)
-    )
+    wind = []
+    if w is not None:
+        wn = np.asarray(w["windspeed_north"], dtype=np.float64)
+        we = np.asarray(w["windspeed_east"], dtype=np.float64)
+        ok = np.isfinite(wn) & np.isfinite(we) & (np.hypot(wn, we) <= MAX_WIND_M_S)
+        if ok.any():
+            wind = [(wn[ok].mean(), we[ok].mean())]
+    fixes = np.column_stack([t, lat, lon, alt, vel]).astype(np.float64)
+    return flight_from_fixes(fixes, p, waypoints={}, reached=reached, wind=wind, decoder=decoder)
 
 
 __all__ = ["read_ulog", "read_ulog_flight"]

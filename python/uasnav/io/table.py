@@ -14,8 +14,6 @@ rename): on an error nothing is left behind and an existing file is untouched.
 
 from __future__ import annotations
 
-import csv
-import io
 import os
 import re
 from collections.abc import Mapping
@@ -27,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
+from uasnav.io._text import csv_rows, read_text, show_cell, split_lines
 
 _KEY = re.compile(r"[\w.-]+")
 _COMMENT = re.compile(r"#\s*([\w.-]+)\s*:\s*(.*)$")
@@ -131,15 +130,13 @@ def read_csv_table(path: str | os.PathLike[str]) -> tuple[dict[str, NDArray[np.f
     Raises
     ------
     DataFormatError
-        Missing file, no header, duplicated column name, a row of the wrong width or a cell that
-        is not a number (names the line and column).
+        Missing file, no header, duplicated column name, a row of the wrong width, a cell that
+        is not a number or is infinite, malformed CSV or text that is not UTF-8 (names the line
+        and column).
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DataFormatError("no such file", path=str(p)) from None
-    lines = text.splitlines()
+    source = str(p)
+    lines = split_lines(read_text(p))
     comments: dict[str, str] = {}
     i = 0
     while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
@@ -147,27 +144,30 @@ def read_csv_table(path: str | os.PathLike[str]) -> tuple[dict[str, NDArray[np.f
         if m:
             comments[m.group(1)] = m.group(2).strip()
         i += 1
-    if i >= len(lines):
-        raise DataFormatError("empty file (no header row)", path=str(p))
-    reader = csv.reader(io.StringIO("\n".join(lines[i:])))
-    header = [h.strip() for h in next(reader)]
+    first = next(csv_rows(lines, i, source), None)
+    if first is None:
+        raise DataFormatError("empty file (no header row)", path=source)
+    header_line, cells = first
+    header = [h.strip() for h in cells]
     if len(set(header)) != len(header):
-        raise DataFormatError(f"duplicated column name in {header}", path=str(p), line=i + 1)
+        raise DataFormatError(f"duplicated column name in {header}", path=source, line=header_line)
     rows: list[list[float]] = []
-    for k, row in enumerate(reader):
-        line = i + 2 + k
-        if not row:
-            continue
+    for line, row in csv_rows(lines, header_line, source, header):
         if len(row) != len(header):
-            raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=str(p), line=line)
+            raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=source, line=line)
         vals = []
         for name, cell in zip(header, row, strict=True):
             try:
-                vals.append(float(cell))
+                v = float(cell)
             except ValueError:
                 raise DataFormatError(
-                    f"not a number: {cell!r}", path=str(p), line=line, column=name
+                    f"not a number: {show_cell(cell)}", path=source, line=line, column=name
                 ) from None
+            if np.isinf(v):  # the writer refuses ±inf; NaN is a missing value
+                raise DataFormatError(
+                    f"infinite value {show_cell(cell)}", path=source, line=line, column=name
+                )
+            vals.append(v)
         rows.append(vals)
     data = np.array(rows, dtype=np.float64).reshape(len(rows), len(header))
     return {name: data[:, j].copy() for j, name in enumerate(header)}, comments

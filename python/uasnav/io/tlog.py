@@ -11,7 +11,11 @@ Flight (:func:`read_tlog_flight`): ``GLOBAL_POSITION_INT``, ``MISSION_ITEM(_INT)
 ``DO_CHANGE_SPEED`` mission items; times are the log's wall clock (s).
 
 Errors: a missing or unreadable file and an undecodable message are a
-:class:`~uasnav.errors.DataFormatError` naming the file.
+:class:`~uasnav.errors.DataFormatError` naming the file. Corrupt messages fail their MAVLink
+checksum and are dropped by pymavlink; the readers count them and warn once
+(:class:`~uasnav.errors.CorruptDataWarning`). The 8-byte time stamp that a ``.tlog`` puts before
+each message has no checksum: fixes whose time stamp is out of order are dropped too
+(:func:`uasnav.io.flight.valid_fixes`).
 """
 
 from __future__ import annotations
@@ -23,8 +27,8 @@ import numpy as np
 
 from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
-from uasnav.io._common import build_log
-from uasnav.io._mavlink import connect, messages
+from uasnav.io._common import because, build_log, corruption_meta, report_corruption
+from uasnav.io._mavlink import messages, reading
 from uasnav.io.flight import FlightLog, flight_from_fixes, wind_from
 from uasnav.units import STANDARD_GRAVITY
 
@@ -51,29 +55,40 @@ def read_tlog(path: str | os.PathLike[str]) -> dict[str, ImuLog]:
         Missing/unreadable file, corrupt message, no IMU message, a non-finite value.
     """
     p = Path(path)
-    conn = connect(p, dialect="ardupilotmega")
     rows: dict[str, list[tuple[float, ...]]] = {}
-    for msg in messages(conn, IMU_TYPES, p, "MAVLink"):
-        key = msg.get_type()
-        d = msg.to_dict()
-        t = d["time_usec"] * 1e-6 if "time_usec" in d else d["time_boot_ms"] * 1e-3
-        if key == "HIGHRES_IMU":
-            row = (t, d["xgyro"], d["ygyro"], d["zgyro"], d["xacc"], d["yacc"], d["zacc"], d["temperature"])
-        else:
-            temp = d.get("temperature", 0)
-            row = (
-                t,
-                d["xgyro"] * 1e-3,
-                d["ygyro"] * 1e-3,
-                d["zgyro"] * 1e-3,
-                d["xacc"] * 1e-3 * STANDARD_GRAVITY,
-                d["yacc"] * 1e-3 * STANDARD_GRAVITY,
-                d["zacc"] * 1e-3 * STANDARD_GRAVITY,
-                temp * 0.01 if temp else np.nan,
-            )
-        rows.setdefault(key, []).append(row)
+    with reading(p, dialect="ardupilotmega") as (conn, decoder):
+        for msg in messages(conn, IMU_TYPES, p, "MAVLink"):
+            key = msg.get_type()
+            d = msg.to_dict()
+            t = d["time_usec"] * 1e-6 if "time_usec" in d else d["time_boot_ms"] * 1e-3
+            if key == "HIGHRES_IMU":
+                row = (
+                    t,
+                    d["xgyro"],
+                    d["ygyro"],
+                    d["zgyro"],
+                    d["xacc"],
+                    d["yacc"],
+                    d["zacc"],
+                    d["temperature"],
+                )
+            else:
+                temp = d.get("temperature", 0)
+                row = (
+                    t,
+                    d["xgyro"] * 1e-3,
+                    d["ygyro"] * 1e-3,
+                    d["zgyro"] * 1e-3,
+                    d["xacc"] * 1e-3 * STANDARD_GRAVITY,
+                    d["yacc"] * 1e-3 * STANDARD_GRAVITY,
+                    d["zacc"] * 1e-3 * STANDARD_GRAVITY,
+                    temp * 0.01 if temp else np.nan,
+                )
+            rows.setdefault(key, []).append(row)
     if not rows:
-        raise DataFormatError(f"no IMU messages ({', '.join(IMU_TYPES)})", path=str(p))
+        raise DataFormatError(f"no IMU messages ({', '.join(IMU_TYPES)}){because(decoder)}", path=str(p))
+    # MAVLink messages carry a checksum: corrupt ones were dropped by pymavlink (counted here)
+    report_corruption(str(p), decoder, 0, sum(len(r) for r in rows.values()), "IMU")
     out = {}
     for key in sorted(rows):
         a = np.asarray(rows[key], dtype=np.float64)
@@ -90,6 +105,7 @@ def read_tlog(path: str | os.PathLike[str]) -> dict[str, ImuLog]:
                 "message": key,
                 "boot_segment": k + 1,
                 "frame": "FRD",
+                **corruption_meta(decoder, 0),
             }
             out[name] = build_log(str(p), name, seg[:, 0], seg[:, 1:4], seg[:, 4:7], temp, meta)
     return out
@@ -108,46 +124,54 @@ def read_tlog_flight(path: str | os.PathLike[str]) -> FlightLog:
         Missing/unreadable file, corrupt message, or no GLOBAL_POSITION_INT message.
     """
     p = Path(path)
-    conn = connect(p, dialect="ardupilotmega")
     fixes: list[tuple[float, ...]] = []
     items: dict[int, tuple[int, float, float, float, float]] = {}
     reached: list[tuple[float, int]] = []
     wind = []
     wpnav = None
-    for m in messages(conn, _FLIGHT_TYPES, p, "MAVLink"):
-        kind = m.get_type()
-        if kind == "GLOBAL_POSITION_INT":
-            fixes.append(
-                (
-                    m._timestamp,
-                    m.lat * 1e-7,
-                    m.lon * 1e-7,
-                    m.alt * 1e-3,
-                    m.vx * 0.01,
-                    m.vy * 0.01,
-                    m.vz * 0.01,
+    with reading(p, dialect="ardupilotmega") as (conn, decoder):
+        for m in messages(conn, _FLIGHT_TYPES, p, "MAVLink"):
+            kind = m.get_type()
+            if kind == "GLOBAL_POSITION_INT":
+                fixes.append(
+                    (
+                        m._timestamp,
+                        m.lat * 1e-7,
+                        m.lon * 1e-7,
+                        m.alt * 1e-3,
+                        m.vx * 0.01,
+                        m.vy * 0.01,
+                        m.vz * 0.01,
+                    )
                 )
-            )
-        elif kind in ("MISSION_ITEM_INT", "MISSION_ITEM"):
-            scale = 1e-7 if kind == "MISSION_ITEM_INT" else 1.0
-            items[m.seq] = (m.command, m.x * scale, m.y * scale, m.z, m.param2)
-        elif kind == "MISSION_ITEM_REACHED":
-            reached.append((m._timestamp, int(m.seq)))
-        elif kind == "WIND":
-            wind.append(wind_from(float(m.speed), float(m.direction)))
-        elif kind == "PARAM_VALUE" and m.param_id.rstrip("\x00") == "WPNAV_SPEED":
-            wpnav = float(m.param_value) * 0.01
+            elif kind in ("MISSION_ITEM_INT", "MISSION_ITEM"):
+                scale = 1e-7 if kind == "MISSION_ITEM_INT" else 1.0
+                items[m.seq] = (m.command, m.x * scale, m.y * scale, m.z, m.param2)
+            elif kind == "MISSION_ITEM_REACHED":
+                reached.append((m._timestamp, int(m.seq)))
+            elif kind == "WIND":
+                speed, direction = float(m.speed), float(m.direction)
+                # a wind the autopilot could not estimate (NaN, negative) is no estimate
+                if np.isfinite(speed) and np.isfinite(direction) and speed >= 0:
+                    wind.append(wind_from(speed, direction))
+            elif kind == "PARAM_VALUE" and m.param_id.rstrip("\x00") == "WPNAV_SPEED":
+                value = float(m.param_value) * 0.01
+                wpnav = value if np.isfinite(value) and value > 0 else None
     if not fixes:
-        raise DataFormatError("no GLOBAL_POSITION_INT messages", path=str(p))
+        raise DataFormatError(f"no GLOBAL_POSITION_INT messages{because(decoder)}", path=str(p))
     # seq 0 is the home position on ArduPilot; navigation waypoints carry a position.
     wps = {
         s: (x, y, z)
         for s, (cmd, x, y, z, _) in items.items()
-        if s > 0 and cmd == _MAV_NAV_WAYPOINT and (x != 0 or y != 0)
+        if s > 0 and cmd == _MAV_NAV_WAYPOINT and (x != 0 or y != 0) and np.all(np.isfinite((x, y, z)))
     }
-    speeds = [p2 for s, (cmd, *_, p2) in items.items() if cmd == _MAV_DO_CHANGE_SPEED and p2 > 0]
+    speeds = [
+        p2 for s, (cmd, *_, p2) in items.items() if cmd == _MAV_DO_CHANGE_SPEED and np.isfinite(p2) and p2 > 0
+    ]
     cruise = speeds[0] if speeds else wpnav
-    return flight_from_fixes(fixes, p, waypoints=wps, reached=reached, wind=wind, cruise_ms=cruise)
+    return flight_from_fixes(
+        fixes, p, waypoints=wps, reached=reached, wind=wind, cruise_ms=cruise, decoder=decoder
+    )
 
 
 __all__ = ["IMU_TYPES", "read_tlog", "read_tlog_flight"]

@@ -8,7 +8,6 @@ simulator uses FRD with −g on z) and ``meta["frame"] = "sensor (z up)"`` says 
 
 from __future__ import annotations
 
-import csv
 import os
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import numpy as np
 
 from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
+from uasnav.io._text import csv_rows, read_text, show_cell, split_lines
 from uasnav.units import convert
 
 HEADER_PREFIX = "Time (s)"
@@ -37,40 +37,59 @@ def is_xio_csv(first_line: str) -> bool:
 
 
 def read_xio_csv(path: str | os.PathLike[str]) -> ImuLog:
-    """Read an x-io CSV (see module docs). Errors name the file, line and column."""
+    """Read an x-io CSV (see module docs).
+
+    Raises
+    ------
+    DataFormatError
+        Missing file or column, a non-numeric, missing or non-finite cell, non-increasing time,
+        malformed CSV or text that is not UTF-8 (names the file, line and column).
+    """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise DataFormatError("no such file", path=str(p)) from None
-    rows = list(csv.reader(text.splitlines()))
-    if not rows:
-        raise DataFormatError("empty file", path=str(p))
-    header = [h.strip() for h in rows[0]]
+    source = str(p)
+    lines = split_lines(read_text(p))
+    first = next(csv_rows(lines, 0, source), None)
+    if first is None:
+        raise DataFormatError("empty file", path=source)
+    header_line, cells = first
+    header = [h.strip() for h in cells]
     missing = [c for c in _COLS if c not in header]
     if missing:
-        raise DataFormatError(f"missing column(s) {missing}", path=str(p), line=1, column=missing[0])
+        raise DataFormatError(
+            f"missing column(s) {missing}", path=source, line=header_line, column=missing[0]
+        )
     want = list(_COLS) + [c for c in _MAG if c in header]
     idx = [header.index(c) for c in want]
-    data = np.empty((len(rows) - 1, len(want)))
-    for r, row in enumerate(rows[1:]):
-        for j, (c, i) in enumerate(zip(want, idx, strict=True)):
+    rows: list[list[float]] = []
+    row_lines: list[int] = []
+    for line, row in csv_rows(lines, header_line, source, header):
+        vals = []
+        for c, i in zip(want, idx, strict=True):
+            if i >= len(row):
+                raise DataFormatError(f"missing cell (row has {len(row)})", path=source, line=line, column=c)
+            cell = row[i]
             try:
-                v = float(row[i])
-            except (ValueError, IndexError):
-                cell = row[i] if i < len(row) else "<missing>"
-                raise DataFormatError(f"not a number: {cell!r}", path=str(p), line=r + 2, column=c) from None
+                v = float(cell)
+            except ValueError:
+                raise DataFormatError(
+                    f"not a number: {show_cell(cell)}", path=source, line=line, column=c
+                ) from None
             if not np.isfinite(v):
-                raise DataFormatError(f"non-finite value {row[i]!r}", path=str(p), line=r + 2, column=c)
-            data[r, j] = v
+                raise DataFormatError(f"non-finite value {show_cell(cell)}", path=source, line=line, column=c)
+            vals.append(v)
+        rows.append(vals)
+        row_lines.append(line)
+    if len(rows) < 2:
+        raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
+    data = np.array(rows, dtype=np.float64)
     t = data[:, 0]
     d = np.diff(t)
     if np.any(d <= 0):
         i = int(np.flatnonzero(d <= 0)[0]) + 1
         raise DataFormatError(
-            f"time stamp not increasing ({t[i - 1]!r} then {t[i]!r})",
-            path=str(p),
-            line=i + 2,
+            f"time stamp not increasing ({float(t[i - 1])!r} then {float(t[i])!r})",
+            path=source,
+            line=row_lines[i],
             column="Time (s)",
         )
     mag = data[:, 7:10] if data.shape[1] >= 10 else None

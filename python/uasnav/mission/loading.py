@@ -12,17 +12,25 @@ a document fetched from the network is untrusted input, so parsing is hardened:
 * every document is validated against the XSD shipped in the package for its root element,
   and schema errors name the line and the broken rule.
 
-URL fetches have a timeout, a size limit and an on-disk cache revalidated with HTTP
-conditional requests (``ETag`` / ``Last-Modified``); only documents that passed validation
-are cached, and a cached body is checked against its recorded SHA-256 before use.
+URL fetches have a total deadline (connect + headers + body), follow redirects to http(s)
+only, read at most ``max_bytes + 1`` bytes (local files and devices too), and keep an on-disk
+cache revalidated with HTTP conditional requests (``ETag`` / ``Last-Modified``); only
+documents that passed validation are cached (an unwritable cache only warns), and a cached
+body is checked against its recorded SHA-256 before use.
 """
 
 from __future__ import annotations
 
 import hashlib
+import http.client
 import json
+import math
 import os
+import socket
+import threading
+import time
 import urllib.error
+import urllib.parse
 import urllib.request
 import warnings
 from dataclasses import dataclass
@@ -32,7 +40,8 @@ from pathlib import Path
 from lxml import etree
 
 from uasnav.atomicfile import atomic_write_bytes, atomic_write_text
-from uasnav.errors import DataFormatError, InputError
+from uasnav.errors import DataFormatError, InputError, ResourceLimitError
+from uasnav.limits import read_file_limited, read_limited
 
 #: Largest document accepted (bytes).
 MAX_BYTES = 8 * 1024 * 1024
@@ -175,6 +184,133 @@ class Fetched:
     origin: str
 
 
+def check_timeout(timeout_s: float) -> float:
+    """``timeout_s`` as a float if it is a finite number of seconds > 0, else :class:`InputError`."""
+    try:
+        t = float(timeout_s)
+    except (TypeError, ValueError):
+        raise InputError(f"timeout: expected a number of seconds, got {timeout_s!r}") from None
+    if not (math.isfinite(t) and t > 0):
+        raise InputError(f"timeout: expected a finite number of seconds > 0, got {timeout_s!r}")
+    return t
+
+
+class _Deadline:
+    """A total deadline for one fetch: at expiry every connection it watches is shut down.
+
+    ``socket`` timeouts apply to each read, so a server sending one byte per second never trips
+    them; shutting the socket down from a timer thread wakes any blocked read (connect, status
+    line, headers, body) at the deadline, whatever the server does.
+    """
+
+    def __init__(self, seconds: float) -> None:
+        self.end = time.monotonic() + seconds
+        self.expired = False
+        self._lock = threading.Lock()
+        self._socks: list[socket.socket] = []
+        self._timer = threading.Timer(seconds, self._expire)
+        self._timer.daemon = True
+        self._timer.start()
+
+    def remaining(self) -> float:
+        return max(self.end - time.monotonic(), 1e-3)
+
+    def watch(self, sock: socket.socket | None) -> None:
+        if sock is None:
+            return
+        with self._lock:
+            self._socks.append(sock)
+            if self.expired:
+                self._shut(sock)
+
+    @staticmethod
+    def _shut(sock: socket.socket) -> None:
+        try:
+            sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass  # already closed
+
+    def _expire(self) -> None:
+        with self._lock:
+            self.expired = True
+            for sock in self._socks:
+                self._shut(sock)
+
+    def cancel(self) -> None:
+        self._timer.cancel()
+
+
+def _opener(deadline: _Deadline) -> urllib.request.OpenerDirector:
+    """A urllib opener (proxies from the environment as usual) whose connections obey
+    ``deadline`` and whose redirects go to http(s) only."""
+
+    def watched(base: type[http.client.HTTPConnection]) -> type[http.client.HTTPConnection]:
+        class Conn(base):  # type: ignore[misc, valid-type]
+            def __init__(self, *args: object, **kw: object) -> None:
+                kw["timeout"] = deadline.remaining()  # per operation; the deadline is total
+                super().__init__(*args, **kw)  # type: ignore[arg-type]
+                # Watch the TCP socket as soon as it exists, so that a TLS handshake or a proxy
+                # CONNECT that drips is cut at the deadline too.
+                create = self._create_connection
+
+                def create_watched(*a: object, **k: object) -> socket.socket:
+                    sock = create(*a, **k)
+                    deadline.watch(sock)
+                    return sock
+
+                self._create_connection = create_watched
+
+        return Conn
+
+    http_conn, https_conn = watched(http.client.HTTPConnection), watched(http.client.HTTPSConnection)
+
+    class Http(urllib.request.HTTPHandler):
+        def http_open(self, req):  # type: ignore[no-untyped-def]
+            return self.do_open(http_conn, req)
+
+    class Https(urllib.request.HTTPSHandler):
+        def https_open(self, req):  # type: ignore[no-untyped-def]
+            return self.do_open(https_conn, req, context=self._context)  # type: ignore[attr-defined]
+
+    class Redirect(urllib.request.HTTPRedirectHandler):
+        max_redirections = 5
+
+        def http_error_302(self, req, fp, code, msg, headers):  # type: ignore[no-untyped-def]
+            # urllib follows ftp:// redirects and reports file:// ones as an HTTP error; only
+            # http(s) is promised, so anything else is refused here with its target named.
+            target = headers.get("location") or headers.get("uri") or ""
+            scheme = urllib.parse.urlsplit(urllib.parse.urljoin(req.full_url, target)).scheme.lower()
+            if scheme not in ("http", "https"):
+                fp.close()
+                raise InputError(
+                    f"{req.full_url}: redirect to {target!r} refused (only http:// and https:// are followed)"
+                )
+            return super().http_error_302(req, fp, code, msg, headers)
+
+        http_error_301 = http_error_303 = http_error_307 = http_error_308 = http_error_302
+
+    return urllib.request.build_opener(Http, Https, Redirect)
+
+
+def _one_line(exc: BaseException) -> str:
+    """An exception's text on one line, at most 200 characters (servers send anything)."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+def _download(req: urllib.request.Request, url: str, deadline: _Deadline, max_bytes: int):
+    """GET ``req`` within ``deadline``; returns (body, ETag, Last-Modified)."""
+    with _opener(deadline).open(req, timeout=deadline.remaining()) as resp:
+        length = resp.headers.get("Content-Length")
+        if length is not None and length.strip().isdigit() and int(length) > max_bytes:
+            raise DataFormatError(f"Content-Length {length} exceeds the limit of {max_bytes} bytes", path=url)
+        try:
+            data = read_limited(resp, max_bytes, url)
+        except ResourceLimitError:
+            raise DataFormatError(f"document exceeds the limit of {max_bytes} bytes", path=url) from None
+        return data, resp.headers.get("ETag"), resp.headers.get("Last-Modified")
+
+
 def fetch(
     url: str,
     *,
@@ -184,61 +320,84 @@ def fetch(
     kind: str | None = None,
     offline_fallback: bool = True,
 ) -> Fetched:
-    """Download ``url`` with a timeout, a size limit and a revalidated cache.
+    """Download ``url`` with a total deadline, a size limit and a revalidated cache.
 
-    The body is parsed and schema-validated before it is cached. With ``offline_fallback`` a
-    network failure falls back to a previously validated cached copy (with a warning).
+    ``timeout_s`` bounds the whole exchange (connect, status line, headers, redirects and body),
+    not each socket read. Redirects are followed to http(s) URLs only. The body is read up to
+    ``max_bytes + 1`` bytes, then parsed and schema-validated before it is cached. With
+    ``offline_fallback`` a network failure falls back to a previously validated cached copy
+    (with a warning). A cache directory that cannot be written only warns: the document was
+    fetched and validated, so the load succeeds.
     """
     if not is_url(url):
         raise InputError(f"{url!r}: only http:// and https:// URLs are fetched")
+    timeout_s = check_timeout(timeout_s)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     key = hashlib.sha256(url.encode()).hexdigest()[:32]
     body_path, meta_path = cdir / f"{key}.xml", cdir / f"{key}.json"
     cached: bytes | None = None
     meta: dict = {}
-    if body_path.is_file() and meta_path.is_file():
-        try:
-            meta = json.loads(meta_path.read_text())
-            blob = body_path.read_bytes()
+    try:
+        if body_path.is_file() and meta_path.is_file():
+            meta = json.loads(read_file_limited(meta_path, 1 << 16))
+            blob = read_file_limited(body_path, max_bytes)
             if meta.get("url") == url and hashlib.sha256(blob).hexdigest() == meta.get("sha256"):
                 cached = blob
-        except (OSError, ValueError):
-            cached = None
+    except (OSError, ValueError, AttributeError):  # unreadable, oversize or not a JSON object
+        cached, meta = None, {}
     req = urllib.request.Request(url, headers={"User-Agent": "uasnav-mission", "Accept": "application/xml"})
     if cached is not None:
         if meta.get("etag"):
             req.add_header("If-None-Match", meta["etag"])
         if meta.get("last_modified"):
             req.add_header("If-Modified-Since", meta["last_modified"])
+    deadline = _Deadline(timeout_s)
+    failure: str | None = None
     try:
-        with urllib.request.urlopen(req, timeout=timeout_s) as resp:
-            length = resp.headers.get("Content-Length")
-            if length is not None and length.isdigit() and int(length) > max_bytes:
-                raise DataFormatError(
-                    f"Content-Length {length} exceeds the limit of {max_bytes} bytes", path=url
-                )
-            data = resp.read(max_bytes + 1)
-            if len(data) > max_bytes:
-                raise DataFormatError(f"document exceeds the limit of {max_bytes} bytes", path=url)
-            etag, modified = resp.headers.get("ETag"), resp.headers.get("Last-Modified")
+        data, etag, modified = _download(req, url, deadline, max_bytes)
     except urllib.error.HTTPError as exc:
+        exc.close()
         if exc.code == 304 and cached is not None:
             return Fetched(cached, "revalidated")
-        raise InputError(f"{url}: HTTP {exc.code} {exc.reason}") from None
-    except (urllib.error.URLError, TimeoutError, OSError) as exc:
+        if not deadline.expired:
+            raise InputError(f"{url}: HTTP {exc.code} {_one_line(exc.reason)}") from None
+        failure = f"no complete answer within the timeout of {timeout_s:g} s"
+    except (urllib.error.URLError, http.client.HTTPException, OSError) as exc:
+        if deadline.expired:
+            failure = f"no complete answer within the timeout of {timeout_s:g} s"
+        elif isinstance(exc, http.client.HTTPException) and not isinstance(exc, ConnectionError):
+            failure = f"malformed HTTP response ({type(exc).__name__}: {_one_line(exc)})"
+        else:
+            failure = _one_line(getattr(exc, "reason", None) or exc)
+    finally:
+        deadline.cancel()
+    if failure is None and deadline.expired:
+        # The deadline fired between two reads: what was read may be a truncated body.
+        failure = f"no complete answer within the timeout of {timeout_s:g} s"
+    if failure is not None:
         if offline_fallback and cached is not None:
-            warnings.warn(f"{url}: {exc}; using the cached copy", stacklevel=2)
+            warnings.warn(f"{url}: {failure}; using the cached copy", stacklevel=2)
             return Fetched(cached, "cache-offline")
-        raise InputError(f"{url}: cannot fetch ({exc})") from None
+        raise InputError(f"{url}: cannot fetch ({failure})")
     validate(parse_bytes(data, url, max_bytes=max_bytes), url, kind)
-    cdir.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(body_path, data)
-    atomic_write_text(
-        meta_path,
-        json.dumps(
-            {"url": url, "etag": etag, "last_modified": modified, "sha256": hashlib.sha256(data).hexdigest()}
-        ),
-    )
+    try:
+        cdir.mkdir(parents=True, exist_ok=True)
+        atomic_write_bytes(body_path, data)
+        atomic_write_text(
+            meta_path,
+            json.dumps(
+                {
+                    "url": url,
+                    "etag": etag,
+                    "last_modified": modified,
+                    "sha256": hashlib.sha256(data).hexdigest(),
+                }
+            ),
+        )
+    except OSError as exc:
+        # The document is valid and in hand: a cache that cannot be written costs a refetch
+        # next time, not this load.
+        warnings.warn(f"{url}: not cached in {cdir} ({exc.strerror or exc})", stacklevel=2)
     return Fetched(data, "network")
 
 
@@ -265,15 +424,11 @@ def load_document(
         where, data = str(source), fetch(str(source), kind=kind, **fetch_kw).data
     else:
         where = str(source)
-        try:
-            size = os.path.getsize(source)
-            max_bytes = fetch_kw.get("max_bytes", MAX_BYTES)
-            if size > max_bytes:
-                raise DataFormatError(f"document is {size} bytes, limit is {max_bytes}", path=where)
-            with open(source, "rb") as fh:
-                data = fh.read()
-        except OSError as exc:
-            raise InputError(f"{where}: cannot read ({exc.strerror})") from None
+        if os.path.isdir(source):
+            raise InputError(f"{where}: is a directory, not a document")
+        # The limit is enforced on the bytes read, not on the size the file reports: a device
+        # (/dev/zero), a FIFO or a growing file reports 0 or less than it delivers.
+        data = read_file_limited(source, fetch_kw.get("max_bytes", MAX_BYTES), where)
     tree = parse_bytes(data, where, max_bytes=fetch_kw.get("max_bytes", MAX_BYTES))
     validate(tree, where, kind)
     return tree, where

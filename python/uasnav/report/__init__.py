@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from uasnav.atomicfile import atomic_write_bytes, atomic_write_text
+from uasnav.atomicfile import output_set
 from uasnav.errors import InputError
 from uasnav.jsonable import to_jsonable
 
@@ -77,6 +77,13 @@ class SectionWriter:
         cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
         self.blocks.append(f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
         return self
+
+    def verdict(self, name: str, v: Any) -> str:
+        """Record a :class:`~uasnav.experiments.verdicts.Verdict` under ``data["verdicts"][name]``
+        (its outcome, rule and inputs, for report.json) and return its sentence, so the text a
+        section prints around a verdict comes from the same numbers as the verdict."""
+        self.data.setdefault("verdicts", {})[name] = v.to_dict()
+        return str(v.sentence)
 
     def figure(self, fig: Figure, name: str, caption: str = "") -> SectionWriter:
         """Embed a matplotlib figure (also saved as ``figures/<key>-<name>.png``)."""
@@ -175,6 +182,7 @@ def build_report(
             )
         sections = [s for s in sections if s.key in set(only)]
     parts, data, seconds = [], {}, {}
+    figures: list[tuple[str, bytes]] = []  # written with the html and json, all or nothing
     for i, sec in enumerate(sections, 1):
         say(f"[{i}/{len(sections)}] {sec.title} …")
         w = SectionWriter(key=sec.key, seed=seed, quick=quick, out_dir=out, progress=say)
@@ -183,8 +191,7 @@ def build_report(
         seconds[sec.key] = time.perf_counter() - t0
         say(f"[{i}/{len(sections)}] {sec.title}: done in {seconds[sec.key]:.1f} s")
         data[sec.key] = w.data
-        for name, png in w.figures:
-            atomic_write_bytes(out / "figures" / name, png)
+        figures.extend(w.figures)
         parts.append(
             f'<section id="{sec.key}"><h2>{html.escape(sec.title)}</h2>{"".join(w.blocks)}</section>'
         )
@@ -197,13 +204,14 @@ def build_report(
         f"<ul>{toc}</ul>{''.join(parts)}</body></html>"
     )
     html_path, json_path = out / "report.html", out / "report.json"
-    atomic_write_text(html_path, doc)
-    atomic_write_text(
-        json_path,
-        json.dumps(
-            to_jsonable({"seed": seed, "quick": quick, "sections": data, "seconds": seconds}), indent=2
-        ),
+    report_json = json.dumps(
+        to_jsonable({"seed": seed, "quick": quick, "sections": data, "seconds": seconds}), indent=2
     )
+    with output_set() as files:
+        for name, png in figures:
+            files.write_bytes(out / "figures" / name, png)
+        files.write_text(html_path, doc)
+        files.write_text(json_path, report_json)
     return ReportResult(html_path=html_path, json_path=json_path, data=data, seconds=seconds)
 
 

@@ -34,6 +34,7 @@ from scipy.spatial.transform import Rotation
 from uasnav import earth
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog
+from uasnav.limits import check_memory
 from uasnav.sim.model import SensorModel, ThermalErrorTruth, TriadModel, load_preset
 from uasnav.sim.profiles import TemperatureProfile, named_profile
 
@@ -368,6 +369,34 @@ def _triad(
     return _rows_to_columns(y), _rows_to_columns(bias), thermal
 
 
+#: Peak memory per output sample (bytes) while one sensor is simulated (measured ≈ 225 B
+#: static, more on a rate table), and per sample of each finished log kept in memory (≈ 232 B:
+#: outputs and truth channels). Used to refuse absurd durations before allocating.
+_PEAK_BYTES_PER_SAMPLE = 320
+_KEPT_BYTES_PER_SAMPLE = 240
+
+
+def check_size(duration: float, rate: float, sensors: int = 1) -> None:
+    """Refuse (:class:`~uasnav.errors.ResourceLimitError`) a simulation of ``duration`` s at
+    ``rate`` Hz for ``sensors`` sensors whose memory would exceed the limit of
+    :mod:`uasnav.limits` (``UASNAV_MAX_MEMORY``). Invalid durations and rates are left to the
+    checks that name them (:func:`simulate`)."""
+    try:
+        duration, rate = float(duration), float(rate)
+    except (TypeError, ValueError):
+        return
+    if not (math.isfinite(duration) and duration > 0 and math.isfinite(rate) and rate > 0):
+        return
+    n = duration * rate
+    each = _KEPT_BYTES_PER_SAMPLE * sensors + _PEAK_BYTES_PER_SAMPLE
+    who = f" × {sensors} sensors" if sensors > 1 else ""
+    check_memory(
+        n * each,
+        f"simulate: {n:.3g} samples ({duration:g} s at {rate:g} Hz){who}",
+        option="the duration or the rate",
+    )
+
+
 def simulate_one(
     model: SensorModel,
     *,
@@ -394,6 +423,7 @@ def simulate_one(
     dur = prof.duration if duration is None else float(duration)
     if not (math.isfinite(dur) and dur > 0):
         raise InputError(f"duration: must be a positive number of seconds, got {duration!r}")
+    check_size(dur, rate)
     n = round(dur * rate)
     if n < 2:
         raise InputError(f"duration × rate gives {n} samples; need at least 2")
@@ -576,8 +606,10 @@ def array_mountings(shape: str = "cube", per_face: float = 1) -> list[FloatArray
     """
     from uasnav import redundancy
 
-    if not per_face > 0:
-        raise InputError(f"per_face: must be > 0, got {per_face}")
+    if not (per_face > 0 and math.isfinite(per_face)):
+        raise InputError(f"per_face: must be a finite number > 0, got {per_face!r}")
+    # At most 20 faces, ~1 KiB per mounting: refuse before building 10⁹ matrices.
+    check_memory(per_face * 20 * 1024.0, f"an array of {per_face:g} sensors per face", option="per_face")
     if shape == "planar":
         if per_face != int(per_face):
             raise InputError(f"per_face: a planar array needs a whole number of sensors, got {per_face}")
@@ -630,6 +662,11 @@ def simulate_array(
         shape = "user"
     if not (math.isfinite(mounting_error_rad) and mounting_error_rad >= 0):
         raise InputError(f"mounting_error_rad: must be finite and >= 0, got {mounting_error_rad!r}")
+    # All logs are kept: refuse up front rather than after simulating most of the sensors.
+    duration = kwargs.get("duration")
+    if duration is None:
+        duration = _resolve_profile(model, kwargs.get("profile", "static")).duration
+    check_size(duration, kwargs.get("rate", 100.0), len(mounts))
     seed = int(kwargs.get("seed", 0))
     rng = _rng(seed, 10_000, "array")
     logs = []
@@ -699,6 +736,7 @@ def thermal_bias_derivative(
 __all__ = [
     "ARRAY_SHAPES",
     "array_mountings",
+    "check_size",
     "die_temperature",
     "gauss_markov_sum",
     "random_walk",

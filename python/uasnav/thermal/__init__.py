@@ -31,7 +31,7 @@ from dataclasses import replace
 import numpy as np
 
 from uasnav.errors import InputError
-from uasnav.imu import ImuLog
+from uasnav.imu import ImuLog, require_log
 from uasnav.thermal._common import (
     NotFittedError,
     SelectionResult,
@@ -65,6 +65,7 @@ def apply(model: BiasModel, log: ImuLog) -> ImuLog:
     ``meta["thermal_calibration"]["clipped"]`` and a :class:`TemperatureRangeWarning` is
     issued). Raises :class:`InputError` if the log has no temperature channel.
     """
+    log = require_log(log)
     if log.temp is None:
         raise InputError("apply: the log has no temperature channel (temp is None)")
     with warnings.catch_warnings(record=True) as caught:

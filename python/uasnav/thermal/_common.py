@@ -16,6 +16,16 @@ FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
 
+#: Physical range of a sensor die temperature (°C): training data and model files outside it
+#: are refused. Wider than any IMU's operating range (typically −40…85 °C, −55…125 °C for
+#: military grades) so that only corrupt or mis-scaled values are caught.
+TEMP_MIN_C = -100.0
+TEMP_MAX_C = 200.0
+#: Largest |bias| (rad/s) accepted for training: ≈ 5700 °/s, above the full scale of any MEMS
+#: gyro (±2000 °/s ≈ ±35 rad/s); larger values are corrupt or not in rad/s.
+BIAS_MAX_RADS = 100.0
+
+
 class TemperatureRangeWarning(UserWarning):
     """Temperatures outside a model's calibrated range were clipped to it (never extrapolated)."""
 
@@ -37,17 +47,45 @@ def check_temp(temp: ArrayLike, name: str = "temp") -> FloatArray:
     return t
 
 
+def check_training_temp(temp: ArrayLike, name: str = "temp") -> FloatArray:
+    """Temperatures (n,) °C to train a model on: finite and inside the physical range
+    [:data:`TEMP_MIN_C`, :data:`TEMP_MAX_C`] °C, or :class:`InputError` naming the first bad row.
+
+    A model's calibrated range is the span of its training temperatures; one absurd value
+    (1e308 °C from a corrupt log) would otherwise make a "valid" model over [27, 1e308] °C.
+    """
+    t = check_temp(temp, name)
+    out = np.flatnonzero((t < TEMP_MIN_C) | (t > TEMP_MAX_C))
+    if out.size:
+        i = int(out[0])
+        raise InputError(
+            f"{name}: {t[i]:g} °C at row {i} is outside the physical range "
+            f"[{TEMP_MIN_C:g}, {TEMP_MAX_C:g}] °C of a sensor die temperature "
+            f"({out.size} such row{'s' if out.size > 1 else ''})"
+        )
+    return t
+
+
 def check_fit_data(temp: ArrayLike, bias: ArrayLike, min_samples: int = 4) -> tuple[FloatArray, FloatArray]:
-    """(temp (n,) °C, bias (n, k) rad/s) validated for fitting."""
-    t = check_temp(temp)
+    """(temp (n,) °C, bias (n, k) rad/s) validated for fitting: temperatures finite and physical
+    (:func:`check_training_temp`), biases finite and within ±:data:`BIAS_MAX_RADS` rad/s, at
+    least ``min_samples`` samples, a temperature span > 0."""
+    t = check_training_temp(temp)
     b = np.asarray(bias, dtype=np.float64)
     if b.ndim == 1:
         b = b[:, None]
-    if b.ndim != 2 or b.shape[0] != t.size:
+    if b.ndim != 2 or b.shape[0] != t.size or b.shape[1] == 0:
         raise InputError(f"bias: expected shape ({t.size}, k) matching temp, got {b.shape}")
     bad = np.argwhere(~np.isfinite(b))
     if bad.size:
         raise InputError(f"bias: non-finite value at row {bad[0][0]}, column {bad[0][1]}")
+    big = np.argwhere(np.abs(b) > BIAS_MAX_RADS)
+    if big.size:
+        i, j = int(big[0][0]), int(big[0][1])
+        raise InputError(
+            f"bias: {b[i, j]:g} rad/s at row {i}, column {j} exceeds ±{BIAS_MAX_RADS:g} rad/s "
+            "(beyond any gyro's full scale; is the unit rad/s?)"
+        )
     if t.size < min_samples:
         raise InputError(f"temp: need at least {min_samples} samples to fit, got {t.size}")
     if np.ptp(t) <= 0:

@@ -26,7 +26,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from uasnav.errors import InputError
-from uasnav.thermal._common import FloatArray
+from uasnav.limits import check_count
+from uasnav.thermal._common import FloatArray, check_temp
 
 
 def bin_means(
@@ -50,6 +51,10 @@ def bin_means(
     values_mean : ndarray, shape (m, k)
         Mean values of each non-empty bin (unit of ``values``).
     """
+    # Bin indices renumbered 0…m−1 over the non-empty bins (same order, same sums): memory grows
+    # with the samples, never with the largest index (1e15 from a tiny block length).
+    _, index = np.unique(index, return_inverse=True)
+    index = index.ravel()
     counts = np.bincount(index)
     ok = counts > 0
     tm = np.bincount(index, temp, minlength=counts.size)[ok] / counts[ok]
@@ -82,10 +87,12 @@ def bin_by_temperature(temp: ArrayLike, values: ArrayLike, width_c: float) -> tu
     values_mean : ndarray, shape (m, k)
         Mean values per bin.
     """
-    if not width_c > 0:
+    if not (np.isfinite(width_c) and width_c > 0):
         raise InputError(f"width_c: expected a bin width > 0 °C, got {width_c}")
-    t = np.asarray(temp, dtype=np.float64)
+    t = check_temp(temp)
     v = np.asarray(values, dtype=np.float64)
+    # The edges are allocated: bound their number before (a width of 1e-12 °C would ask for 10¹⁴).
+    check_count(np.ptp(t) / width_c + 2, 8, f"temperature bins of {width_c:g} °C", option="the bin width")
     edges = np.arange(t.min(), t.max() + width_c, width_c)
     idx = np.clip(np.digitize(t, edges) - 1, 0, edges.size - 2)
     return bin_means(idx, t, v)
@@ -119,10 +126,14 @@ def bin_by_time(
     tt = np.asarray(t, dtype=np.float64)
     te = np.asarray(temp, dtype=np.float64)
     v = np.asarray(values, dtype=np.float64)
-    if seconds <= 0:
+    if not np.isfinite(seconds):
+        raise InputError(f"seconds: expected a finite block length (s), got {seconds}")
+    if seconds <= 0 or tt.size == 0:
         return te, v
-    idx = np.floor((tt - tt[0]) / seconds).astype(np.int64)
-    return bin_means(idx, te, v)
+    q = np.floor((tt - tt[0]) / seconds)
+    if not np.isfinite(q).all() or q.max() >= 2.0**62:
+        raise InputError(f"seconds: block length {seconds:g} s is too short for a log of {np.ptp(tt):g} s")
+    return bin_means(q.astype(np.int64), te, v)
 
 
 __all__ = ["bin_by_temperature", "bin_by_time", "bin_means"]

@@ -24,6 +24,7 @@ from typing import Any, Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from uasnav import jsoncheck as jc
 from uasnav.errors import InputError, NumericalError
 from uasnav.thermal._common import (
     BoolArray,
@@ -41,6 +42,9 @@ from uasnav.thermal._common import (
 from uasnav.thermal.base import ModelDict, register_model
 from uasnav.thermal.binning import bin_by_temperature
 from uasnav.thermal.modelfile import dumps_model, save_model
+
+#: Most neurons per hidden layer (the Rust engine's ``MAX_NEURONS``).
+MAX_HIDDEN = 16
 
 
 @dataclass
@@ -79,29 +83,49 @@ class Network:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Network:
-        """Inverse of :meth:`to_dict` (two tanh hidden layers, linear output)."""
-        layers = d["layers"]
-        acts = [layer["activation"] for layer in layers]
-        if acts != ["tanh", "tanh", "linear"]:
-            raise InputError(f"layers: expected activations tanh, tanh, linear, got {acts}")
-        w1 = np.asarray(layers[0]["weights"], dtype=np.float64)
-        w2 = np.asarray(layers[1]["weights"], dtype=np.float64)
-        w3 = np.asarray(layers[2]["weights"], dtype=np.float64)
-        n1, n2 = len(layers[0]["biases"]), len(layers[1]["biases"])
-        if w1.shape != (n1, 1) or w2.shape != (n2, n1) or w3.shape != (1, n2):
-            raise InputError(f"layers: inconsistent weight shapes {w1.shape}, {w2.shape}, {w3.shape}")
+    def from_dict(cls, d: dict[str, Any], path: str = "model") -> Network:
+        """Inverse of :meth:`to_dict` (two tanh hidden layers, linear output), every value
+        checked (:class:`DataFormatError` naming its JSON path under ``path``): finite numbers,
+        normalisation scales > 0, 1…:data:`MAX_HIDDEN` neurons per layer, consistent shapes."""
+        d = jc.only(jc.obj(d, path), ("input_norm", "output_norm", "layers"), path)
+        norms = []
+        for key in ("input_norm", "output_norm"):
+            q = jc.at(path, key)
+            n = jc.only(jc.obj(jc.field(d, key, path), q), ("offset", "scale"), q)
+            norms.append(
+                (
+                    jc.number(jc.field(n, "offset", q), jc.at(q, "offset")),
+                    jc.number(jc.field(n, "scale", q), jc.at(q, "scale"), positive=True),
+                )
+            )
+        lp = jc.at(path, "layers")
+        layers = jc.array(jc.field(d, "layers", path), lp)
+        if len(layers) != 3:
+            raise jc.fail(lp, f"expected 3 layers (tanh, tanh, linear), got {len(layers)}")
+        ws, bs = [], []
+        fan_in = 1
+        for i, (layer, act) in enumerate(zip(layers, ("tanh", "tanh", "linear"), strict=True)):
+            q = jc.at(lp, i)
+            e = jc.only(jc.obj(layer, q), ("activation", "weights", "biases"), q)
+            jc.string(jc.field(e, "activation", q), jc.at(q, "activation"), (act,))
+            top = 1 if i == 2 else MAX_HIDDEN
+            b = jc.vector(jc.field(e, "biases", q), jc.at(q, "biases"), max_len=top)
+            ws.append(jc.matrix(jc.field(e, "weights", q), jc.at(q, "weights"), rows=b.size, cols=fan_in))
+            bs.append(b)
+            fan_in = b.size
+        if bs[2].size != 1:
+            raise jc.fail(jc.at(jc.at(lp, 2), "biases"), f"the output layer has one neuron, got {bs[2].size}")
         return cls(
-            W1=w1[:, 0].copy(),
-            b1=np.asarray(layers[0]["biases"], dtype=np.float64),
-            W2=w2,
-            b2=np.asarray(layers[1]["biases"], dtype=np.float64),
-            w3=w3[0].copy(),
-            b3=float(layers[2]["biases"][0]),
-            in_offset=float(d["input_norm"]["offset"]),
-            in_gain=float(d["input_norm"]["scale"]),
-            out_offset=float(d["output_norm"]["offset"]),
-            out_scale=float(d["output_norm"]["scale"]),
+            W1=ws[0][:, 0].copy(),
+            b1=bs[0],
+            W2=ws[1],
+            b2=bs[1],
+            w3=ws[2][0].copy(),
+            b3=float(bs[2][0]),
+            in_offset=norms[0][0],
+            in_gain=norms[0][1],
+            out_offset=norms[1][0],
+            out_scale=norms[1][1],
         )
 
 
@@ -390,8 +414,23 @@ class NeuralBiasModel:
 
     def fit(self, temp: ArrayLike, bias: ArrayLike) -> NeuralBiasModel:
         """Train one network per axis on temperatures (n,) °C and biases (n, k) rad/s."""
-        if not (isinstance(self.hidden, int | np.integer) and 1 <= self.hidden <= 16):
-            raise InputError(f"hidden: expected an integer in 1…16, got {self.hidden!r}")
+        if not (isinstance(self.hidden, int | np.integer) and 1 <= self.hidden <= MAX_HIDDEN):
+            raise InputError(f"hidden: expected an integer in 1…{MAX_HIDDEN}, got {self.hidden!r}")
+        # Bounds that keep training finite in time (restarts × epochs LM steps per axis).
+        for name, lo, hi in (
+            ("restarts", 1, 100),
+            ("max_epochs", 1, 100_000),
+            ("max_fail", 1, 100_000),
+            ("max_samples", 20, 10_000_000),
+            ("seed", 0, 2**63 - 1),
+        ):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | np.integer) or not lo <= v <= hi:
+                raise InputError(f"{name}: expected an integer in {lo}…{hi}, got {v!r}")
+        if not (np.isfinite(self.derivative_bin_c) and self.derivative_bin_c > 0):
+            raise InputError(f"derivative_bin_c: expected a bin width > 0 °C, got {self.derivative_bin_c}")
+        if self.engine not in ("rust", "numpy"):
+            raise InputError(f"engine: expected 'rust' or 'numpy', got {self.engine!r}")
         t, b = check_fit_data(temp, bias, min_samples=20)
         keep = subsample_uniform(t.size, self.max_samples)
         t, b = t[keep], b[keep]
@@ -486,12 +525,20 @@ class NeuralBiasModel:
 
     @classmethod
     def from_dict(cls, d: ModelDict, range_c: tuple[float, float]) -> NeuralBiasModel:
-        """Inverse of :meth:`to_dict`."""
-        nets = [Network.from_dict(m) for m in d["models"]]
+        """Inverse of :meth:`to_dict`; every network checked by :meth:`Network.from_dict`."""
+        models = jc.array(jc.field(d, "models"), "models")
+        nets = [Network.from_dict(x, jc.at("models", i)) for i, x in enumerate(models)]
         m = cls(hidden=int(nets[0].b1.size))
         m.networks_ = nets
         dm = d.get("derivative_models")
-        m.derivative_networks_ = None if dm is None else [Network.from_dict(x) for x in dm]
+        m.derivative_networks_ = (
+            None
+            if dm is None
+            else [
+                Network.from_dict(x, jc.at("derivative_models", i))
+                for i, x in enumerate(jc.array(dm, "derivative_models"))
+            ]
+        )
         m.range_c_ = (float(range_c[0]), float(range_c[1]))
         m.training_ = []
         m._json = None

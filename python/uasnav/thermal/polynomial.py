@@ -15,8 +15,11 @@ from typing import Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
+from uasnav import jsoncheck as jc
 from uasnav.errors import InputError
 from uasnav.thermal._common import (
+    TEMP_MAX_C,
+    TEMP_MIN_C,
     BoolArray,
     FloatArray,
     NotFittedError,
@@ -30,6 +33,9 @@ from uasnav.thermal._common import (
 )
 from uasnav.thermal.base import ModelDict, register_model
 from uasnav.thermal.modelfile import save_model
+
+#: Highest polynomial order fitted or loaded.
+MAX_ORDER = 20
 
 
 @register_model
@@ -58,8 +64,8 @@ class PolynomialBiasModel:
 
     def fit(self, temp: ArrayLike, bias: ArrayLike) -> PolynomialBiasModel:
         """Fit to temperatures (n,) °C and biases (n, k) rad/s; returns self."""
-        if not (isinstance(self.order, int | np.integer) and 0 <= self.order <= 20):
-            raise InputError(f"order: expected an integer in 0…20, got {self.order!r}")
+        if not (isinstance(self.order, int | np.integer) and 0 <= self.order <= MAX_ORDER):
+            raise InputError(f"order: expected an integer in 0…{MAX_ORDER}, got {self.order!r}")
         t, b = check_fit_data(temp, bias, min_samples=self.order + 1)
         lo, hi = float(t.min()), float(t.max())
         self.center_c_ = 0.5 * (lo + hi)
@@ -112,15 +118,35 @@ class PolynomialBiasModel:
 
     @classmethod
     def from_dict(cls, d: ModelDict, range_c: tuple[float, float]) -> PolynomialBiasModel:
-        """Inverse of :meth:`to_dict`."""
-        models = d["models"]
-        coefs = [m["coefficients"] for m in models]
-        if len({len(c) for c in coefs}) != 1:
-            raise InputError("models: axes have different polynomial orders")
-        m = cls(order=len(coefs[0]) - 1)
-        m.center_c_ = float(models[0]["center_c"])
-        m.scale_c_ = float(models[0]["scale_c"])
-        m.coef_ = np.asarray(coefs, dtype=np.float64).T.copy()
+        """Inverse of :meth:`to_dict`, every value checked (:class:`DataFormatError` naming its
+        JSON path): per axis ``center_c`` (°C, physical), ``scale_c`` > 0 (°C), 1…21
+        finite coefficients; all axes share one centring and one order."""
+        models = jc.array(jc.field(d, "models"), "models")
+        if d.get("derivative_models") is not None:
+            raise jc.fail("derivative_models", "a polynomial model has none (expected null)")
+        coefs: list[FloatArray] = []
+        norm: tuple[float, float] | None = None
+        for i, entry in enumerate(models):
+            p = jc.at("models", i)
+            e = jc.only(jc.obj(entry, p), ("center_c", "scale_c", "coefficients"), p)
+            c = jc.number(
+                jc.field(e, "center_c", p), jc.at(p, "center_c"), lo=TEMP_MIN_C, hi=TEMP_MAX_C, unit="°C"
+            )
+            sc = jc.number(jc.field(e, "scale_c", p), jc.at(p, "scale_c"), positive=True, unit="°C")
+            cp = jc.at(p, "coefficients")
+            k = jc.vector(jc.field(e, "coefficients", p), cp, max_len=MAX_ORDER + 1)
+            if norm is None:
+                norm = (c, sc)
+            elif (c, sc) != norm:
+                # One centring serves every axis: differing values cannot be represented.
+                raise jc.fail(p, "center_c/scale_c differ from models[0]'s (the axes share one)")
+            if coefs and k.size != coefs[0].size:
+                raise jc.fail(cp, f"{k.size} coefficients, models[0] has {coefs[0].size}")
+            coefs.append(k)
+        assert norm is not None
+        m = cls(order=coefs[0].size - 1)
+        m.center_c_, m.scale_c_ = norm
+        m.coef_ = np.stack(coefs, axis=1)
         m.range_c_ = (float(range_c[0]), float(range_c[1]))
         return m
 

@@ -18,7 +18,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.ndimage import median_filter
 
+from uasnav import jsoncheck as jc
+from uasnav.errors import InputError
+from uasnav.limits import check_count
 from uasnav.thermal._common import (
+    TEMP_MAX_C,
+    TEMP_MIN_C,
     BoolArray,
     FloatArray,
     NotFittedError,
@@ -52,7 +57,12 @@ class Px4BiasModel:
 
     def fit(self, temp: ArrayLike, bias: ArrayLike) -> Px4BiasModel:
         """Fit to time-ordered temperatures (n,) °C and gyro biases (n, k) rad/s."""
+        if isinstance(self.median_window, bool) or not isinstance(self.median_window, int | np.integer):
+            raise InputError(f"median_window: expected an integer ≥ 1, got {self.median_window!r}")
+        if not (np.isfinite(self.bin_c) and self.bin_c > 0):
+            raise InputError(f"bin_c: expected a bin width > 0 °C, got {self.bin_c}")
         t, b = check_fit_data(temp, bias, min_samples=8)
+        check_count(np.ptp(t) / self.bin_c + 2, 8, f"temperature bins of {self.bin_c:g} °C", option="bin_c")
         w = max(1, min(int(self.median_window), t.size))
         tf = median_filter(t, size=w, mode="nearest")
         bf = median_filter(b, size=(w, 1), mode="nearest")
@@ -139,12 +149,29 @@ class Px4BiasModel:
 
     @classmethod
     def from_dict(cls, d: ModelDict, range_c: tuple[float, float]) -> Px4BiasModel:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict`, every value checked (:class:`DataFormatError` naming its
+        JSON path): per axis ``tref_c`` (°C, physical, the same on every axis) and exactly 4
+        finite coefficients X0…X3."""
+        models = jc.array(jc.field(d, "models"), "models")
+        if d.get("derivative_models") is not None:
+            raise jc.fail("derivative_models", "a px4 model has none (expected null)")
+        tref: float | None = None
+        coefs = []
+        for i, entry in enumerate(models):
+            p = jc.at("models", i)
+            e = jc.only(jc.obj(entry, p), ("tref_c", "coefficients"), p)
+            t = jc.number(
+                jc.field(e, "tref_c", p), jc.at(p, "tref_c"), lo=TEMP_MIN_C, hi=TEMP_MAX_C, unit="°C"
+            )
+            if tref is not None and t != tref:
+                # PX4 holds one TREF per sensor: differing values cannot be represented.
+                raise jc.fail(jc.at(p, "tref_c"), f"{t:g} °C differs from models[0]'s {tref:g} °C")
+            tref = t
+            coefs.append(jc.vector(jc.field(e, "coefficients", p), jc.at(p, "coefficients"), length=4))
+        assert tref is not None
         m = cls()
-        m.tref_c_ = float(d["models"][0]["tref_c"])
-        m.coef_ = np.asarray([x["coefficients"] for x in d["models"]], dtype=np.float64).T.copy()
-        if m.coef_.shape[0] != 4:
-            raise ValueError(f"PX4 models need 4 coefficients, got {m.coef_.shape[0]}")
+        m.tref_c_ = tref
+        m.coef_ = np.stack(coefs, axis=1)
         m.range_c_ = (float(range_c[0]), float(range_c[1]))
         return m
 

@@ -18,9 +18,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from uasnav.errors import InputError
-from uasnav.imu import ImuLog
+from uasnav.imu import ImuLog, require_log
 from uasnav.io import read_log
-from uasnav.thermal._common import FloatArray, SelectionResult, TemperatureRangeWarning, sr
+from uasnav.thermal._common import (
+    FloatArray,
+    SelectionResult,
+    TemperatureRangeWarning,
+    check_training_temp,
+    sr,
+)
 from uasnav.thermal.base import BiasModel
 from uasnav.thermal.binning import bin_by_time
 from uasnav.thermal.neural import NeuralBiasModel, select_hidden_neurons
@@ -59,6 +65,8 @@ def load_training_data(path: str | os.PathLike[str], average_s: float = 1.0) -> 
     log = read_log(path)
     if log.temp is None:
         raise InputError(f"{path}: no temp column; thermal calibration needs the sensor temperature")
+    # Checked before averaging: the row named is the log's, and 1e308 °C cannot overflow a mean.
+    check_training_temp(log.temp, f"{path}: temp")
     temp, bias = bin_by_time(log.t, log.temp, log.gyro, average_s)
     if temp.size < MIN_TRAINING_SAMPLES:
         raise InputError(
@@ -168,7 +176,18 @@ class ModelEvaluation:
     truth_key : str or None
         The truth column compared against (``"gyro_bias_thermal"`` or ``"gyro_bias"``), if any.
     error_vs_truth : ResidualStats or None
-        ``truth − model(temp)`` (rad/s), if the log has a truth column.
+        ``truth − model(temp)`` (rad/s), if the log has a truth column. Not like with like: the
+        model was fitted to the *training* log's static output, so it carries that log's turn-on
+        bias (and Earth rate), which no truth column of another log contains. Use
+        ``thermal_error_vs_truth``.
+    thermal_error_vs_truth : ResidualStats or None
+        The temperature-dependent part compared like with like: ``truth − model(temp)`` minus its
+        mean over the log (rad/s; ``mean`` is therefore 0). The constant the model carries cannot
+        be told from a constant thermal error without the training log's truth, so it is removed
+        and reported as ``truth_offset``.
+    truth_offset : ndarray, shape (3,), or None
+        The removed mean of ``truth − model(temp)`` per axis (rad/s): minus the training log's
+        turn-on bias and Earth rate, plus any constant thermal error.
     """
 
     n_samples: int
@@ -176,6 +195,8 @@ class ModelEvaluation:
     residual: ResidualStats
     truth_key: str | None
     error_vs_truth: ResidualStats | None
+    thermal_error_vs_truth: ResidualStats | None = None
+    truth_offset: FloatArray | None = None
 
 
 def evaluate_model(model: BiasModel, log: ImuLog, source: str = "log") -> ModelEvaluation:
@@ -186,18 +207,23 @@ def evaluate_model(model: BiasModel, log: ImuLog, source: str = "log") -> ModelE
     Temperatures outside the calibrated range are clipped (counted, no warning). ``source`` names
     the log in errors. Raises :class:`InputError` if the log has no temperature.
     """
+    log = require_log(log)
     if log.temp is None:
         raise InputError(f"{source}: no temp column; cannot evaluate a thermal model")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TemperatureRangeWarning)
         pred, clipped = model.predict(log.temp, return_clipped=True)
     key = next((k for k in TRUTH_KEYS if k in log.truth), None)
+    err = None if key is None else log.truth[key] - pred
+    offset = None if err is None else err.mean(axis=0)
     return ModelEvaluation(
         n_samples=log.n,
         clipped_samples=int(clipped.sum()),
         residual=ResidualStats.of(log.gyro - pred),
         truth_key=key,
-        error_vs_truth=None if key is None else ResidualStats.of(log.truth[key] - pred),
+        error_vs_truth=None if err is None else ResidualStats.of(err),
+        thermal_error_vs_truth=None if err is None else ResidualStats.of(err - offset),
+        truth_offset=offset,
     )
 
 

@@ -6,6 +6,11 @@
 * regression on the same features: k-nearest neighbours and gradient boosting (scikit-learn);
 * kinematic point mass: a speed profile along the plan with acceleration from rest, braking
   to a corner speed V·cos(θ/2) and to a stop at the end, no wind.
+
+A class-based method (the two LVQ variants) is reported as not applicable, with the reason,
+instead of as a number, when its training data cannot support it (see
+:func:`class_method_reason`): e.g. 0.1 m/s ΔV bins over a few dozen real elements give almost one
+class per element, and the "classifier" then memorises single samples.
 """
 
 from __future__ import annotations
@@ -99,13 +104,63 @@ def kinematic_times(
     return np.interp(s_end_m, s, tau) - np.interp(s_start_m, s, tau)
 
 
+#: A class-based method needs on average at least this many training elements per class.
+#: Below it (more classes than half the samples) the classes are a regression target in disguise —
+#: the same criterion as scikit-learn's "number of unique classes is greater than 50%" warning.
+MIN_ELEMENTS_PER_CLASS = 2.0
+
+
+def class_method_reason(labels: np.ndarray, what: str) -> str | None:
+    """Why a classifier cannot be fitted sensibly on ``labels``, or None if it can.
+
+    Rule: not applicable when the number of distinct classes k exceeds n / MIN_ELEMENTS_PER_CLASS
+    for n training elements (fewer than two elements per class on average).
+
+    Parameters
+    ----------
+    labels : ndarray, shape (n,)
+        The class label of each training element.
+    what : str
+        What the classes are, for the message (e.g. "ΔV classes of 0.1 m/s").
+    """
+    y = np.asarray(labels)
+    n = int(y.size)
+    k = int(np.unique(y).size)
+    if n == 0:
+        return "no training elements"
+    if k > n / MIN_ELEMENTS_PER_CLASS:
+        return (
+            f"{k} {what} from {n} training elements: fewer than {MIN_ELEMENTS_PER_CLASS:g} elements "
+            "per class on average, so a classifier cannot be fitted sensibly (train on more "
+            "elements or use coarser classes)"
+        )
+    return None
+
+
 @dataclass
 class MethodResult:
-    """Predicted element times (s) of one method on the test elements and their e%."""
+    """Predicted element times (s) of one method on the test elements and their e%.
+
+    ``reason`` is None for a method that was fitted; otherwise it says why the method is not
+    applicable to the training data given, and ``time_s`` and ``error_pct`` are NaN (never
+    averaged: check :attr:`applicable`).
+    """
 
     name: str
     time_s: np.ndarray
     error_pct: np.ndarray
+    reason: str | None = None
+
+    @property
+    def applicable(self) -> bool:
+        """True if the method was fitted and its times are predictions."""
+        return self.reason is None
+
+    @classmethod
+    def not_applicable(cls, name: str, n_test: int, reason: str) -> MethodResult:
+        """A method that could not be fitted: NaN times and e% for ``n_test`` elements."""
+        nan = np.full(n_test, np.nan)
+        return cls(name, nan, nan.copy(), reason)
 
 
 def evaluate_methods(
@@ -122,17 +177,16 @@ def evaluate_methods(
     """
     from uasnav.trajectory.predictor import TrajectoryPredictor
 
-    lvq = (lvq_factory() if lvq_factory else TrajectoryPredictor(random_state=random_state)).fit(train)  # type: ignore[attr-defined]
-    out = [
-        MethodResult(
-            "LVQ (thesis)",
-            t := lvq.element_times(test.features, test.length_m, test.v_ref_ms),
-            percent_error(t, test.t_real_s),
-        )
-    ]
-    lvq_dv = TrajectoryPredictor(random_state=random_state, target="dv").fit(train)
-    t = lvq_dv.element_times(test.features, test.length_m, test.v_ref_ms)
-    out.append(MethodResult("LVQ on ΔV classes", t, percent_error(t, test.t_real_s)))
+    out = []
+    lvq = lvq_factory() if lvq_factory else TrajectoryPredictor(random_state=random_state)
+    lvq_dv = TrajectoryPredictor(random_state=random_state, target="dv")
+    for name, model in (("LVQ (thesis)", lvq), ("LVQ on ΔV classes", lvq_dv)):
+        reason = class_method_reason(*_class_labels(model, train))
+        if reason is not None:
+            out.append(MethodResult.not_applicable(name, len(test), reason))
+            continue
+        t = model.fit(train).element_times(test.features, test.length_m, test.v_ref_ms)  # type: ignore[attr-defined]
+        out.append(MethodResult(name, t, percent_error(t, test.t_real_s)))
     for name, factor in (("distance ÷ speed", 1.0), ("distance ÷ 0.8·speed", 0.8)):
         t = distance_over_speed(test.length_m, test.v_ref_ms, factor)
         out.append(MethodResult(name, t, percent_error(t, test.t_real_s)))
@@ -151,10 +205,20 @@ def evaluate_methods(
     return out
 
 
+def _class_labels(model: object, train: ElementSamples) -> tuple[np.ndarray, str]:
+    """The labels a TrajectoryPredictor would train its network on, and what they are."""
+    if getattr(model, "target", "cell") == "dv":
+        width = float(getattr(model, "dv_bin_ms", 0.1))
+        return np.rint(train.dv_ms / width), f"ΔV classes of {width:g} m/s"
+    return train.cell, "populated feature cells"
+
+
 __all__ = [
+    "MIN_ELEMENTS_PER_CLASS",
     "CellMeanDV",
     "MethodResult",
     "RegressorDV",
+    "class_method_reason",
     "distance_over_speed",
     "evaluate_methods",
     "kinematic_times",

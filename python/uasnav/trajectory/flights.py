@@ -123,11 +123,20 @@ class RunErrors:
         e% of every element of every run (%), runs in order.
     run_pct : tuple of float
         e% of each run's total time (%).
+    reason : str or None
+        None if the method was fitted in every fold; otherwise why it is not applicable (the
+        first fold whose training runs cannot support it) and ``element_pct``/``run_pct`` are NaN.
     """
 
     name: str
     element_pct: NDArray[np.float64]
     run_pct: tuple[float, ...]
+    reason: str | None = None
+
+    @property
+    def applicable(self) -> bool:
+        """True if the method was fitted in every fold."""
+        return self.reason is None
 
 
 def leave_one_run_out(
@@ -151,6 +160,7 @@ def leave_one_run_out(
     if len(samples) < 2:
         raise InputError("leave-one-run-out needs at least two mission runs")
     per: dict[str, tuple[list[float], list[float]]] = {}
+    reasons: dict[str, str] = {}
     for k, test in enumerate(samples):
         train = ElementSamples.concat([s for i, s in enumerate(samples) if i != k])
         _, run = flights.runs[k]
@@ -165,9 +175,19 @@ def leave_one_run_out(
             )
         for m in evaluate_methods(train, test, kinematic_s=kin, random_state=random_state):
             element, whole = per.setdefault(m.name, ([], []))
+            if not m.applicable:
+                # One fold the method cannot be fitted in makes the whole comparison unfair
+                # (its mean would cover other runs than the other methods'): not applicable.
+                reasons.setdefault(m.name, f"leaving out run {k + 1}: {m.reason}")
             element += m.error_pct.tolist()
             whole.append(float(abs(m.time_s.sum() - test.t_real_s.sum()) / test.t_real_s.sum() * 100))
-    return [RunErrors(n, np.array(e, dtype=float), tuple(r)) for n, (e, r) in per.items()]
+    out = []
+    for n, (e, r) in per.items():
+        if n in reasons:
+            out.append(RunErrors(n, np.full(len(e), np.nan), (float("nan"),) * len(r), reasons[n]))
+        else:
+            out.append(RunErrors(n, np.array(e, dtype=float), tuple(r)))
+    return out
 
 
 __all__ = ["FlightSamples", "RunErrors", "flight_samples", "leave_one_run_out"]

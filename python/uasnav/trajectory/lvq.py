@@ -30,6 +30,7 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from uasnav.errors import InputError
+from uasnav.limits import check_memory, check_work
 
 _ALGORITHMS = ("lvq1", "lvq2.1", "glvq")
 
@@ -129,6 +130,39 @@ class LVQClassifier(ClassifierMixin, BaseEstimator):
             raise InputError(f"window must be in (0, 1), got {self.window}")
         if self.max_iter is not None and self.max_iter < 1:
             raise InputError(f"max_iter must be ≥ 1, got {self.max_iter}")
+        if isinstance(self.n_prototypes, bool) or not isinstance(self.n_prototypes, int | np.integer):
+            raise InputError(f"n_prototypes must be an integer ≥ 1, got {self.n_prototypes!r}")
+
+    @classmethod
+    def from_arrays(
+        cls, classes: np.ndarray, prototypes: np.ndarray, prototype_labels: np.ndarray, **params: object
+    ) -> LVQClassifier:
+        """A fitted classifier from its arrays (a saved model), checked: ``classes`` (S²,)
+        integers, strictly increasing (as :func:`numpy.unique` leaves them); ``prototypes``
+        (S¹, n_features) finite; ``prototype_labels`` (S¹,) indices into ``classes``, every class
+        held by at least one prototype. Raises :class:`InputError` naming the array at fault."""
+        c = np.asarray(classes)
+        w = np.asarray(prototypes)
+        lab = np.asarray(prototype_labels)
+        if c.ndim != 1 or c.size < 2 or c.dtype.kind not in "iu" or np.any(np.diff(c) <= 0):
+            raise InputError("classes: expected ≥ 2 distinct integers in increasing order")
+        if w.ndim != 2 or w.shape[0] < 1 or w.shape[1] < 1 or w.dtype.kind not in "fiu":
+            raise InputError(f"prototypes: expected a (S¹, n_features) matrix, got shape {w.shape}")
+        if not np.isfinite(w).all():
+            raise InputError("prototypes: non-finite value")
+        if lab.shape != (w.shape[0],) or lab.dtype.kind not in "iu":
+            raise InputError(f"prototype_labels: expected {w.shape[0]} integers (one per prototype)")
+        if lab.min() < 0 or lab.max() >= c.size:
+            raise InputError(f"prototype_labels: indices must be in 0…{c.size - 1}")
+        if np.unique(lab).size != c.size:
+            raise InputError("prototype_labels: a class has no prototype (it could never be predicted)")
+        m = cls(n_prototypes=int(w.shape[0]), **params)  # type: ignore[arg-type]
+        m.classes_ = c.astype(np.int64)
+        m.prototypes_ = w.astype(np.float64)
+        m.prototype_labels_ = lab.astype(np.intp)
+        m.n_features_in_ = int(w.shape[1])
+        m.n_iter_ = 0
+        return m
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> LVQClassifier:
         """Train on X, shape (n, n_features), labels y, shape (n,). Returns self."""
@@ -138,6 +172,7 @@ class LVQClassifier(ClassifierMixin, BaseEstimator):
         classes, y_idx, counts = np.unique(y, return_inverse=True, return_counts=True)
         if classes.size < 2:
             raise ValueError(f"LVQ needs samples of at least 2 classes; got 1 class: {classes[0]!r}")
+        _check_cost(int(self.n_prototypes), X.shape, self.max_iter)
         rng = np.random.default_rng(self.random_state)
         per = neurons_per_class(counts, int(self.n_prototypes))
         labels = np.repeat(np.arange(classes.size), per)
@@ -214,6 +249,18 @@ class LVQClassifier(ClassifierMixin, BaseEstimator):
         tags = super().__sklearn_tags__()
         tags.classifier_tags.multi_class = True
         return tags
+
+
+def _check_cost(n_prototypes: int, x_shape: tuple[int, ...], max_iter: int | None) -> None:
+    """Refuse, before allocating, a fit beyond the memory or work limit (:mod:`uasnav.limits`):
+    the presentation order, learning rates and presented samples take n_steps·(n_features + 2)
+    floats, and each presentation costs about S¹·n_features operations plus Python overhead."""
+    n, nf = int(x_shape[0]), int(x_shape[1])
+    n_steps = float(max_iter) if max_iter is not None else max(50.0 * n_prototypes, float(n))
+    what = f"LVQ training with {n_prototypes} prototypes over {n_steps:.3g} presentations"
+    hint = "n_prototypes (--prototypes)"
+    check_memory(8.0 * (n_steps * (nf + 2) + n_prototypes * (nf + 2)), what, option=hint)
+    check_work(n_steps * (3.0 * n_prototypes * nf + 5e3), what, option=hint)
 
 
 def _train_lvq1(

@@ -3,21 +3,41 @@
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 
 import numpy as np
 
 from uasnav.errors import DataFormatError, InputError
+from uasnav.limits import read_file_limited
 from uasnav.trajectory.geometry import geodetic_to_local
+
+#: Largest plan file read (bytes): a plan of 100 000 waypoints is about 4 MB.
+MAX_PLAN_BYTES = 16 * 2**20
 
 
 def read_plan(path: str | Path) -> tuple[np.ndarray, tuple[float, float, float] | None]:
-    """Read a plan CSV. Returns (waypoints north/east m, geodetic origin or None)."""
+    """Read a plan CSV. Returns (waypoints north/east m, geodetic origin or None).
+
+    At most :data:`MAX_PLAN_BYTES` are read (whatever size the file reports); a UTF-8 byte-order
+    mark is accepted. Raises :class:`DataFormatError` naming the line for malformed content.
+    """
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise InputError(f"no such plan file: {p}")
-    with open(p, newline="") as fh:
-        rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
+    if p.is_dir():
+        raise InputError(f"{p}: is a directory, not a plan file")
+    raw = read_file_limited(p, MAX_PLAN_BYTES)
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise DataFormatError("not UTF-8 text", path=str(p), line=line) from None
+    reader = csv.reader(io.StringIO(text, newline=""))
+    try:
+        rows = [r for r in reader if r and not r[0].lstrip().startswith("#")]
+    except csv.Error as exc:
+        raise DataFormatError(f"malformed CSV ({exc})", path=str(p), line=reader.line_num) from None
     if not rows:
         raise DataFormatError("empty plan", path=str(p))
     head = [h.strip().lower() for h in rows[0]]
@@ -47,4 +67,4 @@ def read_plan(path: str | Path) -> tuple[np.ndarray, tuple[float, float, float] 
     return geodetic_to_local(vals[:, 0], vals[:, 1], alt, origin=origin)[:, :2], origin
 
 
-__all__ = ["read_plan"]
+__all__ = ["MAX_PLAN_BYTES", "read_plan"]

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from uasnav import jsoncheck as jc
 from uasnav.atomicfile import atomic_write_text
 from uasnav.errors import DataFormatError, InputError
 from uasnav.trajectory.features import N_CELLS, WIND_MAX_MS, Features, cell_index, features
@@ -30,6 +31,22 @@ MODEL_FORMAT = "uasnav-trajectory-lvq/1"
 _N_TABLE = 3 * N_CELLS
 #: Slowest speed (m/s) accepted from V_ref + ΔV before the element is flagged and clamped.
 MIN_SPEED_MS = 0.2
+#: Shortest segment length L (m) a model is trained or loaded with. The thesis uses 10 m; below
+#: 1 m an element is shorter than GNSS position noise, and a plan's element count (memory,
+#: time) grows as its length / L (``segment_m`` = 1e-9 would ask for 10⁹ elements per metre).
+MIN_SEGMENT_M = 1.0
+#: Longest segment length L (m): a plan must be at least 2 L long to hold one element.
+MAX_SEGMENT_M = 10_000.0
+#: Largest speed, speed change ΔV and wind (m/s) a model file may hold: beyond any small UAS
+#: (and the CLI's ``--wind`` bound of 100 m/s); larger values are corrupt.
+MAX_SPEED_MS = 150.0
+#: Most competitive neurons S¹ a model may declare (the thesis uses 256).
+MAX_PROTOTYPES = 100_000
+#: Largest model file read (bytes); a 256-prototype model is about 40 kB.
+MAX_MODEL_BYTES = 64 * 2**20
+#: Width of the LVQ input (:meth:`uasnav.trajectory.features.Features.matrix`): θ, θ_w (cos,
+#: sin), |V_w|, kind.
+N_FEATURES = 5
 
 
 @dataclass
@@ -134,11 +151,32 @@ class TrajectoryPredictor:
     # -- training ------------------------------------------------------------------------
     def fit(self, samples: ElementSamples) -> TrajectoryPredictor:
         """Train the network and the per-cell ΔV table on measured elements. Returns self."""
+        try:
+            _check_params(self.get_params())
+        except DataFormatError as e:  # the same rules as a model file's "params", as InputError
+            raise InputError(str(e)) from None
         if len(samples) == 0:
             raise InputError("no training elements")
         good = np.isfinite(samples.dv_ms)
         if not good.all():
             raise InputError(f"{int((~good).sum())} training element(s) have a NaN ΔV")
+        # The limits a model file is loaded with: a model that could not be read back is refused
+        # here, at training, naming the element (a corrupt log's 1e308 m/s would otherwise do).
+        v_max = MAX_SPEED_MS
+        for name, x, ok, accepted in (
+            ("ΔV", samples.dv_ms, np.abs(samples.dv_ms) <= v_max, f"[-{v_max:g}, {v_max:g}]"),
+            ("commanded speed", samples.v_ref_ms, (samples.v_ref_ms > 0) & (samples.v_ref_ms <= v_max),
+             f"(0, {v_max:g}]"),
+            ("wind speed", samples.features.wind_ms,
+             (samples.features.wind_ms >= 0) & (samples.features.wind_ms <= v_max), f"[0, {v_max:g}]"),
+        ):  # fmt: skip
+            bad = np.flatnonzero(~ok)
+            if bad.size:
+                i = int(bad[0])
+                raise InputError(
+                    f"training element {i}: {name} {float(x[i]):g} m/s is outside {accepted} m/s "
+                    f"({bad.size} such element{'s' if bad.size > 1 else ''})"
+                )
         cells = samples.cell
         self.count_table_ = np.bincount(cells, minlength=_N_TABLE)
         sums = np.bincount(cells, weights=samples.dv_ms, minlength=_N_TABLE)
@@ -269,22 +307,16 @@ class TrajectoryPredictor:
         return Feasibility(required_s=req, predicted_s=pred.waypoint_times_s, tolerance_s=float(tolerance_s))
 
     # -- persistence ---------------------------------------------------------------------
+    def get_params(self) -> dict[str, Any]:
+        """The constructor parameters (the model file's ``"params"``)."""
+        return {k: getattr(self, k) for k in _PARAM_KEYS}
+
     def to_dict(self) -> dict[str, Any]:
         """The fitted model as JSON-able data."""
         self._check_fitted()
         d: dict[str, Any] = {
             "format": MODEL_FORMAT,
-            "params": {
-                "segment_m": self.segment_m,
-                "n_prototypes": self.n_prototypes,
-                "algorithm": self.algorithm,
-                "learning_rate": self.learning_rate,
-                "lr_decay": self.lr_decay,
-                "max_iter": self.max_iter,
-                "random_state": self.random_state,
-                "target": self.target,
-                "dv_bin_ms": self.dv_bin_ms,
-            },
+            "params": self.get_params(),
             "label_dv_ms": {str(int(k)): float(v) for k, v in zip(self.labels_, self.label_dv_, strict=True)},
             "cruise_ms": self.cruise_ms_,
             "wind_range_ms": list(self.wind_range_ms_),
@@ -305,54 +337,162 @@ class TrajectoryPredictor:
 
     def save(self, path: str | Path) -> None:
         """Write the model as JSON, atomically."""
-        atomic_write_text(path, json.dumps(self.to_dict(), indent=1))
+        d = self.to_dict()
+        try:
+            text = json.dumps(d, indent=1, allow_nan=False)  # JSON has no NaN: never write one
+        except ValueError:
+            raise InputError("the model holds non-finite numbers and cannot be saved") from None
+        atomic_write_text(path, text)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], source: str = "<dict>") -> TrajectoryPredictor:
-        """Rebuild a fitted predictor from :meth:`to_dict` data."""
+        """Rebuild a fitted predictor from :meth:`to_dict` data, every value checked: types,
+        finiteness, ranges (:data:`MIN_SEGMENT_M` ≤ ``segment_m`` ≤ :data:`MAX_SEGMENT_M`,
+        speeds and ΔV within ±:data:`MAX_SPEED_MS`), class keys inside the class grid, shapes
+        of the LVQ arrays. Raises :class:`DataFormatError` naming ``source`` and the JSON path."""
         if not isinstance(d, dict) or d.get("format") != MODEL_FORMAT:
             raise DataFormatError(f"not a {MODEL_FORMAT} model", path=source)
-        try:
-            self = cls(**d["params"])
-            self.cruise_ms_ = float(d["cruise_ms"])
-            self.wind_range_ms_ = (float(d["wind_range_ms"][0]), float(d["wind_range_ms"][1]))
-            self.n_train_ = int(d["n_train"])
-            self.dv_global_ = float(d["dv_global_ms"])
-            lab = sorted((int(k), float(v)) for k, v in d["label_dv_ms"].items())
-            self.labels_ = np.array([k for k, _ in lab], dtype=int)
-            self.label_dv_ = np.array([v for _, v in lab])
-            self.dv_table_ = np.full(_N_TABLE, np.nan)
-            self.count_table_ = np.zeros(_N_TABLE, dtype=int)
-            for k, v in d["dv_table_ms"].items():
-                self.dv_table_[int(k)] = float(v)
-                self.count_table_[int(k)] = int(d["count_table"][k])
-            if "lvq" in d:
-                lvq = LVQClassifier(n_prototypes=len(d["lvq"]["prototype_labels"]))
-                lvq.classes_ = np.asarray(d["lvq"]["classes"], dtype=int)
-                lvq.prototypes_ = np.asarray(d["lvq"]["prototypes"], dtype=float)
-                lvq.prototype_labels_ = np.asarray(d["lvq"]["prototype_labels"], dtype=int)
-                lvq.n_features_in_ = lvq.prototypes_.shape[1]
-                lvq.n_iter_ = 0
-                self.lvq_ = lvq
-            else:
-                self.lvq_ = None
-                self.single_cell_ = int(d["single_cell"])
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise DataFormatError(f"malformed model: {exc!r}", path=source) from None
-        if self.lvq_ is not None and not np.isin(self.lvq_.classes_, self.labels_).all():
-            raise DataFormatError("model class without a ΔV entry", path=source)
+        with jc.reraise_in(source):
+            return cls._from_checked(d)
+
+    @classmethod
+    def _from_checked(cls, d: dict[str, Any]) -> TrajectoryPredictor:
+        jc.only(d, _FILE_KEYS)
+        params = _check_params(jc.obj(jc.field(d, "params"), "params"), "params")
+        self = cls(**params)
+        self.cruise_ms_ = jc.number(jc.field(d, "cruise_ms"), "cruise_ms", positive=True, hi=MAX_SPEED_MS)
+        self.wind_range_ms_ = _wind_range(jc.field(d, "wind_range_ms"))
+        self.n_train_ = jc.integer(jc.field(d, "n_train"), "n_train", lo=1)
+        self.dv_global_ = jc.number(
+            jc.field(d, "dv_global_ms"), "dv_global_ms", lo=-MAX_SPEED_MS, hi=MAX_SPEED_MS
+        )
+        # Class keys: feature cells 0…383 for target "cell"; ΔV bins k (ΔV ≈ k·dv_bin_ms) for "dv".
+        if self.target == "cell":
+            lab_lo, lab_hi = 0, _N_TABLE - 1
+        else:
+            lab_hi = int(MAX_SPEED_MS / self.dv_bin_ms)
+            lab_lo = -lab_hi
+        labels = _int_map(jc.field(d, "label_dv_ms"), "label_dv_ms", lab_lo, lab_hi, _dv)
+        self.labels_ = np.array(sorted(labels), dtype=int)
+        self.label_dv_ = np.array([labels[k] for k in self.labels_])
+        dv = _int_map(jc.field(d, "dv_table_ms"), "dv_table_ms", 0, _N_TABLE - 1, _dv)
+        counts = _int_map(jc.field(d, "count_table"), "count_table", 0, _N_TABLE - 1, _count)
+        if set(counts) != set(dv):
+            odd = min(set(counts) ^ set(dv))
+            raise jc.fail("count_table", f"cell {odd} is in only one of dv_table_ms and count_table")
+        if sum(counts.values()) != self.n_train_:
+            raise jc.fail("count_table", f"counts sum to {sum(counts.values())}, n_train is {self.n_train_}")
+        if self.target == "cell" and set(labels) != set(dv):
+            raise jc.fail("label_dv_ms", "classes differ from the cells of dv_table_ms (target 'cell')")
+        self.dv_table_ = np.full(_N_TABLE, np.nan)
+        self.count_table_ = np.zeros(_N_TABLE, dtype=int)
+        for k, v in dv.items():
+            self.dv_table_[k] = v
+            self.count_table_[k] = counts[k]
+        if ("lvq" in d) == ("single_cell" in d):
+            raise jc.fail("lvq", "a model holds exactly one of 'lvq' and 'single_cell'")
+        if "lvq" in d:
+            self.lvq_ = _lvq(jc.obj(d["lvq"], "lvq"), self.labels_)
+        else:
+            self.lvq_ = None
+            self.single_cell_ = jc.integer(d["single_cell"], "single_cell", lo=lab_lo, hi=lab_hi)
+            if self.labels_.tolist() != [self.single_cell_]:
+                raise jc.fail("single_cell", f"{self.single_cell_} is not the one class of label_dv_ms")
         return self
 
     @classmethod
     def load(cls, path: str | Path) -> TrajectoryPredictor:
-        """Read a model written by :meth:`save`."""
-        try:
-            d = json.loads(Path(path).read_text())
-        except json.JSONDecodeError as exc:
-            raise DataFormatError(f"invalid JSON: {exc.msg}", path=str(path), line=exc.lineno) from None
-        except OSError as exc:
-            raise InputError(f"cannot read model {path}: {exc.strerror}") from None
+        """Read a model written by :meth:`save` (at most :data:`MAX_MODEL_BYTES`), checked as
+        :meth:`from_dict` does."""
+        with jc.reraise_in(str(path)):
+            d = jc.parse(jc.read_text(path, MAX_MODEL_BYTES), "invalid JSON")
         return cls.from_dict(d, source=str(path))
 
 
-__all__ = ["MIN_SPEED_MS", "MODEL_FORMAT", "Feasibility", "PlanPrediction", "TrajectoryPredictor"]
+_PARAM_KEYS = (
+    "segment_m", "n_prototypes", "algorithm", "learning_rate", "lr_decay", "max_iter", "random_state",
+    "target", "dv_bin_ms",
+)  # fmt: skip
+_FILE_KEYS = (
+    "format", "params", "label_dv_ms", "cruise_ms", "wind_range_ms", "n_train", "dv_global_ms",
+    "dv_table_ms", "count_table", "lvq", "single_cell",
+)  # fmt: skip
+
+
+def _check_params(p: dict[str, Any], path: str = "") -> dict[str, Any]:
+    """The predictor's parameters checked (by a model file's rules: JSON types, ranges);
+    missing keys keep their defaults. Raises :class:`DataFormatError` naming the key."""
+    jc.only(p, _PARAM_KEYS, path)
+    # NumPy scalars (from a caller's arithmetic) are checked as the Python numbers they hold.
+    p = {k: v.item() if isinstance(v, np.generic) else v for k, v in p.items()}
+    checks = {
+        "segment_m": lambda v, q: jc.number(v, q, lo=MIN_SEGMENT_M, hi=MAX_SEGMENT_M, unit="m"),
+        "n_prototypes": lambda v, q: jc.integer(v, q, lo=1, hi=MAX_PROTOTYPES),
+        "algorithm": lambda v, q: jc.string(v, q, ("lvq1", "lvq2.1", "glvq")),
+        "learning_rate": lambda v, q: jc.number(v, q, positive=True),
+        "lr_decay": lambda v, q: jc.string(v, q, ("none", "linear")),
+        "max_iter": lambda v, q: None if v is None else jc.integer(v, q, lo=1),
+        "random_state": lambda v, q: None if v is None else jc.integer(v, q, lo=0),
+        "target": lambda v, q: jc.string(v, q, ("cell", "dv")),
+        "dv_bin_ms": lambda v, q: jc.number(v, q, positive=True, hi=MAX_SPEED_MS, unit="m/s"),
+    }
+    return {k: checks[k](v, jc.at(path, k)) for k, v in p.items()}
+
+
+def _dv(v: object, path: str) -> float:
+    return jc.number(v, path, lo=-MAX_SPEED_MS, hi=MAX_SPEED_MS, unit="m/s")
+
+
+def _count(v: object, path: str) -> int:
+    return jc.integer(v, path, lo=1)
+
+
+def _int_map(x: object, path: str, lo: int, hi: int, value: Any) -> dict[int, Any]:
+    """A JSON object with integer keys in [lo, hi] (class indices), values checked by ``value``."""
+    d = jc.obj(x, path)
+    if not d:
+        raise jc.fail(path, "empty")
+    return {jc.integer_key(k, path, lo=lo, hi=hi): value(v, jc.at(path, k)) for k, v in d.items()}
+
+
+def _wind_range(x: object) -> tuple[float, float]:
+    if not (isinstance(x, list) and len(x) == 2):
+        raise jc.fail("wind_range_ms", f"expected [min, max] as an array of two numbers, got {jc.show(x)}")
+    lo, hi = (
+        jc.number(v, jc.at("wind_range_ms", i), lo=0, hi=MAX_SPEED_MS, unit="m/s") for i, v in enumerate(x)
+    )
+    if lo > hi:
+        raise jc.fail("wind_range_ms", f"minimum {jc.show(x[0])} exceeds maximum {jc.show(x[1])}")
+    return lo, hi
+
+
+def _lvq(d: dict[str, Any], labels: np.ndarray) -> LVQClassifier:
+    """The LVQ network of a model file (``"lvq"``), checked against the model's classes."""
+    jc.only(d, ("classes", "prototypes", "prototype_labels"), "lvq")
+    classes = jc.array(jc.field(d, "classes", "lvq"), "lvq.classes", max_len=MAX_PROTOTYPES)
+    c = np.array([jc.integer(v, jc.at("lvq.classes", i)) for i, v in enumerate(classes)], dtype=np.int64)
+    if not np.isin(c, labels).all():
+        raise jc.fail("lvq.classes", "a class has no ΔV entry in label_dv_ms")
+    w = jc.matrix(jc.field(d, "prototypes", "lvq"), "lvq.prototypes", cols=N_FEATURES)
+    if w.shape[0] > MAX_PROTOTYPES:
+        raise jc.fail("lvq.prototypes", f"{w.shape[0]} prototypes, at most {MAX_PROTOTYPES}")
+    pl = jc.array(jc.field(d, "prototype_labels", "lvq"), "lvq.prototype_labels", max_len=MAX_PROTOTYPES)
+    lab = np.array(
+        [jc.integer(v, jc.at("lvq.prototype_labels", i), lo=0, hi=c.size - 1) for i, v in enumerate(pl)],
+        dtype=np.intp,
+    )
+    try:
+        return LVQClassifier.from_arrays(c, w, lab)
+    except InputError as e:
+        raise jc.fail("lvq", str(e)) from None
+
+
+__all__ = [
+    "MAX_SEGMENT_M",
+    "MIN_SEGMENT_M",
+    "MIN_SPEED_MS",
+    "MODEL_FORMAT",
+    "Feasibility",
+    "PlanPrediction",
+    "TrajectoryPredictor",
+]

@@ -18,6 +18,8 @@
 //! byte-exactly without re-serialising. This loader checks the checksum, format, schema
 //! version, kind, units, shapes and finiteness: a corrupt or mismatched file is an error naming
 //! what is wrong, never a silently wrong network.
+// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use super::{Activation, Affine, LayerSpec, Mlp};
 use serde::Deserialize;
 use std::string::{String, ToString};
@@ -119,7 +121,7 @@ fn net_from_json(
         if let Some(r) = l.weights.iter().position(|row| row.len() != fan_in) {
             return Err(ModelFileError(format!(
                 "{where_}: layer {i}: weight row {r} has {} entries, expected {fan_in}",
-                l.weights[r].len()
+                l.weights.get(r).map_or(0, Vec::len)
             )));
         }
         fan_in = l.biases.len();

@@ -118,11 +118,30 @@ pub fn parity_residuals<T: Real, const M: usize>(
             got: out.len(),
         });
     }
+    // `wls` squares sigma, so a negative or infinite one would pass silently as |σ| or as
+    // weight 0: the same check as `FdiFuser::new`.
+    if sigma
+        .iter()
+        .take(n)
+        .any(|s| !num_traits::Float::is_finite(*s) || *s <= T::zero())
+    {
+        return Err(NavError::InvalidParameter {
+            what: "sigma",
+            reason: "every axis noise must be finite and positive",
+        });
+    }
     let zero = [T::zero(); M];
     let all = [true; M];
     let f = wls(array, z, sigma, &zero[..n], &all[..n])?;
     for (i, r) in out.iter_mut().enumerate().take(n) {
         *r = z[i] - array.axis(i).dot(&f.value);
+        // Finite samples near the float range can still overflow the residual.
+        if !num_traits::Float::is_finite(*r) {
+            return Err(NavError::NonFinite {
+                what: "parity residual (samples too large)",
+                index: i,
+            });
+        }
     }
     Ok(())
 }

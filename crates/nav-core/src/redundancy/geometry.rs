@@ -179,8 +179,22 @@ impl Polyhedron {
     }
 }
 
+/// A tolerance must be finite and ≥ 0: a NaN would make every `x > tol` test false and
+/// accept anything.
+fn check_tol<T: Real>(tol: T) -> Result<(), NavError> {
+    if num_traits::Float::is_finite(tol) && tol >= T::zero() {
+        Ok(())
+    } else {
+        Err(NavError::InvalidParameter {
+            what: "tol",
+            reason: "must be finite and >= 0",
+        })
+    }
+}
+
 /// Checks that `c` is a proper rotation: `‖CᵀC − I‖_max ≤ tol` and `det C > 0`.
 pub fn check_rotation<T: Real>(c: &Matrix3<T>, tol: T) -> Result<(), NavError> {
+    check_tol(tol)?;
     if c.iter().any(|v| !num_traits::Float::is_finite(*v)) {
         return Err(NavError::NonFinite {
             what: "mounting",
@@ -260,6 +274,7 @@ impl<T: Real, const M: usize> SensorArray<T, M> {
 
     /// Adds a single-axis sensor with sensitive axis `h` (IMU frame, unit length to `tol`).
     pub fn push_single(&mut self, h: &Vector3<T>, tol: T) -> Result<(), NavError> {
+        check_tol(tol)?;
         if h.iter().any(|v| !num_traits::Float::is_finite(*v)) {
             return Err(NavError::NonFinite {
                 what: "sensor axis",
@@ -330,6 +345,7 @@ impl<T: Real, const M: usize> SensorArray<T, M> {
     /// Axes `axes[i]` (IMU frame, unit to `tol`) grouped into sensors by `sensor_of[i]`,
     /// which must start at 0 and never decrease or skip (axes of one sensor are adjacent).
     pub fn from_axes(axes: &[Vector3<T>], sensor_of: &[usize], tol: T) -> Result<Self, NavError> {
+        check_tol(tol)?;
         if axes.len() != sensor_of.len() {
             return Err(NavError::LengthMismatch {
                 what: "sensor_of",

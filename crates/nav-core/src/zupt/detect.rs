@@ -15,6 +15,8 @@
 //! `E[T] ≈ (2σ²_{n,a})/σ_a² + (3σ²_{n,ω} + ‖b_ω‖²)/σ_ω²` (σ_n per-sample noise, b_ω the gyro
 //! bias), i.e. ≈ 2–3 for a consumer MEMS IMU at rest; motion drives `T` to 10²–10⁴. Raise
 //! `σ_a`, `σ_ω` for noisier sensors (the known failure: noisy IMUs never detected as static).
+// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use crate::scalar::from_usize;
 use crate::{NavError, Real};
 
@@ -102,6 +104,9 @@ impl<T: Real> StationarityDetector<T> {
 
     /// Adds one sample (specific force m/s², angular rate rad/s, body frame) and returns the
     /// statistic `T` over the trailing window (partial at the start) and the decision `T < γ`.
+    // Ring-buffer indices are taken modulo `window_samples ≤ DETECT_CAPACITY = buf.len()`
+    // (checked by `validate` in `new`): every index is in range.
+    #[allow(clippy::indexing_slicing)]
     pub fn push(
         &mut self,
         accel_m_s2: &[T; 3],
@@ -169,6 +174,9 @@ impl<T: Real> StationarityDetector<T> {
 
 /// Batch detection over a log with a *centred* window: `stat_out[k]`, `mask_out[k]` use the
 /// `W` samples around `k` (the first and last `W/2` samples reuse the nearest full window).
+// Every slice was checked to have length n above; k < n and k − lag ≥ 0 (k + 1 ≥ w > lag),
+// head ≤ tail < n: every index is in range.
+#[allow(clippy::indexing_slicing)]
 pub fn detect_static<T: Real>(
     accel_m_s2: &[[T; 3]],
     gyro_rad_s: &[[T; 3]],

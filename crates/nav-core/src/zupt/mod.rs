@@ -224,10 +224,12 @@ impl<T: Real> ZuptConfig<T> {
                 reason: "must be finite and within ±π/2",
             });
         }
-        if !num_traits::Float::is_finite(self.height_m) {
+        // "Within the bound" is false for NaN too.
+        let height_ok = num_traits::Float::abs(self.height_m) <= lit(crate::earth::MAX_HEIGHT_M);
+        if !height_ok {
             return Err(NavError::InvalidParameter {
                 what: "height_m",
-                reason: "must be finite",
+                reason: "must be finite and within ±100 km of the ellipsoid",
             });
         }
         Ok(())

@@ -7,6 +7,8 @@
 //! `Σiy ← Σiy − (Σy − y_0)`), and `Σi`, `Σi²` are closed forms of `n`. To stop rounding error
 //! from accumulating, the sums are recomputed from the buffer once per `capacity` pushes
 //! (O(1) amortised) and the values are stored relative to the first sample.
+// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use crate::scalar::{from_usize, lit};
 use crate::Real;
 
@@ -68,6 +70,9 @@ impl<T: Real> SlopeEstimator<T> {
 
     /// Adds one sample (must be finite: the caller checks) and returns the updated slope.
     #[inline]
+    // Ring-buffer indices are taken modulo `window`, and `window ≤ SLOPE_CAPACITY = buf.len()`
+    // (clamped in `new`): every index is in range.
+    #[allow(clippy::indexing_slicing)]
     pub fn push(&mut self, y: T) -> T {
         let take = self.phase == 0;
         self.phase = (self.phase + 1) % self.stride;
@@ -102,6 +107,8 @@ impl<T: Real> SlopeEstimator<T> {
         self.slope
     }
 
+    // As in `push`: indices modulo `window ≤ buf.len()`.
+    #[allow(clippy::indexing_slicing)]
     fn recompute(&mut self) {
         let (mut sy, mut siy) = (T::zero(), T::zero());
         for i in 0..self.n {

@@ -106,20 +106,36 @@ def _static(w: SectionWriter, static: StaticAllan) -> None:
     from uasnav.plotting import new_figure
 
     rows = []
+    why_lines = []
     for sp in static.presets:
         for tc in sp.terms:
             fit = float(np.mean(tc.fit))
-            if tc.resolvable or tc.tau_cross_s is None:
+            rec = tc.recovery
+            term = f"{tc.term} ({tc.unit})"
+            # Rule: compare with the specification only where the data identify the term on
+            # every axis; otherwise say which axes do not and why (the reasons follow the table).
+            blind = [] if rec is None else [ax for j, ax in enumerate("xyz") if not rec.identifiable[j]]
+            if rec is not None and blind:
+                note = f"not identifiable on {', '.join(blind)}"
+                for j, ax in enumerate("xyz"):
+                    if not rec.identifiable[j]:
+                        why_lines.append(f"{sp.preset} {tc.sensor} {ax} {tc.term}: {rec.reasons[j]}")
+            elif tc.resolvable or tc.tau_cross_s is None:
                 note = f"{(np.mean(tc.fit) / tc.spec - 1) * 100:+.1f} %"
             else:
                 note = f"not resolvable (white noise dominates to τ ≈ {tc.tau_cross_s / 3600:.3g} h)"
-            term = f"{tc.term} ({tc.unit})"
+            if rec is not None:
+                note += f"; spec inside the 95 % interval on {int(np.sum(rec.inside))}/3 axes"
             rows.append((sp.preset, tc.sensor, term, tc.spec, fit, float(np.mean(tc.points)), note))
-            w.data[f"{sp.preset}_{tc.sensor}_{tc.term}"] = {
-                "spec": tc.spec,
-                "fit": tc.fit,
-                "points": tc.points,
-            }
+            entry: dict[str, object] = {"spec": tc.spec, "fit": tc.fit, "points": tc.points}
+            if rec is not None:
+                entry.update(
+                    ci_low=rec.ci_low,
+                    ci_high=rec.ci_high,
+                    spec_inside_ci=rec.inside,
+                    identifiable=rec.identifiable,
+                )
+            w.data[f"{sp.preset}_{tc.sensor}_{tc.term}"] = entry
         if sp.preset == "ax1":
             fig, ax = new_figure()
             plot_adev(sp.gyro_curve, ax=ax, labels=["gyro x", "gyro y", "gyro z"], report=sp.gyro_report)
@@ -146,6 +162,12 @@ def _static(w: SectionWriter, static: StaticAllan) -> None:
         ),
         fmt="{:.4g}",
     )
+    if why_lines:
+        w.p(
+            "Terms the logs do not identify (95 % profile-likelihood interval of the fit contains 0): "
+            + "; ".join(why_lines)
+            + "."
+        )
 
 
 def build(w: SectionWriter) -> None:

@@ -9,6 +9,7 @@ import numpy as np
 
 from uasnav.experiments import calibration
 from uasnav.experiments.thesis import FIG30_RAMP_RANGE_C, FIG34_DELTA_OMEGA, TABLE7, TABLE8
+from uasnav.experiments.verdicts import change
 from uasnav.report import Section, SectionWriter
 
 
@@ -185,8 +186,9 @@ def build(w: SectionWriter) -> None:
     w.data["hysteresis_width_std"] = hy.width_std.tolist()
 
     w.p(
-        f"Robustness: with the ramp temperature quantised to 1 °C the BPNN's Sr grows from "
-        f"{tab[calibration.BPNN_THESIS].sr:.3g} to {r.quantised_sr:.3g} rad/s. Evaluated over "
+        "Robustness: with the ramp temperature quantised to 1 °C the BPNN's Sr (rad/s) "
+        + w.verdict("quantised_sr", change(tab[calibration.BPNN_THESIS].sr, r.quantised_sr))
+        + f". Evaluated over "
         f"{r.wide_range_c[0]:.1f} … {r.wide_range_c[1]:.1f} °C, {r.n_clipped} of {r.n_wide} temperatures "
         "fall outside the calibrated range: they are clipped to it, flagged (return_clipped) and warned "
         "about (TemperatureRangeWarning); the model never extrapolates."

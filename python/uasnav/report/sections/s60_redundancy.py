@@ -5,6 +5,7 @@ Renders :func:`uasnav.experiments.redundancy.run`.
 
 from __future__ import annotations
 
+from uasnav.experiments.verdicts import within_spread
 from uasnav.report import Section, SectionWriter
 
 _T15_HEAD = ["θ (rad)", "t_red thesis (s)", "t_red ours", "t thesis (s)", "t ours", "Δt% thesis", "Δt% ours"]
@@ -104,8 +105,17 @@ def build(w: SectionWriter) -> None:
         "(tens of seconds). Fusion averages the six biases, so against a typical face the times "
         "grow by about 1/k_r = √6 (Δt% ≈ +145 %) for bias-dominated, linear θ growth (and 1/k_r² "
         "for noise-dominated √t growth); against one particular face the result can be anything, "
-        "including negative when that face happens to have a small bias. The thesis' 22–88 % on "
-        "one face is within that spread."
+        "including negative when that face happens to have a small bias. "
+        + w.verdict(
+            "table15_thesis_dt_within_spread",
+            within_spread(
+                [x.dt_percent_thesis for x in t15.variants[0].rows],
+                t15.mc_dt_percent,
+                [f"θ = {x.threshold_rad:.2e} rad" for x in t15.variants[0].rows],
+                "The thesis' one-face Δt% lies",
+            ),
+        )
+        + "."
     )
 
     # --- improvement vs theory -------------------------------------------------------------------

@@ -5,6 +5,7 @@ Renders :func:`uasnav.experiments.mission.run`.
 
 from __future__ import annotations
 
+from uasnav.experiments.verdicts import majority
 from uasnav.report import Section, SectionWriter
 
 _SYM = {"necessary": "●", "optional": "✓", "incompatible": ""}
@@ -63,15 +64,21 @@ def build(w: SectionWriter) -> None:
         for r in t20.rows
     ]
     w.table(["equipment", *[m.name for m in missions]], rows20, caption="Derived / printed Table 20.")
+    # The two kinds the caption explains, counted from the comparison itself.
+    blank = sum(n for a, b, n in t20.kinds if a == "optional" and b == "incompatible")
+    required = sum(n for a, b, n in t20.kinds if b == "necessary" and a != "necessary")
+    share = majority(blank + required, t20.cells - t20.agree)
+    w.verdict("table20_disagreements_explained", share)
     w.table(
         ["derived (ours)", "Table 20 (thesis)", "cells"],
         [list(k) for k in t20.kinds],
         caption=(
             f"Disagreements: {t20.cells - t20.agree} of {t20.cells} cells; {t20.cells - t20.agree_necessary} "
-            "on necessary vs not. Most are "
-            "Table 20 leaving blank what Table 19 allows (Table 20 uses blank for 'not relevant'), and "
-            "Table 20 requiring items that no feature rule asks for (RTK/differential GNSS for mapping, "
-            "the advanced autopilot for mapping), which §5.2.2.4 motivates by mission objectives."
+            f"on necessary vs not. {share.verdict.capitalize()} of them ({blank + required}) are "
+            f"Table 20 leaving blank what Table 19 allows ({blank}; Table 20 uses blank for 'not "
+            f"relevant'), or Table 20 requiring items that no feature rule asks for ({required}; e.g. "
+            "RTK/differential GNSS and the advanced autopilot for mapping), which §5.2.2.4 motivates "
+            "by mission objectives."
         ),
     )
     w.data["table20"] = {"cells": t20.cells, "agree": t20.agree, "agree_necessary": t20.agree_necessary}

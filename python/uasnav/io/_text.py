@@ -1,0 +1,208 @@
+"""Reading text files for the CSV readers: bounded, decoded with positions, parsed row by row.
+
+Every CSV reader of :mod:`uasnav.io` (log format v1, x-io, flight CSV, numeric tables) reads
+through :func:`read_text` and :func:`csv_rows`, so each hostile input gets one
+:class:`~uasnav.errors.DataFormatError` naming the file, line and (where it can be told) column:
+
+- more bytes than the memory limit allows (checked on the bytes read, so ``/dev/zero`` or a
+  FIFO cannot exhaust memory; :mod:`uasnav.limits`, ``UASNAV_MAX_MEMORY``);
+- bytes that are not UTF-8 (a Latin-1 ``é``, a UTF-16 file), NUL bytes (a binary file);
+- a stray ``"`` that opens a quoted cell running over several lines, a cell longer than the
+  :mod:`csv` module's field limit (128 KiB), any other :class:`csv.Error`.
+
+A UTF-8 byte-order mark at the start of the file is accepted and removed.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import re
+from collections.abc import Iterator, Sequence
+
+from uasnav.errors import DataFormatError, ResourceLimitError
+from uasnav.limits import ENV_MEMORY, format_size, max_memory, read_limited
+
+#: Peak bytes of memory per byte of CSV text while a reader parses it (text, lines, Python
+#: floats, the final arrays; measured ≈ 6 on log format v1). The bytes a reader accepts are
+#: ``max_memory() / TEXT_MEMORY_FACTOR``.
+TEXT_MEMORY_FACTOR = 8
+
+_BOMS = {
+    b"\xff\xfe\x00\x00": "UTF-32",
+    b"\x00\x00\xfe\xff": "UTF-32",
+    b"\xff\xfe": "UTF-16",
+    b"\xfe\xff": "UTF-16",
+}
+_UTF8_BOM = b"\xef\xbb\xbf"
+_NEWLINE = re.compile(r"\r\n|\r|\n")
+
+
+def max_text_bytes() -> int:
+    """Largest text file (bytes) the CSV readers accept under the current memory limit."""
+    return max_memory() // TEXT_MEMORY_FACTOR
+
+
+def read_text(path: str | os.PathLike[str]) -> str:
+    """The text of ``path`` as UTF-8 (a leading byte-order mark removed), read bounded.
+
+    Raises
+    ------
+    DataFormatError
+        Missing file, a directory, an unreadable file, invalid UTF-8 or a NUL byte (names the
+        line and column), or more bytes than :func:`max_text_bytes` (a
+        :class:`~uasnav.errors.ResourceLimitError` too).
+    """
+    p = str(path)
+    limit = max_text_bytes()
+    try:
+        with open(p, "rb") as fh:
+            raw = read_limited(fh, limit, p)
+    except FileNotFoundError:
+        raise DataFormatError("no such file", path=p) from None
+    except IsADirectoryError:
+        raise DataFormatError("is a directory, not a file", path=p) from None
+    except ResourceLimitError:
+        raise ResourceLimitError(
+            f"{p}: larger than {format_size(limit)}, the largest text file read under the memory limit "
+            f"of {format_size(max_memory())} (parsing needs about {TEXT_MEMORY_FACTOR} bytes of memory "
+            f"per byte of text); raise the limit with {ENV_MEMORY} (e.g. {ENV_MEMORY}=16G)"
+        ) from None
+    except OSError as e:
+        raise DataFormatError(f"cannot read ({e.strerror or e})", path=p) from None
+    return decode(raw, p)
+
+
+def decode(raw: bytes, source: str) -> str:
+    """``raw`` decoded as UTF-8 without a leading BOM; errors name line and column (see module)."""
+    for bom, name in _BOMS.items():
+        if raw.startswith(bom):
+            raise DataFormatError(f"a {name} text file; save it as UTF-8", path=source, line=1)
+    if raw.startswith(_UTF8_BOM):
+        raw = raw[len(_UTF8_BOM) :]
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line, column, at = _where(raw, e.start)
+        bad = raw[e.start : e.start + 1].hex()
+        raise DataFormatError(
+            f"not UTF-8 text: byte 0x{bad}{at} ({e.reason}); save the file as UTF-8",
+            path=source,
+            line=line,
+            column=column,
+        ) from None
+    nul = text.find("\x00")
+    if nul >= 0:
+        line, column, at = _where(raw, len(text[:nul].encode("utf-8")))
+        raise DataFormatError(
+            f"NUL byte{at}: a binary file, not CSV text", path=source, line=line, column=column
+        )
+    return text
+
+
+def _where(raw: bytes, offset: int) -> tuple[int, str | None, str]:
+    """Where byte ``offset`` is: (line, CSV column name, " at character k" or "").
+
+    The column is the header name when the offset lies in a data row after a header; otherwise
+    it is ``None`` and the position within the line is given instead.
+    """
+    line_start = raw.rfind(b"\n", 0, offset) + 1
+    line = raw.count(b"\n", 0, offset) + 1
+    before = raw[line_start:offset].decode("utf-8", errors="replace")
+    cell = before.count(",")
+    header = _header_before(raw[:line_start].decode("utf-8", errors="replace"))
+    if header is not None and cell < len(header):
+        return line, header[cell], ""
+    return line, None, f" at character {len(before) + 1}"
+
+
+def _header_before(text: str) -> list[str] | None:
+    """The header cells of CSV ``text`` (first line that is neither blank nor a ``#`` comment)."""
+    for ln in text.splitlines():
+        if ln.strip() and not ln.startswith("#"):
+            return [h.strip() for h in ln.split(",")]
+    return None
+
+
+def split_lines(text: str) -> list[str]:
+    """The lines of ``text``, split at ``\\n``, ``\\r\\n`` or ``\\r`` only (unlike
+    :meth:`str.splitlines`, which also splits at form feeds and Unicode separators and would
+    make line numbers disagree with an editor's)."""
+    lines = _NEWLINE.split(text)
+    if lines and lines[-1] == "":
+        lines.pop()
+    return lines
+
+
+def csv_rows(
+    lines: Sequence[str], start: int, source: str, header: Sequence[str] | None = None
+) -> Iterator[tuple[int, list[str]]]:
+    """Parse ``lines[start:]`` as CSV: ``(line, cells)`` per row, ``line`` 1-based in the file.
+
+    ``header`` (the column names, if known) names the column in errors. Blank lines are
+    skipped. A row spanning several lines (a ``"`` that opens a quoted cell) and every
+    :class:`csv.Error` are a :class:`DataFormatError` naming the line and column.
+    """
+    # each line with its newline, so a quoted cell running over lines shows where it started
+    reader = csv.reader(ln + "\n" for ln in lines[start:])
+    while True:
+        first = start + reader.line_num + 1  # file line (1-based) of the next row's first line
+        try:
+            row = next(reader)
+        except StopIteration:
+            return
+        except csv.Error as e:
+            line = start + reader.line_num  # the line being read when the error occurred
+            text = lines[line - 1] if 0 < line <= len(lines) else ""
+            raise _csv_error(e, text, source, line, header) from None
+        last = start + reader.line_num
+        if last > first:
+            quoted = next((j for j, c in enumerate(row) if "\n" in c), len(row) - 1)
+            raise DataFormatError(
+                f"unbalanced '\"': a quoted cell starts here and runs over {last - first + 1} lines",
+                path=source,
+                line=first,
+                column=_name(header, quoted),
+            )
+        if not row or all(not c.strip() for c in row):
+            continue
+        yield first, row
+
+
+def show_cell(cell: str, limit: int = 40) -> str:
+    """A cell for an error message: quoted, shortened if long."""
+    return repr(cell) if len(cell) <= limit else f"{cell[:limit]!r}… ({len(cell)} characters)"
+
+
+def _name(header: Sequence[str] | None, j: int) -> str:
+    if header is not None and 0 <= j < len(header):
+        return header[j]
+    return f"#{j + 1}"
+
+
+def _csv_error(
+    e: csv.Error, text: str, source: str, line: int, header: Sequence[str] | None
+) -> DataFormatError:
+    msg = str(e)
+    if "field larger than field limit" in msg:
+        limit = csv.field_size_limit()
+        cells = text.split(",")
+        j = next((k for k, c in enumerate(cells) if len(c) > limit), len(cells) - 1)
+        return DataFormatError(
+            f"a cell of more than {limit} characters (not a number; a stray '\"' or binary data?)",
+            path=source,
+            line=line,
+            column=_name(header, j),
+        )
+    return DataFormatError(f"malformed CSV ({msg})", path=source, line=line)
+
+
+__all__ = [
+    "TEXT_MEMORY_FACTOR",
+    "csv_rows",
+    "decode",
+    "max_text_bytes",
+    "read_text",
+    "show_cell",
+    "split_lines",
+]
