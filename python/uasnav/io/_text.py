@@ -16,6 +16,7 @@ A UTF-8 byte-order mark at the start of the file is accepted and removed.
 from __future__ import annotations
 
 import csv
+import math
 import os
 import re
 from collections.abc import Iterator, Sequence
@@ -172,6 +173,20 @@ def csv_rows(
 def show_cell(cell: str, limit: int = 40) -> str:
     """A cell for an error message: quoted, shortened if long."""
     return repr(cell) if len(cell) <= limit else f"{cell[:limit]!r}… ({len(cell)} characters)"
+
+
+def finite_cell(cell: str, *, path: str, line: int, column: str) -> float:
+    """One CSV cell as a finite float, else :class:`DataFormatError` naming file, line, column
+    and the cell as written (the one cell rule of every CSV reader)."""
+    try:
+        v = float(cell)
+    except ValueError:
+        raise DataFormatError(
+            f"not a number: {show_cell(cell)}", path=path, line=line, column=column
+        ) from None
+    if not math.isfinite(v):
+        raise DataFormatError(f"non-finite value {show_cell(cell)}", path=path, line=line, column=column)
+    return v
 
 
 def _name(header: Sequence[str] | None, j: int) -> str:

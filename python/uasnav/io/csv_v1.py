@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
-from uasnav.io._text import csv_rows, read_text, show_cell, split_lines
+from uasnav.io._text import csv_rows, finite_cell, read_text, split_lines
 from uasnav.io.table import as_column, write_rows
 
 REQUIRED = ("t", "gx", "gy", "gz", "ax", "ay", "az")
@@ -99,18 +99,7 @@ def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
             raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=source, line=line_no)
         vals = []
         for c, j in zip(wanted, idx, strict=True):
-            cell = row[j].strip()
-            try:
-                v = float(cell)
-            except ValueError:
-                raise DataFormatError(
-                    f"not a number: {show_cell(cell)}", path=source, line=line_no, column=c
-                ) from None
-            if not np.isfinite(v):
-                raise DataFormatError(
-                    f"non-finite value {show_cell(cell)}", path=source, line=line_no, column=c
-                )
-            vals.append(v)
+            vals.append(finite_cell(row[j].strip(), path=source, line=line_no, column=c))
         rows.append(vals)
         row_lines.append(line_no)
     if len(rows) < 2:

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from uasnav.errors import DataFormatError, InputError
 from uasnav.io._common import nothing_valid, report_corruption, salvage
 from uasnav.io._quiet import LibraryOutput
-from uasnav.io._text import csv_rows, read_text, show_cell, split_lines
+from uasnav.io._text import csv_rows, finite_cell, read_text, split_lines
 
 FloatArray = NDArray[np.float64]
 
@@ -246,15 +246,7 @@ def read_flight_csv(path: str | os.PathLike[str]) -> FlightLog:
         for name, k in zip(FLIGHT_CSV_COLUMNS, idx, strict=True):
             if k >= len(r):
                 raise DataFormatError(f"missing cell (row has {len(r)})", path=source, line=line, column=name)
-            try:
-                v = float(r[k])
-            except ValueError:
-                raise DataFormatError(
-                    f"not a number: {show_cell(r[k])}", path=source, line=line, column=name
-                ) from None
-            if not np.isfinite(v):
-                raise DataFormatError(f"NaN/inf: {show_cell(r[k])}", path=source, line=line, column=name)
-            vals.append(v)
+            vals.append(finite_cell(r[k], path=source, line=line, column=name))
         rows.append(vals)
         row_lines.append(line)
     if len(rows) < 2:

@@ -15,7 +15,7 @@ import numpy as np
 
 from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
-from uasnav.io._text import csv_rows, read_text, show_cell, split_lines
+from uasnav.io._text import csv_rows, finite_cell, read_text, split_lines
 from uasnav.units import convert
 
 HEADER_PREFIX = "Time (s)"
@@ -67,16 +67,7 @@ def read_xio_csv(path: str | os.PathLike[str]) -> ImuLog:
         for c, i in zip(want, idx, strict=True):
             if i >= len(row):
                 raise DataFormatError(f"missing cell (row has {len(row)})", path=source, line=line, column=c)
-            cell = row[i]
-            try:
-                v = float(cell)
-            except ValueError:
-                raise DataFormatError(
-                    f"not a number: {show_cell(cell)}", path=source, line=line, column=c
-                ) from None
-            if not np.isfinite(v):
-                raise DataFormatError(f"non-finite value {show_cell(cell)}", path=source, line=line, column=c)
-            vals.append(v)
+            vals.append(finite_cell(row[i], path=source, line=line, column=c))
         rows.append(vals)
         row_lines.append(line)
     if len(rows) < 2:
