@@ -42,6 +42,60 @@ def bench_allan(n: int, repeat: int) -> None:
     )
 
 
+def bench_noise(hours: float, repeat: int) -> None:
+    """IEEE 952 identification of a 3-axis octave curve: the maximum-likelihood fit with profile
+    intervals (uasnav.noise.identify, issue 14) against nav-core's weighted NNLS fit without
+    intervals (the previous default), on the same curve."""
+    from uasnav import _core
+    from uasnav.allan import oadev
+    from uasnav.noise import identify
+    from uasnav.units import convert
+
+    rate = 100.0
+    n = int(hours * 3600 * rate)
+    rng = np.random.default_rng(1)
+    arw = float(convert(3.18, "deg/√h", "rad/√s"))
+    rrw = float(convert(30.0, "deg/h/√h", "rad/s/√s"))
+    walk = np.cumsum(rng.normal(0.0, rrw / np.sqrt(rate), (n, 3)), axis=0)
+    y = rng.normal(0.0, arw * np.sqrt(rate), (n, 3)) + walk
+    curve = oadev(y, rate=rate, taus="octave", unit="rad/s")
+
+    def nnls() -> None:
+        for j in range(3):
+            _core.noise_fit_ieee952(curve.taus, np.ascontiguousarray(curve.adev[:, j] ** 2), curve.rel_error)
+
+    t_ml = median_time(lambda: identify(curve, kind="gyro"), repeat)
+    t_nnls = median_time(nnls, repeat)
+    print(
+        f"noise identify 3 axes, {len(curve.taus)} τ ({hours:g} h at 100 Hz): ML + 95 % intervals "
+        f"{t_ml * 1e3:8.1f} ms | Rust NNLS (no intervals) {t_nnls * 1e3:8.2f} ms"
+        f" | ratio {t_ml / t_nnls:6.0f}x"
+    )
+
+
+def bench_io(n: int, repeat: int) -> None:
+    """CSV log format v1: write_log / read_log (17 significant digits, atomic, every cell
+    checked with file/line/column errors) against numpy.savetxt / numpy.loadtxt of the same table."""
+    import os
+    import tempfile
+
+    from uasnav import sim
+    from uasnav.io import read_log, write_log
+
+    log = sim.simulate("ax1", profile="static", duration=n / 100.0, rate=100.0, seed=1)
+    with tempfile.TemporaryDirectory() as d:
+        ours, peer = os.path.join(d, "log.csv"), os.path.join(d, "np.csv")
+        table = np.column_stack([log.t, log.gyro, log.accel, log.temp])
+        t_w = median_time(lambda: write_log(log, ours), repeat)
+        t_wp = median_time(lambda: np.savetxt(peer, table, fmt="%.17g", delimiter=","), repeat)
+        t_r = median_time(lambda: read_log(ours), repeat)
+        t_rp = median_time(lambda: np.loadtxt(peer, delimiter=","), repeat)
+    print(
+        f"io csv v1 n={n:.0e} ({log.n} rows incl. truth columns): write {t_w:6.2f} s vs savetxt(8 cols) "
+        f"{t_wp:6.2f} s | read {t_r:6.2f} s vs loadtxt(8 cols) {t_rp:6.2f} s"
+    )
+
+
 def bench_sim(n: int, repeat: int) -> None:
     """Full simulator run (ax1: both triads, thermal terms, truth channels) and its flicker
     generator against allantools' Kasdin–Walter power-law noise generator (one axis)."""
@@ -293,6 +347,8 @@ CASES: dict[str, Callable[[bool], None]] = {
     ),
     "redundancy": lambda quick: bench_redundancy(10**5 if quick else 10**6, 3 if quick else 5),
     "redundancy_ardupilot": lambda quick: bench_redundancy_ardupilot(1 if quick else 3),
+    "noise": lambda quick: bench_noise(0.5 if quick else 2.0, 3 if quick else 5),
+    "io": lambda quick: bench_io(10**4 if quick else 10**5, 1 if quick else 3),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
 }
 
