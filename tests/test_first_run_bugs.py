@@ -18,7 +18,6 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-import pytest
 from click.testing import CliRunner
 
 from uasnav.cli import main
@@ -39,8 +38,11 @@ TLOG = (
 # --- bug 3 and 4: trajectory evaluate on the real ArduCopter missions --------------------------
 
 
-@pytest.mark.skipif(not TLOG.exists(), reason="reference data ../shared/data not present")
-def test_trajectory_evaluate_real_tlog_no_library_warnings_and_not_applicable_reason() -> None:
+def test_trajectory_evaluate_real_tlog_no_library_warnings_and_not_applicable_reason(
+    shared_data: Path,
+) -> None:
+    # ../shared/data through the fixture: never skipped in CI (the fixture fails there instead).
+    assert TLOG.resolve() == (shared_data / "flights" / "phoenix_mission1_arducopter.tlog").resolve()
     # --segment 5 is where scikit-learn warned ("number of unique classes is greater than 50%")
     # five times: the ΔV-class LVQ saw 26 classes in 36 training elements. Run as a user does
     # (a fresh interpreter with the default warning filters), not under pytest's capture.

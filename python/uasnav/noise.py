@@ -31,7 +31,7 @@ numbers in SI with their units in the field names.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -41,10 +41,44 @@ from uasnav import _core
 from uasnav.errors import InputError, UnitError
 from uasnav.units import convert, dimension, parse_quantity
 
-if TYPE_CHECKING:
-    # noise.identify reads an AllanResult's fields; allan imports noise for
-    # AllanResult.identify, so the type is needed for annotations only.
-    from uasnav.allan import AllanResult
+
+class AllanCurve(Protocol):
+    """What the noise fit reads from an Allan curve (:class:`uasnav.allan.AllanResult` is one).
+
+    Stated here rather than imported: ``allan`` imports this module for ``AllanResult.identify``,
+    so this module depends on the shape of a curve, not on the ``allan`` module.
+    """
+
+    @property
+    def taus(self) -> NDArray[np.float64]:
+        """Cluster times τ (k,) in s."""
+        ...
+
+    @property
+    def avar(self) -> NDArray[np.float64]:
+        """Allan variance (k,) or (k, c), in ``unit`` squared."""
+        ...
+
+    @property
+    def rel_error(self) -> NDArray[np.float64]:
+        """IEEE 952 relative error of σ(τ) per τ (k,)."""
+        ...
+
+    @property
+    def m(self) -> NDArray[np.int64]:
+        """Cluster sizes (samples) per τ (k,)."""
+        ...
+
+    @property
+    def n_samples(self) -> int:
+        """Samples in the series."""
+        ...
+
+    @property
+    def unit(self) -> str:
+        """Unit of the data ("rad/s", "m/s^2" …; "" if not given)."""
+        ...
+
 
 TERMS = ("quantization", "random_walk", "bias_instability", "rate_random_walk", "rate_ramp")
 
@@ -166,7 +200,7 @@ class NoiseReport:
         Single-point readings on slope lines (N at 1 s, K at 3 s, B = σ_min/0.664 …).
     fit_rms_rel_residual : ndarray, shape (c,)
         RMS relative residual of the fit in σ², per axis.
-    curve : AllanResult
+    curve : AllanCurve
         The curve the terms were read from.
     fit_min_tau_s : ndarray, shape (c,)
         Shortest cluster time (s) used per axis (longer than the curve's first when points
@@ -189,7 +223,7 @@ class NoiseReport:
     fit: NoiseTerms
     points: NoiseTerms
     fit_rms_rel_residual: NDArray[np.float64]
-    curve: AllanResult = field(repr=False)
+    curve: AllanCurve = field(repr=False)
     fit_min_tau_s: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     ci_low: NoiseTerms | None = None
     ci_high: NoiseTerms | None = None
@@ -280,7 +314,7 @@ def band_limited_points(
 
 
 def identify(
-    curve: AllanResult,
+    curve: AllanCurve,
     kind: Literal["gyro", "accel"] | None = None,
     *,
     min_tau: float | Literal["auto"] | None = "auto",
@@ -289,7 +323,7 @@ def identify(
 
     Parameters
     ----------
-    curve : AllanResult
+    curve : AllanCurve
         Computed on gyro data in rad/s or accelerometer data in m/s² (the unit recorded in the
         curve decides the kind unless ``kind`` is given; other units are refused, so
         deg/s data cannot silently produce rad-based coefficients).
@@ -737,6 +771,7 @@ __all__ = [
     "FIELD_UNITS",
     "SI_UNITS",
     "TERMS",
+    "AllanCurve",
     "FilterNoise",
     "NoiseReport",
     "NoiseTerms",

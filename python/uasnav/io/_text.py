@@ -21,6 +21,9 @@ import os
 import re
 from collections.abc import Iterator, Sequence
 
+import numpy as np
+from numpy.typing import NDArray
+
 from uasnav.errors import DataFormatError, ResourceLimitError
 from uasnav.limits import ENV_MEMORY, format_size, max_memory, read_limited
 
@@ -187,6 +190,39 @@ def finite_cell(cell: str, *, path: str, line: int, column: str) -> float:
     if not math.isfinite(v):
         raise DataFormatError(f"non-finite value {show_cell(cell)}", path=path, line=line, column=column)
     return v
+
+
+def numeric_rows(
+    lines: list[str],
+    header_line: int,
+    source: str,
+    header: Sequence[str],
+    columns: Sequence[str],
+    *,
+    exact_width: bool = False,
+) -> tuple[NDArray[np.float64], list[int]]:
+    """The data rows of a CSV table as an (n, len(columns)) float array of ``columns`` (names in
+    ``header``), with the file line of each row; every cell must be a finite number.
+
+    ``exact_width`` refuses a row whose cell count differs from the header's (log format v1);
+    otherwise only a row too short for a wanted column is refused. Fewer than 2 rows is an
+    error (a log or a track needs at least two samples)."""
+    idx = [header.index(c) for c in columns]
+    rows: list[list[float]] = []
+    row_lines: list[int] = []
+    for line, row in csv_rows(lines, header_line, source, header):
+        if exact_width and len(row) != len(header):
+            raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=source, line=line)
+        vals = []
+        for c, j in zip(columns, idx, strict=True):
+            if j >= len(row):
+                raise DataFormatError(f"missing cell (row has {len(row)})", path=source, line=line, column=c)
+            vals.append(finite_cell(row[j].strip(), path=source, line=line, column=c))
+        rows.append(vals)
+        row_lines.append(line)
+    if len(rows) < 2:
+        raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
+    return np.array(rows, dtype=np.float64), row_lines
 
 
 def _name(header: Sequence[str] | None, j: int) -> str:

@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
-from uasnav.io._text import csv_rows, finite_cell, read_text, split_lines
+from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
 from uasnav.io.table import as_column, write_rows
 
 REQUIRED = ("t", "gx", "gy", "gz", "ax", "ay", "az")
@@ -91,20 +91,7 @@ def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
     optional = [c for c in ("temp", "mx", "my", "mz") if c in header]
     truth_cols = [c for c in header if c.startswith("truth_")]
     wanted = list(REQUIRED) + optional + truth_cols
-    idx = [header.index(c) for c in wanted]
-    rows: list[list[float]] = []
-    row_lines: list[int] = []
-    for line_no, row in csv_rows(lines, header_line, source, header):
-        if len(row) != len(header):
-            raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=source, line=line_no)
-        vals = []
-        for c, j in zip(wanted, idx, strict=True):
-            vals.append(finite_cell(row[j].strip(), path=source, line=line_no, column=c))
-        rows.append(vals)
-        row_lines.append(line_no)
-    if len(rows) < 2:
-        raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
-    data = np.array(rows, dtype=np.float64)
+    data, row_lines = numeric_rows(lines, header_line, source, header, wanted, exact_width=True)
     col = {c: data[:, j] for j, c in enumerate(wanted)}
     t = col["t"]
     d = np.diff(t)

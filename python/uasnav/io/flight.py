@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from uasnav.errors import DataFormatError, InputError
 from uasnav.io._common import nothing_valid, report_corruption, salvage
 from uasnav.io._quiet import LibraryOutput
-from uasnav.io._text import csv_rows, finite_cell, read_text, split_lines
+from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
 
 FloatArray = NDArray[np.float64]
 
@@ -238,20 +238,7 @@ def read_flight_csv(path: str | os.PathLike[str]) -> FlightLog:
         raise DataFormatError(
             f"missing column(s) {missing}; need {FLIGHT_CSV_COLUMNS}", path=source, line=header_line
         )
-    idx = [head.index(c) for c in FLIGHT_CSV_COLUMNS]
-    rows: list[list[float]] = []
-    row_lines: list[int] = []
-    for line, r in csv_rows(lines, header_line, source, head):
-        vals = []
-        for name, k in zip(FLIGHT_CSV_COLUMNS, idx, strict=True):
-            if k >= len(r):
-                raise DataFormatError(f"missing cell (row has {len(r)})", path=source, line=line, column=name)
-            vals.append(finite_cell(r[k], path=source, line=line, column=name))
-        rows.append(vals)
-        row_lines.append(line)
-    if len(rows) < 2:
-        raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
-    data = np.array(rows, dtype=np.float64)
+    data, row_lines = numeric_rows(lines, header_line, source, head, FLIGHT_CSV_COLUMNS)
     for j, name in enumerate(FLIGHT_CSV_COLUMNS[1:4], start=1):
         lo, hi = FIX_LIMITS[name]
         out = np.flatnonzero((data[:, j] < lo) | (data[:, j] > hi))

@@ -93,6 +93,8 @@ def _load(p: Path) -> dict[str, np.ndarray]:
                     with zf.open(info) as fh:
                         out[key] = _read_member(fh, info, key, src)
             return out
+    # zipfile raises NotImplementedError for a compression method it does not support (a hostile
+    # or exotic archive): a bad file, reported as such.
     except (zipfile.BadZipFile, zipfile.LargeZipFile, zlib.error, EOFError, NotImplementedError) as e:
         raise DataFormatError(f"not a readable .npz archive ({e})", path=src) from None
     except RuntimeError as e:  # an encrypted member

@@ -15,7 +15,7 @@ import numpy as np
 
 from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
-from uasnav.io._text import csv_rows, finite_cell, read_text, split_lines
+from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
 from uasnav.units import convert
 
 HEADER_PREFIX = "Time (s)"
@@ -59,20 +59,7 @@ def read_xio_csv(path: str | os.PathLike[str]) -> ImuLog:
             f"missing column(s) {missing}", path=source, line=header_line, column=missing[0]
         )
     want = list(_COLS) + [c for c in _MAG if c in header]
-    idx = [header.index(c) for c in want]
-    rows: list[list[float]] = []
-    row_lines: list[int] = []
-    for line, row in csv_rows(lines, header_line, source, header):
-        vals = []
-        for c, i in zip(want, idx, strict=True):
-            if i >= len(row):
-                raise DataFormatError(f"missing cell (row has {len(row)})", path=source, line=line, column=c)
-            vals.append(finite_cell(row[i], path=source, line=line, column=c))
-        rows.append(vals)
-        row_lines.append(line)
-    if len(rows) < 2:
-        raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
-    data = np.array(rows, dtype=np.float64)
+    data, row_lines = numeric_rows(lines, header_line, source, header, want)
     t = data[:, 0]
     d = np.diff(t)
     if np.any(d <= 0):
