@@ -2,109 +2,51 @@
 
 from __future__ import annotations
 
-import math
+from collections.abc import Callable
+from typing import Any
 
 import click
 
-from uasnav.cli._common import NON_NEGATIVE, POSITIVE, echo_json
+from uasnav.cli._common import Real, echo_json
+from uasnav.mission.request import SELECT_OPTIONS, OptionError, SelectOption, parse_select_options
+from uasnav.mission.selection import select
 
-_PARAMS = ("range", "weight", "cost", "resolution")
 
-
-def _parse_size(text: str) -> tuple[float, float]:
-    parts = text.lower().replace("×", "x").split("x")
-    try:
-        if len(parts) != 2:
-            raise ValueError
-        size = (float(parts[0]), float(parts[1]))
-    except ValueError:
-        raise click.BadParameter(
-            f"expected LENGTHxWIDTH in metres (e.g. 70x70), got {text!r}", param_hint="'--image-size'"
-        ) from None
-    if not all(math.isfinite(v) and v > 0 for v in size):
-        raise click.BadParameter(
-            f"expected a finite LENGTHxWIDTH > 0 in metres, got {text!r}", param_hint="'--image-size'"
+def _click_type(opt: SelectOption) -> Any:
+    """The click type of a selector option: typed options are checked at parse time (exit 2)."""
+    if opt.kind == "real":
+        return Real(opt.minimum, opt.maximum, lo_open=opt.minimum_open)
+    if opt.kind == "int":
+        return click.IntRange(
+            None if opt.minimum is None else int(opt.minimum),
+            None if opt.maximum is None else int(opt.maximum),
         )
-    return size
+    if opt.kind == "choice":
+        return click.Choice(opt.choices or ())
+    return None
 
 
-def _parse_pairs(text: str, what: str, allowed: tuple[str, ...]) -> dict[str, str]:
-    out = {}
-    for item in text.split(","):
-        if not item.strip():
+def _options(f: Callable[..., None]) -> Callable[..., None]:
+    """One click option per entry of :data:`SELECT_OPTIONS` (the web form reads the same table)."""
+    for opt in reversed(SELECT_OPTIONS):
+        if opt.kind == "flag":
+            f = click.option(opt.flag, opt.name, is_flag=True, default=bool(opt.default), help=opt.help)(f)
             continue
-        key, sep, val = item.partition("=")
-        key = key.strip()
-        if not sep or key not in allowed:
-            raise click.BadParameter(
-                f"{what}: expected NAME=VALUE with NAME in {', '.join(allowed)}, got {item!r}"
-            )
-        out[key] = val.strip()
-    return out
+        f = click.option(
+            opt.flag,
+            opt.name,
+            type=_click_type(opt),
+            default=opt.default,
+            show_default=opt.default is not None,
+            help=opt.help,
+        )(f)
+    return f
 
 
 @click.command("select")
-@click.option("--mission", default="precision-agriculture", show_default=True, help="Mission id (Table 18).")
-@click.option(
-    "--range", "range_m", type=POSITIVE, default=1500.0, show_default=True, help="Mission range (m)."
-)
-@click.option(
-    "--resolution", type=POSITIVE, default=0.05, show_default=True, help="Ground resolution (m/px)."
-)
-@click.option("--image-size", default="70x70", show_default=True, help="Target size LENGTHxWIDTH (m).")
-@click.option("--altitude", type=POSITIVE, default=50.0, show_default=True, help="Flight altitude AGL (m).")
-@click.option("--imagery", default="multispectral", show_default=True, help="Camera type, or 'any'.")
-@click.option("--wind", type=NON_NEGATIVE, default=5.0, show_default=True, help="Wind speed (m/s).")
-@click.option("--rain", is_flag=True, help="The flight must be possible in rain.")
-@click.option(
-    "--speed", type=NON_NEGATIVE, default=None, help="Required ground speed against the wind (m/s)."
-)
-@click.option(
-    "--order-by",
-    type=click.Choice(_PARAMS),
-    default="cost",
-    show_default=True,
-    help="Most important parameter: its weight is 1.25 (eq. 61 with cost first).",
-)
-@click.option(
-    "--weights", default=None, help="Explicit weights, e.g. range=1,weight=0.75,cost=1.25,resolution=1."
-)
-@click.option(
-    "--targets",
-    default=None,
-    help="TARGET:LIMIT per parameter, e.g. range=5000:1500,weight=800:1600,cost=4000:7000,"
-    "resolution=0.01:0.06.",
-)
-@click.option("--jurisdiction", default="easa", show_default=True, help="Regulations: easa | faa.")
-@click.option("--category", default=None, help="Category (default: open for easa, part107 for faa).")
-@click.option("--db", "db", default=None, help="UAS/camera database: path or http(s) URL.")
-@click.option("--regulations", "regs", default=None, help="Regulations database: path or URL.")
-@click.option("--matrices", default=None, help="Compliance matrices: path or URL.")
-@click.option(
-    "--top", type=click.IntRange(1, 1000), default=10, show_default=True, help="Configurations listed."
-)
+@_options
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def command(
-    mission: str,
-    range_m: float,
-    resolution: float,
-    image_size: str,
-    altitude: float,
-    imagery: str,
-    wind: float,
-    rain: bool,
-    speed: float | None,
-    order_by: str,
-    weights: str | None,
-    targets: str | None,
-    jurisdiction: str,
-    category: str | None,
-    db: str | None,
-    regs: str | None,
-    matrices: str | None,
-    top: int,
-    as_json: bool,
-) -> None:
+def command(as_json: bool, **options: Any) -> None:
     """Equipment, feasible UAS and cameras, and ranked UAS/camera configurations for a mission.
 
     Lists the equipment the mission needs (necessary marked *), the UAS and cameras passing the
@@ -113,73 +55,29 @@ def command(
     failed test and the margin, and the configurations ranked by the weighted score (eq. 61,
     lower is better).
     """
-    from uasnav.errors import InputError
-    from uasnav.mission import (
-        Requirements,
-        Targets,
-        Weights,
-        load_database,
-        load_matrices,
-        load_regulations,
-        select,
-    )
-    from uasnav.mission.regulations import DEFAULT_CATEGORY
+    from uasnav.mission import load_database, load_matrices, load_regulations
 
-    size = _parse_size(image_size)
-    if weights:
-        vals = _parse_pairs(weights, "--weights", _PARAMS)
-        try:
-            w = Weights(**{**Weights.order_by(order_by).__dict__, **{k: float(v) for k, v in vals.items()}})
-        except ValueError:
-            raise click.BadParameter(f"--weights: not numbers in {weights!r}") from None
-        ws = [w.range, w.weight, w.cost, w.resolution]
-        # Negative or all-zero weights would rank every configuration the same (or backwards)
-        # and still print a ranking.
-        if not all(math.isfinite(x) and x >= 0 for x in ws) or not any(x > 0 for x in ws):
-            raise click.BadParameter(
-                f"--weights: expected finite weights >= 0, at least one > 0, got {weights!r}"
-            )
-    else:
-        w = Weights.order_by(order_by)
-    t = Targets()
-    if targets:
-        names = {"range": "range_m", "weight": "weight_g", "cost": "cost_usd", "resolution": "resolution_deg"}
-        kw = {}
-        for k, v in _parse_pairs(targets, "--targets", _PARAMS).items():
-            a, sep, b = v.partition(":")
-            try:
-                kw[names[k]] = (float(a), float(b))
-            except ValueError:
-                raise click.BadParameter(f"--targets: {k}={v!r} is not TARGET:LIMIT") from None
-            if not sep or not all(math.isfinite(x) for x in kw[names[k]]) or a.strip() == b.strip():
-                raise click.BadParameter(f"--targets: {k}={v!r} is not TARGET:LIMIT")
-        t = Targets(**{**t.__dict__, **kw})
-    if category is None:
-        category = DEFAULT_CATEGORY.get(jurisdiction)
-        if category is None:
-            raise InputError(f"--jurisdiction {jurisdiction!r}: give --category too")
-    req = Requirements(
-        mission=mission,
-        range_m=range_m,
-        resolution_m=resolution,
-        image_size_m=size,
-        altitude_m=altitude,
-        imagery=None if imagery == "any" else imagery,
-        wind_ms=wind,
-        rain=rain,
-        speed_ms=speed,
-        jurisdiction=jurisdiction,
-        category=category,
-    )
+    sources = {o.name: options.pop(o.name) for o in SELECT_OPTIONS if o.kind == "source"}
+    try:
+        request = parse_select_options(options)
+    except OptionError as e:
+        # A malformed value is a usage error, like the typed options; a combination the
+        # regulations cannot resolve (no default category) stays a domain error (exit 1).
+        opt = next((o for o in SELECT_OPTIONS if o.name == e.option), None)
+        if opt is None or opt.kind not in ("size", "pairs"):
+            raise
+        raise click.BadParameter(str(e), param_hint=f"'{opt.flag}'") from None
     sel = select(
-        req,
-        database=load_database(db),
-        matrices=load_matrices(matrices),
-        regulations=load_regulations(regs),
-        targets=t,
-        weights=w,
-        top=top,
+        request.requirements,
+        database=load_database(sources["db"]),
+        matrices=load_matrices(sources["matrices"]),
+        regulations=load_regulations(sources["regulations"]),
+        targets=request.targets,
+        weights=request.weights,
+        top=request.top,
     )
+    req, w = request.requirements, request.weights
+    jurisdiction, category = req.jurisdiction, req.category
     if as_json:
         echo_json(sel.to_dict())
         return

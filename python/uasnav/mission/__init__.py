@@ -18,17 +18,27 @@ from uasnav.mission.feasibility import (
 from uasnav.mission.loading import fetch, load_document, parse_bytes, validate
 from uasnav.mission.matrices import Matrices, load_matrices
 from uasnav.mission.regulations import Regulations, load_regulations
+from uasnav.mission.request import (
+    SELECT_OPTIONS,
+    OptionError,
+    SelectRequest,
+    parse_select_options,
+    run_select,
+)
 from uasnav.mission.scoring import Targets, Weights, rank, score_matrix, transfer
 from uasnav.mission.selection import RankedPair, Selection, select
 
 __all__ = [
+    "SELECT_OPTIONS",
     "CameraTable",
     "Database",
     "Matrices",
+    "OptionError",
     "RankedPair",
     "Regulations",
     "Rejection",
     "Requirements",
+    "SelectRequest",
     "Selection",
     "Targets",
     "UasTable",
@@ -41,8 +51,10 @@ __all__ = [
     "load_regulations",
     "mission_time_s",
     "parse_bytes",
+    "parse_select_options",
     "rank",
     "required_hfov_deg",
+    "run_select",
     "score_matrix",
     "select",
     "transfer",
