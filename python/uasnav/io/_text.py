@@ -234,8 +234,8 @@ def _numeric_rows_fast(
     """:func:`numeric_rows` for the common case in one vectorised pass (≈ 2× faster on a large
     log), or ``None`` when some row needs the row-by-row reader's judgement: a ``"`` (quoting),
     rows of different widths, a cell that is not a finite number. The row-by-row reader then
-    finds the first offending cell and names it; numpy's str → float conversion calls Python's
-    ``float`` per cell, so both paths accept exactly the same cells."""
+    finds the first offending cell and names it, or accepts what ``float`` accepts and numpy
+    does not (``1_0``): both paths return the same values for every input."""
     body = lines[start:]
     keep = [k for k, ln in enumerate(body) if ln.strip()]
     if len(keep) < 2:
