@@ -1,0 +1,522 @@
+"""The web application of ``uasnav serve``: mission selection and trajectory prediction.
+
+One FastAPI application serves the HTML pages (Jinja2 templates, one stylesheet and one small
+script of this package: nothing from a CDN), the JSON API (``/api/…``) and its OpenAPI
+description (``/openapi.json``, rendered as a page at ``/api`` by the app itself). Pages and API
+call the same functions: :func:`uasnav.mission.request.run_select` on the documents loaded when
+the server started, and :mod:`uasnav.web.prediction`.
+
+Every page works without JavaScript: forms post, tables filter and sort through query
+parameters, downloads are links. Errors: a bad value is a 4xx naming the field (on a page, the
+message beside the field); anything unexpected is a 500 with a generic message, the details only
+in the server log.
+"""
+
+from __future__ import annotations
+
+import base64
+import logging
+import urllib.parse
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import HTMLResponse, JSONResponse, PlainTextResponse, RedirectResponse, Response
+from fastapi.staticfiles import StaticFiles
+from fastapi.templating import Jinja2Templates
+from starlette.datastructures import UploadFile
+
+from uasnav import __version__
+from uasnav.errors import DataFormatError, UasnavError
+from uasnav.jsonable import to_jsonable
+from uasnav.mission.database import Database, load_database
+from uasnav.mission.matrices import NECESSARY, Matrices, load_matrices
+from uasnav.mission.regulations import Regulations, load_regulations
+from uasnav.mission.request import SELECT_OPTIONS, OptionError, parse_select_options, run_select
+from uasnav.mission.scoring import PARAMETERS
+from uasnav.web import forms, prediction, selection_view, tables
+from uasnav.web.security import BodyTooLarge, GuardMiddleware
+
+log = logging.getLogger("uasnav.web")
+HERE = Path(__file__).parent
+
+#: Largest request body (bytes): a plan and a model upload with room to spare.
+MAX_BODY_BYTES = 16 * 2**20
+#: Largest JSON body of ``POST /api/select`` (bytes).
+MAX_JSON_BYTES = 256 * 2**10
+#: Multipart limits: files, fields, bytes per non-file part.
+MAX_FILES, MAX_FIELDS, MAX_PART_BYTES = 4, 64, 64 * 2**10
+#: Groups of the form, in the thesis' order (Figure 75); an option not named here is a
+#: requirement.
+GROUPS = (
+    ("Mission", ("mission",)),
+    ("Requirements", ()),
+    ("Weather", ("wind", "rain", "night", "temperature", "visibility")),
+    ("Regulations", ("jurisdiction", "category")),
+    ("Scoring", ("order_by", "weights", "targets", "top")),
+)
+GENERIC_500 = "internal server error: the details are in the server log"
+_SECURITY_HEADERS = {
+    "content-security-policy": (
+        "default-src 'self'; img-src 'self' data:; style-src 'self'; script-src 'self'; "
+        "form-action 'self'; frame-ancestors 'none'; base-uri 'none'"
+    ),
+    "x-content-type-options": "nosniff",
+    "referrer-policy": "no-referrer",
+    "x-frame-options": "DENY",
+}
+
+
+@dataclass
+class Documents:
+    """The documents the server loaded once at start (never named by a request)."""
+
+    database: Database
+    matrices: Matrices
+    regulations: Regulations
+    sources: dict[str, str] = field(default_factory=dict)
+
+
+def load_documents(db: str | None = None, matrices: str | None = None, regulations: str | None = None) -> Documents:
+    """Load (and validate) the three documents: paths, URLs, or the shipped copies."""
+    d = load_database(db)
+    m = load_matrices(matrices)
+    r = load_regulations(regulations)
+    return Documents(d, m, r, {"database": d.where, "matrices": m.source or "shipped", "regulations": r.where})
+
+
+class ApiError(Exception):
+    """A 4xx answer naming the field (or header) at fault."""
+
+    def __init__(self, status: int, field: str | None, message: str) -> None:
+        super().__init__(message)
+        self.status, self.field, self.message = status, field, message
+
+
+def _field_of(e: Exception) -> str | None:
+    return getattr(e, "option", None) or getattr(e, "field", None)
+
+
+def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = ()) -> Any:
+    """The ASGI application (FastAPI wrapped in the Host/Origin/size guard).
+
+    Parameters
+    ----------
+    docs : Documents, optional
+        Loaded database, matrices and regulations; default the shipped copies.
+    allowed_hosts : tuple of str
+        Host names this server answers to besides the loopback names.
+    """
+    docs = docs or load_documents()
+    app = FastAPI(
+        title="uasnav mission planner",
+        version=__version__,
+        description="Mission selection (thesis §5.2) and trajectory prediction (thesis §5.1).",
+        docs_url=None,
+        redoc_url=None,
+    )
+    templates = Jinja2Templates(directory=str(HERE / "templates"))
+    templates.env.globals.update(version=__version__, sources=docs.sources, parameters=PARAMETERS)
+    templates.env.filters["num"] = _num
+    app.mount("/static", StaticFiles(directory=str(HERE / "static")), name="static")
+    app.state.docs = docs
+
+    choices = _choices(docs)
+
+    # -- errors ------------------------------------------------------------------------------
+    def error_json(status: int, field: str | None, message: str) -> JSONResponse:
+        return JSONResponse({"error": message, "field": field}, status_code=status)
+
+    @app.exception_handler(ApiError)
+    async def _api_error(request: Request, e: ApiError) -> Response:
+        return error_json(e.status, e.field, e.message)
+
+    @app.exception_handler(RequestValidationError)
+    async def _validation(request: Request, e: RequestValidationError) -> Response:
+        err = e.errors()[0] if e.errors() else {}
+        loc = [str(x) for x in err.get("loc", ()) if x not in ("body", "query", "path")]
+        name = loc[-1] if loc else None
+        return error_json(422, name, f"{name}: {err.get('msg', 'invalid value')}")
+
+    @app.exception_handler(BodyTooLarge)
+    async def _too_large(request: Request, e: BodyTooLarge) -> Response:
+        return error_json(413, "body", str(e))
+
+    @app.exception_handler(Exception)
+    async def _internal(request: Request, e: Exception) -> Response:
+        log.exception("unexpected error on %s %s", request.method, request.url.path)
+        if request.url.path.startswith("/api"):
+            return error_json(500, None, GENERIC_500)
+        return HTMLResponse(
+            templates.get_template("error.html").render(request=request, message=GENERIC_500), status_code=500
+        )
+
+    @app.middleware("http")
+    async def _headers(request: Request, call_next: Any) -> Response:
+        response = await call_next(request)
+        for k, v in _SECURITY_HEADERS.items():
+            response.headers.setdefault(k, v)
+        return response
+
+    # -- mission selection ---------------------------------------------------------------------
+    def selection_page(
+        request: Request, values: dict[str, Any], errors: dict[str, str], result: dict[str, Any] | None, status: int
+    ) -> HTMLResponse:
+        ctx = {
+            "request": request,
+            "groups": _grouped(forms.form_fields(choices)),
+            "values": values,
+            "pairs": {o.name: forms.pair_values(values.get(o.name)) for o in SELECT_OPTIONS if o.kind == "pairs"},
+            "errors": errors,
+            "result": result,
+            "page": "select",
+        }
+        return templates.TemplateResponse(request, "select.html", ctx, status_code=status)
+
+    def run_view(values: dict[str, Any]) -> dict[str, Any]:
+        sel = _run_select(values, docs)
+        req = parse_select_options(values)
+        query = urllib.parse.urlencode({k: v for k, v in values.items() if v is not None})
+        equipment: dict[str, list[dict[str, Any]]] = {}
+        for e in sel["equipment"]:
+            equipment.setdefault(e["group"], []).append(e)
+        return {
+            "sel": sel,
+            "equipment": equipment,
+            "plots": selection_view.transfer_plots(sel, req.targets, docs.database),
+            "breakdown": selection_view.breakdown(sel),
+            "query": query,
+            "margin": selection_view.margin,
+            "necessary": NECESSARY,
+        }
+
+    @app.get("/", response_class=HTMLResponse, include_in_schema=False)
+    def index(request: Request) -> Response:
+        return selection_page(request, {}, {}, None, 200)
+
+    @app.post("/select", response_class=HTMLResponse, include_in_schema=False)
+    async def select_form(request: Request) -> Response:
+        form = await request.form(max_files=MAX_FILES, max_fields=MAX_FIELDS, max_part_size=MAX_PART_BYTES)
+        values = forms.values_from_form(form, form.getlist)
+        errors = forms.field_errors(values)
+        result = None
+        with forms.UploadDir() as uploads:
+            run_values = dict(values)
+            for opt in forms.form_fields(choices):
+                up = form.get(opt.name)
+                if opt.widget == "file" and isinstance(up, UploadFile) and up.filename:
+                    try:
+                        run_values[opt.name] = uploads.store(opt.name, await up.read(forms.MAX_OPTION_FILE_BYTES + 1))
+                    except OptionError as e:
+                        errors[e.option] = str(e)
+            if not errors:
+                try:
+                    result = run_view(run_values)
+                except (OptionError, ApiError) as e:
+                    errors[_field_of(e) or "form"] = getattr(e, "message", str(e))
+                except UasnavError as e:
+                    errors["form"] = str(e)
+        return selection_page(request, values, errors, result, 422 if errors else 200)
+
+    @app.get("/select/export.{fmt}", include_in_schema=False)
+    def select_export(request: Request, fmt: str, table: str = "ranking") -> Response:
+        values = dict(request.query_params)
+        values.pop("table", None)
+        if fmt not in ("json", "csv"):
+            raise ApiError(404, "format", f"format: {fmt!r} is not json or csv")
+        sel = _run_select(values, docs)
+        if fmt == "json":
+            return _download(JSONResponse(sel), "selection.json")
+        if table not in ("ranking", "rejections"):
+            raise ApiError(422, "table", f"table: {table!r} is not ranking or rejections")
+        text = selection_view.ranking_csv(sel) if table == "ranking" else selection_view.rejections_csv(sel)
+        return _download(PlainTextResponse(text, media_type="text/csv; charset=utf-8"), f"{table}.csv")
+
+    # -- database pages ---------------------------------------------------------------------------
+    def table_of(name: str) -> tables.Table:
+        makers = {
+            "uas": lambda: tables.uas_table(docs.database),
+            "cameras": lambda: tables.camera_table(docs.database),
+            "regulations": lambda: tables.regulations_table(docs.regulations),
+            "missions": lambda: tables.mission_table(docs.matrices),
+            "equipment": lambda: tables.equipment_table(docs.matrices),
+        }
+        if name not in makers:
+            raise ApiError(404, "table", f"table: {name!r} is not one of {', '.join(tables.TABLES)}")
+        return makers[name]()
+
+    @app.get("/db", include_in_schema=False)
+    def db_index() -> Response:
+        return RedirectResponse("/db/uas", status_code=303)
+
+    @app.get("/db/{name}", response_class=HTMLResponse, include_in_schema=False)
+    def db_page(request: Request, name: str, q: str = "", sort: str = "", desc: bool = False) -> Response:
+        cols, rows = tables.filter_sort(table_of(name), q[:200], sort, desc)
+        ctx = {
+            "request": request,
+            "name": name,
+            "title": tables.TABLES[name],
+            "tables": tables.TABLES,
+            "columns": cols,
+            "rows": rows,
+            "q": q[:200],
+            "sort": sort,
+            "desc": desc,
+            "page": "db",
+        }
+        return templates.TemplateResponse(request, "db.html", ctx)
+
+    # -- trajectory ---------------------------------------------------------------------------
+    def traj_page(request: Request, values: dict[str, Any], errors: dict[str, str], result: Any, status: int) -> Response:
+        ctx = {"request": request, "values": values, "errors": errors, "page": "trajectory", "result": None}
+        if result is not None:
+            csv_text = prediction.waypoints_csv(result)
+            ctx["result"] = result
+            ctx["drawing"] = prediction.route_drawing(result)
+            ctx["csv_href"] = "data:text/csv;base64," + base64.b64encode(csv_text.encode()).decode()
+            if result.origin is not None:
+                gj = prediction.to_json_text(prediction.waypoints_geojson(result))
+                ctx["geojson_href"] = "data:application/geo+json;base64," + base64.b64encode(gj.encode()).decode()
+        ctx["suffixes"] = ", ".join(prediction.PLAN_SUFFIXES)
+        return templates.TemplateResponse(request, "trajectory.html", ctx, status_code=status)
+
+    async def predict_from_form(form: Any) -> prediction.RoutePrediction:
+        plan = form.get("plan")
+        if not isinstance(plan, UploadFile) or not plan.filename:
+            raise prediction.FieldError("plan", "plan: choose a plan file")
+        data = await plan.read(prediction.MAX_UPLOAD_PLAN_BYTES + 1)
+        wind = prediction.parse_number("wind_speed", form.get("wind_speed") or "0", 0.0, prediction.MAX_WIND_MS)
+        wdir = prediction.parse_number("wind_from", form.get("wind_from") or "0", -360.0, 360.0)
+        speed_text = form.get("speed") or ""
+        speed = (
+            prediction.parse_number("speed", speed_text, 0.0, prediction.MAX_SPEED_MS, lo_open=True)
+            if str(speed_text).strip()
+            else None
+        )
+        plan_ne, origin = prediction.read_uploaded_plan(plan.filename, data)
+        up = form.get("model")
+        if isinstance(up, UploadFile) and up.filename:
+            model = prediction.read_uploaded_model(await up.read(prediction.MAX_UPLOAD_MODEL_BYTES + 1))
+            name = "uploaded model"
+        else:
+            from uasnav.web.default_model import default_model
+
+            model, name = default_model(), "built-in model (simulated flights)"
+        try:
+            return prediction.predict_plan(model, plan_ne, origin, wind, wdir, speed, name)
+        except UasnavError as e:
+            raise prediction.FieldError("plan", f"plan: {e}") from None
+
+    @app.get("/trajectory", response_class=HTMLResponse, include_in_schema=False)
+    def trajectory_form(request: Request) -> Response:
+        return traj_page(request, {}, {}, None, 200)
+
+    @app.post("/trajectory", response_class=HTMLResponse, include_in_schema=False)
+    async def trajectory_post(request: Request) -> Response:
+        form = await request.form(max_files=MAX_FILES, max_fields=MAX_FIELDS, max_part_size=MAX_PART_BYTES)
+        values = {k: v for k, v in form.items() if isinstance(v, str)}
+        try:
+            result = await predict_from_form(form)
+        except prediction.FieldError as e:
+            return traj_page(request, values, {e.field: str(e)}, None, 422)
+        return traj_page(request, values, {}, result, 200)
+
+    # -- JSON API -----------------------------------------------------------------------------------
+    @app.post(
+        "/api/select",
+        tags=["mission"],
+        summary="Run the mission selector (same answer as `uasnav select --json`)",
+        openapi_extra={
+            "requestBody": {"required": True, "content": {"application/json": {"schema": select_schema()}}},
+            "responses": {"422": {"description": "A bad value; `field` names the option."}},
+        },
+    )
+    async def api_select(request: Request) -> Response:
+        body = await _json_body(request)
+        if not isinstance(body, dict):
+            raise ApiError(422, "body", "body: expected a JSON object of selector options")
+        return JSONResponse(_run_select(body, docs))
+
+    @app.get("/api/options", tags=["mission"], summary="The selector's options (names, kinds, units, defaults)")
+    def api_options() -> Response:
+        return JSONResponse(
+            [
+                {
+                    "name": o.name,
+                    "kind": o.kind,
+                    "default": to_jsonable(o.default),
+                    "unit": o.unit,
+                    "minimum": o.minimum,
+                    "maximum": o.maximum,
+                    "choices": list(o.choices) if o.choices else None,
+                    "label": o.label,
+                    "help": o.help,
+                }
+                for o in SELECT_OPTIONS
+                if forms.is_field(o)
+            ]
+        )
+
+    @app.get("/api/db/{name}", tags=["database"], summary="A database table: uas, cameras, regulations, missions, equipment")
+    def api_db(name: str, q: str = "", sort: str = "", desc: bool = False) -> Response:
+        cols, rows = tables.filter_sort(table_of(name), q[:200], sort, desc)
+        return JSONResponse(to_jsonable({"table": name, "columns": cols, "rows": rows}))
+
+    @app.post(
+        "/api/trajectory/predict",
+        tags=["trajectory"],
+        summary="Predict element times, ETA and 4D waypoint times of an uploaded plan",
+        openapi_extra={
+            "requestBody": {
+                "required": True,
+                "content": {
+                    "multipart/form-data": {
+                        "schema": {
+                            "type": "object",
+                            "required": ["plan"],
+                            "properties": {
+                                "plan": {"type": "string", "format": "binary", "description": "Plan file (CSV lat,lon,alt or north,east)"},
+                                "model": {"type": "string", "format": "binary", "description": "Model JSON of `uasnav trajectory train` (default: built-in)"},
+                                "wind_speed": {"type": "number", "minimum": 0, "maximum": 100, "description": "m/s"},
+                                "wind_from": {"type": "number", "description": "deg from north, where the wind comes from"},
+                                "speed": {"type": "number", "exclusiveMinimum": 0, "description": "commanded speed m/s"},
+                                "format": {"type": "string", "enum": ["json", "csv", "geojson"]},
+                            },
+                        }
+                    }
+                },
+            }
+        },
+    )
+    async def api_predict(request: Request) -> Response:
+        if not request.headers.get("content-type", "").startswith("multipart/form-data"):
+            raise ApiError(415, "content-type", "content-type: expected multipart/form-data with a plan file")
+        form = await request.form(max_files=MAX_FILES, max_fields=MAX_FIELDS, max_part_size=MAX_PART_BYTES)
+        fmt = form.get("format") or "json"
+        if fmt not in ("json", "csv", "geojson"):
+            raise ApiError(422, "format", f"format: {fmt!r} is not json, csv or geojson")
+        try:
+            r = await predict_from_form(form)
+            if fmt == "csv":
+                return PlainTextResponse(prediction.waypoints_csv(r), media_type="text/csv; charset=utf-8")
+            if fmt == "geojson":
+                return JSONResponse(to_jsonable(prediction.waypoints_geojson(r)), media_type="application/geo+json")
+        except prediction.FieldError as e:
+            raise ApiError(422, e.field, str(e)) from None
+        return JSONResponse(to_jsonable(r.to_dict()))
+
+    @app.get("/api", response_class=HTMLResponse, include_in_schema=False)
+    def api_docs(request: Request) -> Response:
+        return templates.TemplateResponse(request, "api.html", {"request": request, "spec": app.openapi(), "page": "api"})
+
+    return GuardMiddleware(app, allowed_hosts, MAX_BODY_BYTES)
+
+
+def select_schema() -> dict[str, Any]:
+    """JSON schema of ``POST /api/select``'s body, from the option table."""
+    props: dict[str, Any] = {}
+    for o in SELECT_OPTIONS:
+        if not forms.is_field(o):
+            continue
+        s: dict[str, Any] = {"description": o.help + (f" Unit: {o.unit}." if o.unit else "")}
+        kind_types = {"real": "number", "int": "integer", "flag": "boolean", "choice": "string", "text": "string"}
+        if o.kind in kind_types:
+            s["type"] = kind_types[o.kind]
+        if o.minimum is not None:
+            s["exclusiveMinimum" if o.minimum_open else "minimum"] = o.minimum
+        if o.maximum is not None:
+            s["maximum"] = o.maximum
+        if o.choices:
+            s["enum"] = list(o.choices)
+        if o.default is not None:
+            s["default"] = to_jsonable(o.default)
+        props[o.name] = s
+    return {"type": "object", "additionalProperties": False, "properties": props}
+
+
+async def _json_body(request: Request) -> Any:
+    from uasnav import jsoncheck
+
+    ctype = request.headers.get("content-type", "")
+    if not ctype.split(";")[0].strip().lower() == "application/json":
+        # also a CSRF guard: a cross-site HTML form cannot send application/json
+        raise ApiError(415, "content-type", "content-type: expected application/json")
+    raw = b""
+    async for chunk in request.stream():
+        raw += chunk
+        if len(raw) > MAX_JSON_BYTES:
+            raise ApiError(413, "body", f"body: over {MAX_JSON_BYTES} bytes")
+    try:
+        return jsoncheck.parse(raw.decode("utf-8"), "body: not valid JSON")
+    except UnicodeDecodeError:
+        raise ApiError(400, "body", "body: not UTF-8") from None
+    except DataFormatError as e:
+        raise ApiError(400, "body", str(e)) from None
+
+
+def _run_select(values: dict[str, Any], docs: Documents) -> dict[str, Any]:
+    """``run_select`` on the server's documents, as the JSON ``uasnav select --json`` prints;
+    a bad value is an :class:`ApiError` 422 naming the option."""
+    for key in values:
+        opt = next((o for o in SELECT_OPTIONS if o.name == key), None)
+        if opt is not None and not forms.is_field(opt):
+            raise ApiError(422, key, f"{key}: data sources are set when the server starts, not by a request")
+    mission = values.get("mission")
+    if isinstance(mission, str) and mission.strip() and mission.strip() not in docs.matrices.missions:
+        known = ", ".join(docs.matrices.missions)
+        raise ApiError(422, "mission", f"mission: unknown mission {mission!r}; known: {known}")
+    jur = values.get("jurisdiction")
+    if isinstance(jur, str) and jur.strip() and jur.strip() not in docs.regulations.jurisdictions:
+        known = ", ".join(docs.regulations.jurisdictions)
+        raise ApiError(422, "jurisdiction", f"jurisdiction: unknown jurisdiction {jur!r}; known: {known}")
+    try:
+        sel = run_select(values, database=docs.database, matrices=docs.matrices, regulations=docs.regulations)
+    except OptionError as e:
+        raise ApiError(422, e.option, str(e)) from None
+    except UasnavError as e:
+        raise ApiError(422, None, str(e)) from None
+    return to_jsonable(sel.to_dict())
+
+
+def _download(resp: Response, filename: str) -> Response:
+    resp.headers["content-disposition"] = f'attachment; filename="{filename}"'
+    return resp
+
+
+def _choices(docs: Documents) -> dict[str, tuple[tuple[str, str], ...]]:
+    """Choices the loaded documents offer for text options."""
+    types = sorted(set(docs.database.cameras.types))
+    cats: dict[str, str] = {"": "default for the regulations"}
+    for jid, j in docs.regulations.jurisdictions.items():
+        for cid in j.categories:
+            cats.setdefault(cid, f"{cid} ({jid})")
+    return {
+        "mission": tuple((mid, f"{m.name}") for mid, m in docs.matrices.missions.items()),
+        "imagery": (("any", "any"), *((t, t) for t in types)),
+        "jurisdiction": tuple((jid, f"{jid.upper()} — {j.name}") for jid, j in docs.regulations.jurisdictions.items()),
+        "category": tuple(cats.items()),
+    }
+
+
+def _grouped(fields: list[forms.FormField]) -> list[tuple[str, list[forms.FormField]]]:
+    named = {n: g for g, names in GROUPS for n in names}
+    out: dict[str, list[forms.FormField]] = {g: [] for g, _ in GROUPS}
+    for f in fields:
+        out[named.get(f.name, "Requirements")].append(f)
+    return [(g, fs) for g, fs in out.items() if fs]
+
+
+def _num(x: Any, digits: int = 2) -> str:
+    """A number for a table cell: fixed decimals, thousands separated; '—' for none."""
+    if x is None:
+        return "—"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, int | float):
+        return f"{x:,.{digits}f}"
+    return str(x)
+
+
+__all__ = ["Documents", "create_app", "load_documents", "select_schema"]

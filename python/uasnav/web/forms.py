@@ -1,0 +1,182 @@
+"""The mission-selection form, generated from the selector's one option table.
+
+Every entry of :data:`uasnav.mission.request.SELECT_OPTIONS` that a request may carry becomes
+one form field, named as the API key, with its label, unit, default and help; the command line
+builds its options from the same table, so the form, ``POST /api/select`` and ``uasnav select``
+cannot drift apart. Kinds are handled generically: a kind this module does not know is a text
+field (its value goes to :func:`~uasnav.mission.request.parse_select_options` as typed), a file
+kind is an upload field, and data sources and output paths are never fields.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from uasnav.mission.request import OptionError, SelectOption, parse_select_options, request_options
+from uasnav.mission.scoring import PARAMETERS
+
+#: Kinds naming a file the request uploads (the server stores it in a temporary directory).
+FILE_KINDS = frozenset({"file", "input_file", "infile", "upload", "path", "input"})
+#: Kinds that are never form fields: server-side sources and output files.
+NOT_FIELDS = frozenset({"source", "output", "output_file", "outfile", "output_path", "out"})
+#: Largest uploaded option file (bytes).
+MAX_OPTION_FILE_BYTES = 4 * 2**20
+
+
+def is_field(opt: SelectOption) -> bool:
+    """Whether ``opt`` is a form field (and an API key)."""
+    return opt.kind not in NOT_FIELDS and not opt.kind.startswith("output")
+
+
+def widget(opt: SelectOption) -> str:
+    """The field's widget: number, text, select, checkbox, file or pairs."""
+    if opt.kind in FILE_KINDS or opt.kind.endswith("file"):
+        return "file"
+    return {
+        "real": "number",
+        "int": "number",
+        "flag": "checkbox",
+        "choice": "select",
+        "pairs": "pairs",
+    }.get(opt.kind, "text")
+
+
+@dataclass(frozen=True)
+class FormField:
+    """One rendered field: the option plus the choices the loaded documents offer."""
+
+    option: SelectOption
+    widget: str
+    choices: tuple[tuple[str, str], ...] | None
+    default_text: str
+
+    @property
+    def name(self) -> str:
+        return self.option.name
+
+
+def default_text(opt: SelectOption) -> str:
+    """The option's default as typed in a form ("" for none)."""
+    d = opt.default
+    if d is None or isinstance(d, bool):
+        return ""
+    if isinstance(d, float):
+        return f"{d:g}"
+    return str(d)
+
+
+def form_fields(choices: Mapping[str, tuple[tuple[str, str], ...]]) -> list[FormField]:
+    """The form's fields in the table's order; ``choices`` maps an option name to the
+    (value, label) pairs the loaded documents offer (missions, imagery types, jurisdictions)."""
+    out = []
+    for opt in request_options():
+        if not is_field(opt):
+            continue
+        w = widget(opt)
+        ch = None
+        if opt.name in choices:
+            ch, w = choices[opt.name], "select"
+        elif opt.choices is not None:
+            ch = tuple((c, c) for c in opt.choices)
+        out.append(FormField(opt, w, ch, default_text(opt)))
+    return out
+
+
+def field_names() -> set[str]:
+    """The option names the form (and the API) take."""
+    return {o.name for o in request_options() if is_field(o)}
+
+
+def values_from_form(form: Mapping[str, Any], getlist: Any) -> dict[str, Any]:
+    """Form data → option values as text (blank fields are left out: they take defaults).
+
+    ``pairs`` options come as one sub-field per scored parameter (``weights.cost``), joined
+    into ``cost=1.25,…``; a checkbox is preceded by a hidden ``false`` so the last value wins.
+    """
+    values: dict[str, Any] = {}
+    for opt in request_options():
+        if not is_field(opt) or widget(opt) == "file":
+            continue
+        w = widget(opt)
+        if w == "pairs":
+            parts = []
+            for p in PARAMETERS:
+                v = form.get(f"{opt.name}.{p}")
+                if isinstance(v, str) and v.strip():
+                    parts.append(f"{p}={v.strip()}")
+            if parts:
+                values[opt.name] = ",".join(parts)
+            elif isinstance(form.get(opt.name), str) and form[opt.name].strip():
+                values[opt.name] = form[opt.name]
+            continue
+        got = [v for v in getlist(opt.name) if isinstance(v, str)]
+        if not got:
+            continue
+        v = got[-1]
+        if w == "checkbox" or v.strip():
+            values[opt.name] = v
+    return values
+
+
+def pair_values(text: str | None) -> dict[str, str]:
+    """``"range=1,cost=2"`` → {"range": "1", "cost": "2"} for re-filling the sub-fields."""
+    out: dict[str, str] = {}
+    for item in (text or "").split(","):
+        k, sep, v = item.partition("=")
+        if sep and k.strip() in PARAMETERS:
+            out[k.strip()] = v.strip()
+    return out
+
+
+def field_errors(values: Mapping[str, Any]) -> dict[str, str]:
+    """Every field's own error (each option parsed alone), so the form shows them all at once."""
+    errors = {}
+    for name, value in values.items():
+        try:
+            parse_select_options({name: value})
+        except OptionError as e:
+            errors[e.option] = str(e)
+    return errors
+
+
+class UploadDir:
+    """A temporary directory holding a request's uploaded option files, removed on exit."""
+
+    def __init__(self) -> None:
+        self._tmp: tempfile.TemporaryDirectory[str] | None = None
+
+    def store(self, option: str, data: bytes) -> str:
+        """Write ``data`` under a fixed name of ours; returns the path passed to the parser."""
+        if len(data) > MAX_OPTION_FILE_BYTES:
+            raise OptionError(option, f"{option}: file over {MAX_OPTION_FILE_BYTES} bytes")
+        if self._tmp is None:
+            self._tmp = tempfile.TemporaryDirectory(prefix="uasnav-upload-")
+        p = Path(self._tmp.name) / f"{option}.upload"
+        p.write_bytes(data)
+        return str(p)
+
+    def __enter__(self) -> UploadDir:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._tmp is not None:
+            self._tmp.cleanup()
+
+
+__all__ = [
+    "FILE_KINDS",
+    "NOT_FIELDS",
+    "FormField",
+    "UploadDir",
+    "field_errors",
+    "field_names",
+    "form_fields",
+    "is_field",
+    "pair_values",
+    "values_from_form",
+    "widget",
+]
