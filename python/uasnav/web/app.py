@@ -64,7 +64,8 @@ _SECURITY_HEADERS = {
         "form-action 'self'; frame-ancestors 'none'; base-uri 'none'"
     ),
     "x-content-type-options": "nosniff",
-    "referrer-policy": "no-referrer",
+    # no-referrer would make the browser send "Origin: null" on our own form posts
+    "referrer-policy": "same-origin",
     "x-frame-options": "DENY",
 }
 
