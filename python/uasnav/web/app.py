@@ -296,7 +296,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             if str(speed_text).strip()
             else None
         )
-        plan_ne, origin = prediction.read_uploaded_plan(plan.filename, data)
+        up_plan = prediction.read_uploaded_plan(plan.filename, data)
         up = form.get("model")
         if isinstance(up, UploadFile) and up.filename:
             model = prediction.read_uploaded_model(await up.read(prediction.MAX_UPLOAD_MODEL_BYTES + 1))
@@ -305,8 +305,10 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             from uasnav.web.default_model import default_model
 
             model, name = default_model(), "built-in model (simulated flights)"
+        if speed is None and up_plan.cruise_ms is not None:
+            speed, name = up_plan.cruise_ms, f"{name}; speed from the plan"
         try:
-            return prediction.predict_plan(model, plan_ne, origin, wind, wdir, speed, name)
+            return prediction.predict_plan(model, up_plan.route_ne, up_plan.origin, wind, wdir, speed, name)
         except UasnavError as e:
             raise prediction.FieldError("plan", f"plan: {e}") from None
 

@@ -22,12 +22,13 @@ from typing import Any
 import numpy as np
 
 from uasnav.errors import DataFormatError, InputError, UasnavError
+from uasnav.io.plans import MAX_PLAN_BYTES, PLAN_EXTENSIONS, plan_cruise_speed, plan_route, read_plan
 from uasnav.trajectory.features import wind_vector
-from uasnav.trajectory.plans import MAX_PLAN_BYTES, read_plan
 from uasnav.trajectory.predictor import MAX_MODEL_BYTES, TrajectoryPredictor
 
-#: Plan formats accepted, by file-name suffix.
-PLAN_SUFFIXES = (".csv",)
+#: Plan formats accepted, by file-name suffix (the readers of :mod:`uasnav.io.plans`):
+#: QGroundControl ``.plan``, Mission Planner ``.waypoints``/``.txt``, uasnav's ``.csv``.
+PLAN_SUFFIXES = PLAN_EXTENSIONS
 #: Largest uploaded plan and model (bytes).
 MAX_UPLOAD_PLAN_BYTES = min(MAX_PLAN_BYTES, 4 * 2**20)
 MAX_UPLOAD_MODEL_BYTES = min(MAX_MODEL_BYTES, 8 * 2**20)
@@ -56,8 +57,18 @@ def _write_upload(tmp: Path, stem: str, suffix: str, data: bytes) -> Path:
     return p
 
 
-def read_uploaded_plan(filename: str, data: bytes) -> tuple[np.ndarray, tuple[float, float, float] | None]:
-    """Parse an uploaded plan: (waypoints north/east m, geodetic origin or None).
+@dataclass(frozen=True)
+class UploadedPlan:
+    """An uploaded plan's horizontal route (north/east m, shape (n, 2)), geodetic origin (lat
+    deg, lon deg, alt m; None for a local plan) and commanded cruise speed (m/s, if given)."""
+
+    route_ne: np.ndarray
+    origin: tuple[float, float, float] | None
+    cruise_ms: float | None
+
+
+def read_uploaded_plan(filename: str, data: bytes) -> UploadedPlan:
+    """Parse an uploaded plan with :func:`uasnav.io.plans.read_plan` (format by suffix).
 
     Raises
     ------
@@ -79,12 +90,13 @@ def read_uploaded_plan(filename: str, data: bytes) -> tuple[np.ndarray, tuple[fl
     with tempfile.TemporaryDirectory(prefix="uasnav-plan-") as tmp:
         path = _write_upload(Path(tmp), "plan", suffix, data)
         try:
-            plan_ne, origin = read_plan(path)
+            plan = read_plan(path)
+            route, origin = plan_route(plan)
         except UasnavError as e:
             raise FieldError("plan", "plan: " + str(e).replace(str(path), filename or "plan")) from None
-    if plan_ne.shape[0] < 2:
-        raise FieldError("plan", "plan: needs at least two waypoints")
-    return plan_ne, origin
+    if route.shape[0] < 2:
+        raise FieldError("plan", "plan: needs at least two positioned waypoints")
+    return UploadedPlan(np.asarray(route, dtype=float)[:, :2], origin, plan_cruise_speed(plan))
 
 
 def read_uploaded_model(data: bytes) -> TrajectoryPredictor:
@@ -262,7 +274,15 @@ def route_drawing(r: RoutePrediction, width: float = 640.0, pad: float = 28.0) -
     for e in r.elements:
         poly = " ".join("%.2f,%.2f" % xy(pe, pn) for pn, pe in e["path_ne_m"])
         elements.append({"points": poly, "low": e["low_confidence"], "element": e["element"], "time_s": e["time_s"]})
-    wps = [{**w, "x": xy(w["east_m"], w["north_m"])[0], "y": xy(w["east_m"], w["north_m"])[1]} for w in r.waypoints]
+    # one label per drawn point: a closed route's first and last waypoints share theirs
+    labels: dict[tuple[float, float], list[str]] = {}
+    for w in r.waypoints:
+        labels.setdefault(xy(w["east_m"], w["north_m"]), []).append(f"{w['waypoint']} · {w['time_s']:.1f} s")
+    wps = [
+        # labels right of the point, or left of it near the right edge so none is cut off
+        {"x": x, "y": y, "label": " / ".join(texts), "anchor": "end" if x > 0.6 * width else "start"}
+        for (x, y), texts in labels.items()
+    ]
     target = max(span) / 4
     mag = 10 ** math.floor(math.log10(target))
     bar_m = max(m * mag for m in (1, 2, 5) if m * mag <= target) if target >= mag else mag
@@ -290,6 +310,7 @@ __all__ = [
     "DataFormatError",
     "FieldError",
     "RoutePrediction",
+    "UploadedPlan",
     "parse_number",
     "predict_plan",
     "read_uploaded_model",
