@@ -154,13 +154,6 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             templates.get_template("error.html").render(request=request, message=GENERIC_500), status_code=500
         )
 
-    @app.middleware("http")
-    async def _headers(request: Request, call_next: Any) -> Response:
-        response = await call_next(request)
-        for k, v in _SECURITY_HEADERS.items():
-            response.headers.setdefault(k, v)
-        return response
-
     # -- mission selection ---------------------------------------------------------------------
     def selection_page(
         request: Request, values: dict[str, Any], errors: dict[str, str], result: dict[str, Any] | None, status: int
@@ -414,7 +407,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
     def api_docs(request: Request) -> Response:
         return templates.TemplateResponse(request, "api.html", {"request": request, "spec": app.openapi(), "page": "api"})
 
-    return GuardMiddleware(app, allowed_hosts, MAX_BODY_BYTES)
+    return GuardMiddleware(app, allowed_hosts, MAX_BODY_BYTES, _SECURITY_HEADERS)
 
 
 def select_schema() -> dict[str, Any]:

@@ -12,7 +12,7 @@ and pass.
 from __future__ import annotations
 
 import json
-from collections.abc import Awaitable, Callable, Iterable, MutableMapping
+from collections.abc import Awaitable, Callable, Iterable, Mapping, MutableMapping
 from typing import Any
 
 Scope = MutableMapping[str, Any]
@@ -57,12 +57,23 @@ class GuardMiddleware:
         Host names (no port) this server answers to, besides :data:`LOOPBACK_HOSTS`.
     max_body_bytes : int
         Largest request body, bytes (declared by ``Content-Length`` or streamed).
+    headers : mapping of str to str, optional
+        Headers added to every response that does not set them (Content-Security-Policy …).
+        Done here, in plain ASGI, rather than in a Starlette ``BaseHTTPMiddleware``, which
+        costs a task and a stream per request.
     """
 
-    def __init__(self, app: ASGIApp, allowed_hosts: Iterable[str], max_body_bytes: int) -> None:
+    def __init__(
+        self,
+        app: ASGIApp,
+        allowed_hosts: Iterable[str],
+        max_body_bytes: int,
+        headers: Mapping[str, str] | None = None,
+    ) -> None:
         self.app = app
         self.allowed = {h.lower() for h in (*LOOPBACK_HOSTS, *allowed_hosts)}
         self.max_body_bytes = max_body_bytes
+        self.headers = [(k.lower().encode("latin-1"), v.encode("latin-1")) for k, v in (headers or {}).items()]
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
@@ -95,7 +106,20 @@ class GuardMiddleware:
                     await _refuse(send, 413, f"request body over {self.max_body_bytes} bytes", "body")
                     return
             receive = self._limited(receive)
-        await self.app(scope, receive, send)
+        await self.app(scope, receive, self._with_headers(send))
+
+    def _with_headers(self, send: Send) -> Send:
+        extra = self.headers
+        if not extra:
+            return send
+
+        async def inner(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                have = {k.lower() for k, _ in message.get("headers", [])}
+                message["headers"] = [*message.get("headers", []), *((k, v) for k, v in extra if k not in have)]
+            await send(message)
+
+        return inner
 
     def _limited(self, receive: Receive) -> Receive:
         """``receive`` that stops a streamed (chunked) body past the limit."""
