@@ -60,7 +60,9 @@ def client(port: int, stop_at: float, expected_first: str, out: list[float], fai
 def run(clients: int, duration_s: float) -> dict[str, float]:
     with running_server() as s:
         c = http.client.HTTPConnection("127.0.0.1", s.port, timeout=30)
-        c.request("POST", "/api/select", body=json.dumps(THESIS), headers={"content-type": "application/json"})
+        c.request(
+            "POST", "/api/select", body=json.dumps(THESIS), headers={"content-type": "application/json"}
+        )
         first = json.loads(c.getresponse().read())["ranking"][0]["uas"]
         c.close()
         lat: list[list[float]] = [[] for _ in range(clients)]
@@ -68,7 +70,8 @@ def run(clients: int, duration_s: float) -> dict[str, float]:
         t0 = time.perf_counter()
         stop_at = t0 + duration_s
         threads = [
-            threading.Thread(target=client, args=(s.port, stop_at, first, lat[i], failures)) for i in range(clients)
+            threading.Thread(target=client, args=(s.port, stop_at, first, lat[i], failures))
+            for i in range(clients)
         ]
         for t in threads:
             t.start()
@@ -100,7 +103,8 @@ def main() -> int:
         print(json.dumps(r))
     else:
         print(
-            f"uasnav serve /api/select, {r['clients']} clients x {r['duration_s']} s: {r['requests']} requests, "
+            f"uasnav serve /api/select, {r['clients']} clients x {r['duration_s']} s: "
+            f"{r['requests']} requests, "
             f"{r['failed']} failed, {r['throughput_rps']} req/s, p50 {r['p50_ms']} ms, p90 {r['p90_ms']} ms, "
             f"p99 {r['p99_ms']} ms, max {r['max_ms']} ms"
         )

@@ -70,7 +70,12 @@ def cli_json(values: dict) -> dict:
 
 @pytest.mark.parametrize(
     "values",
-    [THESIS, {}, {**THESIS, "order_by": "weight", "top": 3, "rain": True}, {"range": 300, "jurisdiction": "faa"}],
+    [
+        THESIS,
+        {},
+        {**THESIS, "order_by": "weight", "top": 3, "rain": True},
+        {"range": 300, "jurisdiction": "faa"},
+    ],
 )
 def test_api_select_is_what_the_cli_prints(client, values) -> None:
     r = client.post("/api/select", json=values)
@@ -94,7 +99,9 @@ def test_form_renders_every_field(client) -> None:
         assert f'data-field="{name}"' in html, name
     for o in SELECT_OPTIONS:
         if o.unit and forms.is_field(o) and forms.widget(o) not in ("pairs", "checkbox"):
-            assert re.search(rf'for="f-{o.name}">[^<]*<span class="unit">\({re.escape(o.unit)}\)', html), o.name
+            assert re.search(rf'for="f-{o.name}">[^<]*<span class="unit">\({re.escape(o.unit)}\)', html), (
+                o.name
+            )
     assert 'name="db"' not in html and 'name="matrices"' not in html
 
 
@@ -136,7 +143,9 @@ def test_api_select_hostile_bodies(client) -> None:
     assert post(b"[" * 100_000 + b"]" * 100_000).status_code in (400, 413)
     assert post(b'{"range": NaN}').json()["field"] == "range"
     assert post(b'{"a": "' + b"x" * (300 * 1024) + b'"}').status_code == 413
-    big = client.post("/api/select", content=b"x" * (17 * 2**20), headers={"content-type": "application/json"})
+    big = client.post(
+        "/api/select", content=b"x" * (17 * 2**20), headers={"content-type": "application/json"}
+    )
     assert big.status_code == 413
 
 
@@ -213,7 +222,9 @@ def test_bad_values_are_shown_beside_their_fields(client) -> None:
     r = client.post("/select", data={"range": "-5", "wind": "fast", "weights.cost": "-1", "altitude": "50"})
     assert r.status_code == 422
     for field in ("range", "wind", "weights"):
-        m = re.search(rf'data-field="{field}".*?<span class="msg" id="e-{field}" role="alert">([^<]*)<', r.text, re.S)
+        m = re.search(
+            rf'data-field="{field}".*?<span class="msg" id="e-{field}" role="alert">([^<]*)<', r.text, re.S
+        )
         assert m and m.group(1).startswith(field + ":"), field
     assert 'id="e-altitude" role="alert"></span>' in r.text
     assert 'value="-5"' in r.text  # what the operator typed is kept
@@ -305,20 +316,26 @@ def test_predict_api_matches_the_predictor(client, tmp_path) -> None:
     r2 = client.post("/api/trajectory/predict", files={"plan": ("a.plan", qgc.read_bytes())}, data=form)
     assert r2.json()["waypoint_times_s"] == pytest.approx(out["waypoint_times_s"], abs=1e-6)
     gj = client.post(
-        "/api/trajectory/predict", files={"plan": ("a.csv", p.read_bytes())}, data={**form, "format": "geojson"}
+        "/api/trajectory/predict",
+        files={"plan": ("a.csv", p.read_bytes())},
+        data={**form, "format": "geojson"},
     ).json()
     assert gj["type"] == "FeatureCollection"
     assert [f["properties"]["time_s"] for f in gj["features"][:-1]] == pytest.approx(out["waypoint_times_s"])
     first = gj["features"][0]["geometry"]["coordinates"]
     assert first == pytest.approx([8.5456, 47.3977], abs=1e-7)
-    c = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p.read_bytes())}, data={**form, "format": "csv"})
+    c = client.post(
+        "/api/trajectory/predict", files={"plan": ("a.csv", p.read_bytes())}, data={**form, "format": "csv"}
+    )
     rows = list(csv.DictReader(io.StringIO(c.text)))
     assert [float(x["time_s"]) for x in rows] == pytest.approx(out["waypoint_times_s"], abs=1e-3)
 
 
 def test_predict_page_without_javascript(client, tmp_path) -> None:
     p = _plan_csv(tmp_path)
-    r = client.post("/trajectory", files={"plan": ("a.csv", p.read_bytes())}, data={"wind_speed": "3", "wind_from": "90"})
+    r = client.post(
+        "/trajectory", files={"plan": ("a.csv", p.read_bytes())}, data={"wind_speed": "3", "wind_from": "90"}
+    )
     assert r.status_code == 200 and 'id="prediction"' in r.text
     assert "data:text/csv;base64," in r.text and "data:application/geo+json;base64," in r.text
     assert r.text.count('<circle class="wp"') >= 4
@@ -359,7 +376,9 @@ def test_uploaded_model_is_used(client, tmp_path) -> None:
     path = tmp_path / "m.json"
     m.save(path)
     p = _plan_csv(tmp_path).read_bytes()
-    a = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p), "model": ("m.json", path.read_bytes())})
+    a = client.post(
+        "/api/trajectory/predict", files={"plan": ("a.csv", p), "model": ("m.json", path.read_bytes())}
+    )
     b = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p)})
     assert a.json()["model"] == "uploaded model"
     assert a.json()["waypoint_times_s"] == pytest.approx(b.json()["waypoint_times_s"])

@@ -139,7 +139,9 @@ def test_thesis_scenario_matches_the_cli(pages, server) -> None:
         items = page.locator("dl.equipment li").all_inner_texts()
         assert len(items) == len(expected["equipment"])
         for text, e in zip(items, expected["equipment"], strict=True):
-            assert text.upper().startswith("NECESSARY" if e["necessary"] else "OPTIONAL") and e["name"] in text
+            assert (
+                text.upper().startswith("NECESSARY" if e["necessary"] else "OPTIONAL") and e["name"] in text
+            )
         assert page.locator("#rejections tbody tr").count() == len(expected["rejections"])
         assert page.locator("figure.plot").count() == 4  # Figure 74, one per scored parameter
         shot(page, f"select-results-{tag}")
@@ -153,7 +155,9 @@ def test_ranking_sorts_and_downloads(pages, server) -> None:
     page.click("#select-form button[type=submit]")
     page.wait_for_selector("#results")
     page.click("#ranking th:has-text('Cost (USD)')")
-    costs = [float(x.replace(",", "")) for x in page.locator("#ranking tbody tr td:nth-child(7)").all_inner_texts()]
+    costs = [
+        float(x.replace(",", "")) for x in page.locator("#ranking tbody tr td:nth-child(7)").all_inner_texts()
+    ]
     assert costs == sorted(costs)
     with page.expect_download() as d:
         page.click("a:has-text('JSON')")
@@ -189,7 +193,8 @@ def test_keyboard_only(pages, server) -> None:
     page = pages.new()
     page.goto(server.url + "/")
     order = page.eval_on_selector_all(
-        "#select-form input:not([type=hidden]), #select-form select, #select-form button", "els => els.map(e => e.id || e.type)"
+        "#select-form input:not([type=hidden]), #select-form select, #select-form button",
+        "els => els.map(e => e.id || e.type)",
     )
     seen: list[str] = []
     page.keyboard.press("Tab")
@@ -244,7 +249,12 @@ def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
         page.fill("#t-speed", "3.33")
         page.click("#trajectory-form button[type=submit]")
         page.wait_for_selector("#prediction")
-        times = [float(x) for x in page.eval_on_selector_all("#waypoints td[data-time]", "els => els.map(e => e.dataset.time)")]
+        times = [
+            float(x)
+            for x in page.eval_on_selector_all(
+                "#waypoints td[data-time]", "els => els.map(e => e.dataset.time)"
+            )
+        ]
         assert times == pytest.approx(list(ref.waypoint_times_s), abs=1e-6)
         assert float(page.get_attribute("#eta", "data-eta")) == pytest.approx(ref.eta_s)
         low = page.locator("#elements tbody tr.low").count()

@@ -14,7 +14,13 @@ from uasnav.cli import main
 from uasnav.cli.serve import is_loopback
 from uasnav.web.process import running_server, uasnav_command
 
-THESIS = {"mission": "precision-agriculture", "range": 1500, "image_size": "70x70", "wind": 5, "order_by": "cost"}
+THESIS = {
+    "mission": "precision-agriculture",
+    "range": 1500,
+    "image_size": "70x70",
+    "wind": 5,
+    "order_by": "cost",
+}
 
 
 def _request(port: int, method: str, path: str, body: bytes | None = None, headers: dict | None = None):  # type: ignore[no-untyped-def]
@@ -55,7 +61,9 @@ def test_serve_warns_when_bound_off_loopback() -> None:
 
 
 def test_loopback_detection() -> None:
-    assert is_loopback("127.0.0.1") and is_loopback("localhost") and is_loopback("::1") and is_loopback("[::1]")
+    assert (
+        is_loopback("127.0.0.1") and is_loopback("localhost") and is_loopback("::1") and is_loopback("[::1]")
+    )
     assert is_loopback("127.0.0.2")
     assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.10") and not is_loopback("example.com")
 

@@ -31,7 +31,14 @@ def is_loopback(host: str) -> bool:
     multiple=True,
     help="Further Host name the server answers to (repeatable; the loopback names always are).",
 )
-def command(host: str, port: int, db: str | None, regulations: str | None, matrices: str | None, allow_hosts: tuple[str, ...]) -> None:
+def command(
+    host: str,
+    port: int,
+    db: str | None,
+    regulations: str | None,
+    matrices: str | None,
+    allow_hosts: tuple[str, ...],
+) -> None:
     """Start the web application: mission selection, trajectory prediction, database pages and
     the JSON API (/api, /openapi.json), fully offline.
 

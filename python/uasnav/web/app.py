@@ -80,12 +80,16 @@ class Documents:
     sources: dict[str, str] = field(default_factory=dict)
 
 
-def load_documents(db: str | None = None, matrices: str | None = None, regulations: str | None = None) -> Documents:
+def load_documents(
+    db: str | None = None, matrices: str | None = None, regulations: str | None = None
+) -> Documents:
     """Load (and validate) the three documents: paths, URLs, or the shipped copies."""
     d = load_database(db)
     m = load_matrices(matrices)
     r = load_regulations(regulations)
-    return Documents(d, m, r, {"database": d.where, "matrices": m.source or "shipped", "regulations": r.where})
+    return Documents(
+        d, m, r, {"database": d.where, "matrices": m.source or "shipped", "regulations": r.where}
+    )
 
 
 class ApiError(Exception):
@@ -156,13 +160,19 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
 
     # -- mission selection ---------------------------------------------------------------------
     def selection_page(
-        request: Request, values: dict[str, Any], errors: dict[str, str], result: dict[str, Any] | None, status: int
+        request: Request,
+        values: dict[str, Any],
+        errors: dict[str, str],
+        result: dict[str, Any] | None,
+        status: int,
     ) -> HTMLResponse:
         ctx = {
             "request": request,
             "groups": _grouped(forms.form_fields(choices)),
             "values": values,
-            "pairs": {o.name: forms.pair_values(values.get(o.name)) for o in SELECT_OPTIONS if o.kind == "pairs"},
+            "pairs": {
+                o.name: forms.pair_values(values.get(o.name)) for o in SELECT_OPTIONS if o.kind == "pairs"
+            },
             "errors": errors,
             "result": result,
             "page": "select",
@@ -202,7 +212,9 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
                 up = form.get(opt.name)
                 if opt.widget == "file" and isinstance(up, UploadFile) and up.filename:
                     try:
-                        run_values[opt.name] = uploads.store(opt.name, await up.read(forms.MAX_OPTION_FILE_BYTES + 1))
+                        run_values[opt.name] = uploads.store(
+                            opt.name, await up.read(forms.MAX_OPTION_FILE_BYTES + 1)
+                        )
                     except OptionError as e:
                         errors[e.option] = str(e)
             if not errors:
@@ -263,7 +275,9 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         return templates.TemplateResponse(request, "db.html", ctx)
 
     # -- trajectory ---------------------------------------------------------------------------
-    def traj_page(request: Request, values: dict[str, Any], errors: dict[str, str], result: Any, status: int) -> Response:
+    def traj_page(
+        request: Request, values: dict[str, Any], errors: dict[str, str], result: Any, status: int
+    ) -> Response:
         ctx = {"request": request, "values": values, "errors": errors, "page": "trajectory", "result": None}
         if result is not None:
             csv_text = prediction.waypoints_csv(result)
@@ -272,7 +286,9 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             ctx["csv_href"] = "data:text/csv;base64," + base64.b64encode(csv_text.encode()).decode()
             if result.origin is not None:
                 gj = prediction.to_json_text(prediction.waypoints_geojson(result))
-                ctx["geojson_href"] = "data:application/geo+json;base64," + base64.b64encode(gj.encode()).decode()
+                ctx["geojson_href"] = (
+                    "data:application/geo+json;base64," + base64.b64encode(gj.encode()).decode()
+                )
         ctx["suffixes"] = ", ".join(prediction.PLAN_SUFFIXES)
         return templates.TemplateResponse(request, "trajectory.html", ctx, status_code=status)
 
@@ -281,7 +297,9 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         if not isinstance(plan, UploadFile) or not plan.filename:
             raise prediction.FieldError("plan", "plan: choose a plan file")
         data = await plan.read(prediction.MAX_UPLOAD_PLAN_BYTES + 1)
-        wind = prediction.parse_number("wind_speed", form.get("wind_speed") or "0", 0.0, prediction.MAX_WIND_MS)
+        wind = prediction.parse_number(
+            "wind_speed", form.get("wind_speed") or "0", 0.0, prediction.MAX_WIND_MS
+        )
         wdir = prediction.parse_number("wind_from", form.get("wind_from") or "0", -360.0, 360.0)
         speed_text = form.get("speed") or ""
         speed = (
@@ -335,7 +353,9 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             raise ApiError(422, "body", "body: expected a JSON object of selector options")
         return JSONResponse(_run_select(body, docs))
 
-    @app.get("/api/options", tags=["mission"], summary="The selector's options (names, kinds, units, defaults)")
+    @app.get(
+        "/api/options", tags=["mission"], summary="The selector's options (names, kinds, units, defaults)"
+    )
     def api_options() -> Response:
         return JSONResponse(
             [
@@ -355,7 +375,11 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             ]
         )
 
-    @app.get("/api/db/{name}", tags=["database"], summary="A database table: uas, cameras, regulations, missions, equipment")
+    @app.get(
+        "/api/db/{name}",
+        tags=["database"],
+        summary="A database table: uas, cameras, regulations, missions, equipment",
+    )
     def api_db(name: str, q: str = "", sort: str = "", desc: bool = False) -> Response:
         cols, rows = tables.filter_sort(table_of(name), q[:200], sort, desc)
         return JSONResponse(to_jsonable({"table": name, "columns": cols, "rows": rows}))
@@ -364,27 +388,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         "/api/trajectory/predict",
         tags=["trajectory"],
         summary="Predict element times, ETA and 4D waypoint times of an uploaded plan",
-        openapi_extra={
-            "requestBody": {
-                "required": True,
-                "content": {
-                    "multipart/form-data": {
-                        "schema": {
-                            "type": "object",
-                            "required": ["plan"],
-                            "properties": {
-                                "plan": {"type": "string", "format": "binary", "description": "Plan file (CSV lat,lon,alt or north,east)"},
-                                "model": {"type": "string", "format": "binary", "description": "Model JSON of `uasnav trajectory train` (default: built-in)"},
-                                "wind_speed": {"type": "number", "minimum": 0, "maximum": 100, "description": "m/s"},
-                                "wind_from": {"type": "number", "description": "deg from north, where the wind comes from"},
-                                "speed": {"type": "number", "exclusiveMinimum": 0, "description": "commanded speed m/s"},
-                                "format": {"type": "string", "enum": ["json", "csv", "geojson"]},
-                            },
-                        }
-                    }
-                },
-            }
-        },
+        openapi_extra={"requestBody": {"required": True, "content": {"multipart/form-data": PREDICT_SCHEMA}}},
     )
     async def api_predict(request: Request) -> Response:
         if not request.headers.get("content-type", "").startswith("multipart/form-data"):
@@ -398,16 +402,46 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             if fmt == "csv":
                 return PlainTextResponse(prediction.waypoints_csv(r), media_type="text/csv; charset=utf-8")
             if fmt == "geojson":
-                return JSONResponse(to_jsonable(prediction.waypoints_geojson(r)), media_type="application/geo+json")
+                return JSONResponse(
+                    to_jsonable(prediction.waypoints_geojson(r)), media_type="application/geo+json"
+                )
         except prediction.FieldError as e:
             raise ApiError(422, e.field, str(e)) from None
         return JSONResponse(to_jsonable(r.to_dict()))
 
     @app.get("/api", response_class=HTMLResponse, include_in_schema=False)
     def api_docs(request: Request) -> Response:
-        return templates.TemplateResponse(request, "api.html", {"request": request, "spec": app.openapi(), "page": "api"})
+        return templates.TemplateResponse(
+            request, "api.html", {"request": request, "spec": app.openapi(), "page": "api"}
+        )
 
     return GuardMiddleware(app, allowed_hosts, MAX_BODY_BYTES, _SECURITY_HEADERS)
+
+
+#: The multipart body of ``POST /api/trajectory/predict`` for the OpenAPI description.
+PREDICT_SCHEMA: dict[str, Any] = {
+    "schema": {
+        "type": "object",
+        "required": ["plan"],
+        "properties": {
+            "plan": {
+                "type": "string",
+                "format": "binary",
+                "description": "Plan: QGroundControl .plan, Mission Planner .waypoints, or CSV "
+                "(lat,lon[,alt] or north,east)",
+            },
+            "model": {
+                "type": "string",
+                "format": "binary",
+                "description": "Model JSON of `uasnav trajectory train` (default: the built-in model)",
+            },
+            "wind_speed": {"type": "number", "minimum": 0, "maximum": 100, "description": "m/s"},
+            "wind_from": {"type": "number", "description": "deg from north, where the wind comes from"},
+            "speed": {"type": "number", "exclusiveMinimum": 0, "description": "commanded speed, m/s"},
+            "format": {"type": "string", "enum": ["json", "csv", "geojson"]},
+        },
+    }
+}
 
 
 def select_schema() -> dict[str, Any]:
@@ -417,7 +451,13 @@ def select_schema() -> dict[str, Any]:
         if not forms.is_field(o):
             continue
         s: dict[str, Any] = {"description": o.help + (f" Unit: {o.unit}." if o.unit else "")}
-        kind_types = {"real": "number", "int": "integer", "flag": "boolean", "choice": "string", "text": "string"}
+        kind_types = {
+            "real": "number",
+            "int": "integer",
+            "flag": "boolean",
+            "choice": "string",
+            "text": "string",
+        }
         if o.kind in kind_types:
             s["type"] = kind_types[o.kind]
         if o.minimum is not None:
@@ -491,7 +531,9 @@ def _choices(docs: Documents) -> dict[str, tuple[tuple[str, str], ...]]:
     return {
         "mission": tuple((mid, f"{m.name}") for mid, m in docs.matrices.missions.items()),
         "imagery": (("any", "any"), *((t, t) for t in types)),
-        "jurisdiction": tuple((jid, f"{jid.upper()} — {j.name}") for jid, j in docs.regulations.jurisdictions.items()),
+        "jurisdiction": tuple(
+            (jid, f"{jid.upper()} — {j.name}") for jid, j in docs.regulations.jurisdictions.items()
+        ),
         "category": tuple(cats.items()),
     }
 

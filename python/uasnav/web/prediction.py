@@ -222,7 +222,12 @@ def waypoints_csv(r: RoutePrediction) -> str:
     w = csv.DictWriter(out, cols, extrasaction="ignore", lineterminator="\n")
     w.writeheader()
     for row in r.waypoints:
-        w.writerow({k: (f"{v:.8f}" if k.endswith("_deg") else f"{v:.3f}" if isinstance(v, float) else v) for k, v in row.items()})
+        w.writerow(
+            {
+                k: (f"{v:.8f}" if k.endswith("_deg") else f"{v:.3f}" if isinstance(v, float) else v)
+                for k, v in row.items()
+            }
+        )
     return out.getvalue()
 
 
@@ -247,7 +252,10 @@ def waypoints_geojson(r: RoutePrediction) -> dict[str, Any]:
     feats.append(
         {
             "type": "Feature",
-            "geometry": {"type": "LineString", "coordinates": [[w["lon_deg"], w["lat_deg"]] for w in r.waypoints]},
+            "geometry": {
+                "type": "LineString",
+                "coordinates": [[w["lon_deg"], w["lat_deg"]] for w in r.waypoints],
+            },
             "properties": {"eta_s": r.eta_s},
         }
     )
@@ -272,8 +280,10 @@ def route_drawing(r: RoutePrediction, width: float = 640.0, pad: float = 28.0) -
 
     elements = []
     for e in r.elements:
-        poly = " ".join("%.2f,%.2f" % xy(pe, pn) for pn, pe in e["path_ne_m"])
-        elements.append({"points": poly, "low": e["low_confidence"], "element": e["element"], "time_s": e["time_s"]})
+        poly = " ".join("{:.2f},{:.2f}".format(*xy(pe, pn)) for pn, pe in e["path_ne_m"])
+        elements.append(
+            {"points": poly, "low": e["low_confidence"], "element": e["element"], "time_s": e["time_s"]}
+        )
     # one label per drawn point: a closed route's first and last waypoints share theirs
     labels: dict[tuple[float, float], list[str]] = {}
     for w in r.waypoints:

@@ -53,7 +53,11 @@ class Server:
 
 @contextlib.contextmanager
 def running_server(
-    *args: str, host: str = "127.0.0.1", port: int | None = None, timeout_s: float = 60.0, log_dir: Path | None = None
+    *args: str,
+    host: str = "127.0.0.1",
+    port: int | None = None,
+    timeout_s: float = 60.0,
+    log_dir: Path | None = None,
 ) -> Iterator[Server]:
     """Start ``uasnav serve --host HOST --port PORT ARGS…`` and yield once it answers.
 

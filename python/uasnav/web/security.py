@@ -73,7 +73,9 @@ class GuardMiddleware:
         self.app = app
         self.allowed = {h.lower() for h in (*LOOPBACK_HOSTS, *allowed_hosts)}
         self.max_body_bytes = max_body_bytes
-        self.headers = [(k.lower().encode("latin-1"), v.encode("latin-1")) for k, v in (headers or {}).items()]
+        self.headers = [
+            (k.lower().encode("latin-1"), v.encode("latin-1")) for k, v in (headers or {}).items()
+        ]
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
@@ -116,7 +118,10 @@ class GuardMiddleware:
         async def inner(message: Message) -> None:
             if message["type"] == "http.response.start":
                 have = {k.lower() for k, _ in message.get("headers", [])}
-                message["headers"] = [*message.get("headers", []), *((k, v) for k, v in extra if k not in have)]
+                message["headers"] = [
+                    *message.get("headers", []),
+                    *((k, v) for k, v in extra if k not in have),
+                ]
             await send(message)
 
         return inner
