@@ -415,3 +415,59 @@ def test_default_model_is_deterministic_and_simulated_only() -> None:
     lo, hi = b.wind_range_ms_
     assert lo < 1.0 and hi > 7.0
     assert np.isfinite(b.cruise_ms_)
+
+
+def test_page_downloads_are_what_is_shown(client) -> None:
+    import base64
+
+    r = client.post("/select", data={k: str(v) for k, v in THESIS.items()})
+    found = re.findall(r'href="data:([^;]+);charset=utf-8;base64,([^"]+)" download="([^"]+)"', r.text)
+    uris = {name: base64.b64decode(data).decode() for _, data, name in found}
+    assert set(uris) == {"selection.json", "ranking.csv", "rejections.csv"}
+    api = client.post("/api/select", json=THESIS).json()
+    assert json.loads(uris["selection.json"]) == api
+    assert [row["uas"] for row in csv.DictReader(io.StringIO(uris["ranking.csv"]))] == [
+        x["uas"] for x in api["ranking"]
+    ]
+
+
+def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
+    """An option added to the table later (issue 18: an area file, an output summary) appears
+    in the form and the API without editing the web app; a file option's value is content the
+    server stores itself, never a path it opens; an output path is never a request option."""
+    import uasnav.mission.request as request_mod
+    import uasnav.web.app as web_app
+    from uasnav.mission.request import SelectOption
+
+    extra = (
+        SelectOption("area", "file", None, "Operation area (GeoJSON).", label="Area"),
+        SelectOption("summary", "output", None, "Write the authorisation summary here."),
+    )
+    monkeypatch.setattr(request_mod, "SELECT_OPTIONS", request_mod.SELECT_OPTIONS + extra)
+    seen: list[tuple[str, bytes]] = []
+    real = web_app.run_select
+
+    def spy(values, **kw):  # type: ignore[no-untyped-def]
+        if "area" in values:
+            p = Path(values["area"])
+            seen.append((str(p), p.read_bytes()))
+        return real({k: v for k, v in values.items() if k != "area"}, **kw)
+
+    monkeypatch.setattr(web_app, "run_select", spy)
+    html = client.get("/").text
+    assert 'type="file" id="f-area" name="area"' in html and 'name="summary"' not in html
+    r = client.post("/api/select", json={"area": "/etc/passwd"})
+    assert r.status_code == 200, r.text
+    path, content = seen[-1]
+    assert content == b"/etc/passwd" and path != "/etc/passwd" and not Path(path).exists()
+    r = client.post("/api/select", json={"area": {"type": "FeatureCollection", "features": []}})
+    assert json.loads(seen[-1][1]) == {"type": "FeatureCollection", "features": []}
+    assert client.post("/api/select", json={"area": 5}).json()["field"] == "area"
+    r = client.post("/api/select", json={"summary": "/tmp/summary.html"})
+    assert r.status_code == 422 and r.json()["field"] == "summary"
+    assert client.get("/select/export.json?area=/etc/passwd").json()["field"] == "area"
+    page = client.post(
+        "/select", files={"area": ("zone.geojson", b'{"type": "Polygon"}')}, data={"range": "300"}
+    )
+    assert page.status_code == 200 and seen[-1][1] == b'{"type": "Polygon"}'
+    assert not Path(seen[-1][0]).exists()  # the upload's temporary directory is gone

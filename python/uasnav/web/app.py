@@ -15,8 +15,8 @@ in the server log.
 from __future__ import annotations
 
 import base64
+import json
 import logging
-import urllib.parse
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -31,10 +31,11 @@ from starlette.datastructures import UploadFile
 from uasnav import __version__
 from uasnav.errors import DataFormatError, UasnavError
 from uasnav.jsonable import to_jsonable
+from uasnav.mission import request as select_request
 from uasnav.mission.database import Database, load_database
 from uasnav.mission.matrices import NECESSARY, Matrices, load_matrices
 from uasnav.mission.regulations import Regulations, load_regulations
-from uasnav.mission.request import SELECT_OPTIONS, OptionError, parse_select_options, run_select
+from uasnav.mission.request import OptionError, parse_select_options, run_select
 from uasnav.mission.scoring import PARAMETERS
 from uasnav.web import forms, prediction, selection_view, tables
 from uasnav.web.security import BodyTooLarge, GuardMiddleware
@@ -171,7 +172,9 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             "groups": _grouped(forms.form_fields(choices)),
             "values": values,
             "pairs": {
-                o.name: forms.pair_values(values.get(o.name)) for o in SELECT_OPTIONS if o.kind == "pairs"
+                o.name: forms.pair_values(values.get(o.name))
+                for o in select_request.SELECT_OPTIONS
+                if o.kind == "pairs"
             },
             "errors": errors,
             "result": result,
@@ -179,19 +182,24 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         }
         return templates.TemplateResponse(request, "select.html", ctx, status_code=status)
 
-    def run_view(values: dict[str, Any]) -> dict[str, Any]:
-        sel = _run_select(values, docs)
-        req = parse_select_options(values)
-        query = urllib.parse.urlencode({k: v for k, v in values.items() if v is not None})
+    def run_view(values: dict[str, Any], files: dict[str, str]) -> dict[str, Any]:
+        sel = _run_select(values, docs, files)
+        req = parse_select_options({**values, **files})
         equipment: dict[str, list[dict[str, Any]]] = {}
         for e in sel["equipment"]:
             equipment.setdefault(e["group"], []).append(e)
+        # downloads of exactly what is shown (no second run, uploaded files included)
+        downloads = {
+            "json": _data_uri("application/json", json.dumps(sel, ensure_ascii=False, indent=2)),
+            "ranking": _data_uri("text/csv", selection_view.ranking_csv(sel)),
+            "rejections": _data_uri("text/csv", selection_view.rejections_csv(sel)),
+        }
         return {
             "sel": sel,
             "equipment": equipment,
             "plots": selection_view.transfer_plots(sel, req.targets, docs.database),
             "breakdown": selection_view.breakdown(sel),
-            "query": query,
+            "downloads": downloads,
             "margin": selection_view.margin,
             "necessary": NECESSARY,
         }
@@ -207,19 +215,18 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         errors = forms.field_errors(values)
         result = None
         with forms.UploadDir() as uploads:
-            run_values = dict(values)
+            files = {}
             for opt in forms.form_fields(choices):
                 up = form.get(opt.name)
                 if opt.widget == "file" and isinstance(up, UploadFile) and up.filename:
                     try:
-                        run_values[opt.name] = uploads.store(
-                            opt.name, await up.read(forms.MAX_OPTION_FILE_BYTES + 1)
-                        )
+                        data = await up.read(forms.MAX_OPTION_FILE_BYTES + 1)
+                        files[opt.name] = uploads.store(opt.name, data)
                     except OptionError as e:
                         errors[e.option] = str(e)
             if not errors:
                 try:
-                    result = run_view(run_values)
+                    result = run_view(values, files)
                 except (OptionError, ApiError) as e:
                     errors[_field_of(e) or "form"] = getattr(e, "message", str(e))
                 except UasnavError as e:
@@ -351,7 +358,14 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         body = await _json_body(request)
         if not isinstance(body, dict):
             raise ApiError(422, "body", "body: expected a JSON object of selector options")
-        return JSONResponse(_run_select(body, docs))
+        # a file option carries the file's content (text or JSON), never a path: the server
+        # writes it to its own temporary directory and passes that path to the parser
+        with forms.UploadDir() as uploads:
+            files = {}
+            for opt in select_request.SELECT_OPTIONS:
+                if opt.name in body and forms.is_field(opt) and forms.widget(opt) == "file":
+                    files[opt.name] = uploads.store(opt.name, _content_bytes(opt.name, body.pop(opt.name)))
+            return JSONResponse(_run_select(body, docs, files))
 
     @app.get(
         "/api/options", tags=["mission"], summary="The selector's options (names, kinds, units, defaults)"
@@ -370,7 +384,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
                     "label": o.label,
                     "help": o.help,
                 }
-                for o in SELECT_OPTIONS
+                for o in select_request.SELECT_OPTIONS
                 if forms.is_field(o)
             ]
         )
@@ -447,7 +461,7 @@ PREDICT_SCHEMA: dict[str, Any] = {
 def select_schema() -> dict[str, Any]:
     """JSON schema of ``POST /api/select``'s body, from the option table."""
     props: dict[str, Any] = {}
-    for o in SELECT_OPTIONS:
+    for o in select_request.SELECT_OPTIONS:
         if not forms.is_field(o):
             continue
         s: dict[str, Any] = {"description": o.help + (f" Unit: {o.unit}." if o.unit else "")}
@@ -492,13 +506,41 @@ async def _json_body(request: Request) -> Any:
         raise ApiError(400, "body", str(e)) from None
 
 
-def _run_select(values: dict[str, Any], docs: Documents) -> dict[str, Any]:
+def _content_bytes(name: str, value: Any) -> bytes:
+    """The content of a file option given in a JSON body: text as UTF-8, an object or array as
+    JSON."""
+    if isinstance(value, str):
+        return value.encode("utf-8")
+    if isinstance(value, dict | list):
+        return json.dumps(value).encode("utf-8")
+    raise ApiError(
+        422, name, f"{name}: expected the file's content (text or JSON), got {type(value).__name__}"
+    )
+
+
+def _data_uri(mime: str, text: str) -> str:
+    return f"data:{mime};charset=utf-8;base64," + base64.b64encode(text.encode("utf-8")).decode("ascii")
+
+
+def _run_select(
+    values: dict[str, Any], docs: Documents, files: dict[str, str] | None = None
+) -> dict[str, Any]:
     """``run_select`` on the server's documents, as the JSON ``uasnav select --json`` prints;
-    a bad value is an :class:`ApiError` 422 naming the option."""
+    a bad value is an :class:`ApiError` 422 naming the option.
+
+    ``values`` come from the request and may not name a data source or a file; ``files`` maps
+    file options to paths the server itself wrote (uploads in a temporary directory).
+    """
     for key in values:
-        opt = next((o for o in SELECT_OPTIONS if o.name == key), None)
+        opt = next((o for o in select_request.SELECT_OPTIONS if o.name == key), None)
         if opt is not None and not forms.is_field(opt):
-            raise ApiError(422, key, f"{key}: data sources are set when the server starts, not by a request")
+            what = (
+                "data sources are set when the server starts" if opt.kind == "source" else "server side only"
+            )
+            raise ApiError(422, key, f"{key}: {what}, not part of a request")
+        if opt is not None and forms.widget(opt) == "file":
+            raise ApiError(422, key, f"{key}: upload the file (form) or give its content (JSON), not a path")
+    values = {**values, **(files or {})}
     mission = values.get("mission")
     if isinstance(mission, str) and mission.strip() and mission.strip() not in docs.matrices.missions:
         known = ", ".join(docs.matrices.missions)
