@@ -566,7 +566,7 @@ def _download(resp: Response, filename: str) -> Response:
 def _choices(docs: Documents) -> dict[str, tuple[tuple[str, str], ...]]:
     """Choices the loaded documents offer for text options."""
     types = sorted(set(docs.database.cameras.types))
-    cats: dict[str, str] = {"": "default for the regulations"}
+    cats: dict[str, str] = {"": "default"}
     for jid, j in docs.regulations.jurisdictions.items():
         for cid in j.categories:
             cats.setdefault(cid, f"{cid} ({jid})")
@@ -574,7 +574,7 @@ def _choices(docs: Documents) -> dict[str, tuple[tuple[str, str], ...]]:
         "mission": tuple((mid, f"{m.name}") for mid, m in docs.matrices.missions.items()),
         "imagery": (("any", "any"), *((t, t) for t in types)),
         "jurisdiction": tuple(
-            (jid, f"{jid.upper()} — {j.name}") for jid, j in docs.regulations.jurisdictions.items()
+            (jid, j.name.split(",")[0]) for jid, j in docs.regulations.jurisdictions.items()
         ),
         "category": tuple(cats.items()),
     }
