@@ -408,7 +408,7 @@ def test_default_model_is_deterministic_and_simulated_only() -> None:
 
     a = dm.default_model()
     assert dm.default_model() is a  # cached
-    dm.default_model.cache_clear()
+    dm.clear_cache()
     b = dm.default_model()
     assert json.dumps(a.to_dict(), sort_keys=True) == json.dumps(b.to_dict(), sort_keys=True)
     # trained on every wind of the simulated set: calm to 8 m/s

@@ -26,6 +26,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import HTMLResponse, JSONResponse, PlainTextResponse, RedirectResponse, Response
 from fastapi.staticfiles import StaticFiles
 from fastapi.templating import Jinja2Templates
+from starlette.concurrency import run_in_threadpool
 from starlette.datastructures import UploadFile
 
 from uasnav import __version__
@@ -126,6 +127,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
     templates = Jinja2Templates(directory=str(HERE / "templates"))
     templates.env.globals.update(version=__version__, sources=docs.sources, parameters=PARAMETERS)
     templates.env.filters["num"] = _num
+    templates.env.filters["auto"] = _auto
     app.mount("/static", StaticFiles(directory=str(HERE / "static")), name="static")
     app.state.docs = docs
 
@@ -322,11 +324,14 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         else:
             from uasnav.web.default_model import default_model
 
-            model, name = default_model(), "built-in model (simulated flights)"
+            # trained on first use (seconds): off the event loop, so other requests go on
+            model, name = await run_in_threadpool(default_model), "built-in model (simulated flights)"
         if speed is None and up_plan.cruise_ms is not None:
             speed, name = up_plan.cruise_ms, f"{name}; speed from the plan"
         try:
-            return prediction.predict_plan(model, up_plan.route_ne, up_plan.origin, wind, wdir, speed, name)
+            return await run_in_threadpool(
+                prediction.predict_plan, model, up_plan.route_ne, up_plan.origin, wind, wdir, speed, name
+            )
         except UasnavError as e:
             raise prediction.FieldError("plan", f"plan: {e}") from None
 
@@ -586,6 +591,16 @@ def _grouped(fields: list[forms.FormField]) -> list[tuple[str, list[forms.FormFi
     for f in fields:
         out[named.get(f.name, "Requirements")].append(f)
     return [(g, fs) for g, fs in out.items() if fs]
+
+
+def _auto(x: Any) -> str:
+    """A database value with the decimals it needs: whole numbers plain, small ones to 4
+    significant digits."""
+    if isinstance(x, bool) or not isinstance(x, int | float):
+        return _num(x)
+    if float(x).is_integer():
+        return _num(x, 0)
+    return _num(x, 2) if abs(x) >= 1 else f"{x:.4g}"
 
 
 def _num(x: Any, digits: int = 2) -> str:

@@ -10,6 +10,7 @@ and kept for the life of the process.
 from __future__ import annotations
 
 import functools
+import threading
 import warnings
 
 from uasnav.trajectory.predictor import TrajectoryPredictor
@@ -25,7 +26,9 @@ FLIGHTS_PER_WIND = 3
 SEED = 0
 
 
-@functools.lru_cache(maxsize=1)
+_LOCK = threading.Lock()
+
+
 def default_model() -> TrajectoryPredictor:
     """The built-in model (trained once per process, then cached).
 
@@ -35,6 +38,19 @@ def default_model() -> TrajectoryPredictor:
         Fitted on ``len(TRAINING_WINDS) × 2 × FLIGHTS_PER_WIND`` simulated flights; the same
         every time (fixed seeds).
     """
+    # one training even when the first requests arrive together (server threads)
+    with _LOCK:
+        return _train()
+
+
+def clear_cache() -> None:
+    """Forget the trained model (the next :func:`default_model` trains again)."""
+    with _LOCK:
+        _train.cache_clear()
+
+
+@functools.lru_cache(maxsize=1)
+def _train() -> TrajectoryPredictor:
     parts = []
     index = 0
     for w, (speed, from_deg) in enumerate(TRAINING_WINDS):
@@ -53,4 +69,4 @@ def default_model() -> TrajectoryPredictor:
         return TrajectoryPredictor(random_state=SEED).fit(ElementSamples.concat(parts))
 
 
-__all__ = ["FLIGHTS_PER_WIND", "SEED", "TRAINING_WINDS", "default_model"]
+__all__ = ["FLIGHTS_PER_WIND", "SEED", "TRAINING_WINDS", "clear_cache", "default_model"]
