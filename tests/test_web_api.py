@@ -433,8 +433,9 @@ def test_page_downloads_are_what_is_shown(client) -> None:
 
 def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
     """An option added to the table later (issue 18: an area file, an output summary) appears
-    in the form and the API without editing the web app; a file option's value is content the
-    server stores itself, never a path it opens; an output path is never a request option."""
+    in the form and the API without editing the web app; a file option's value is the document
+    (bytes or parsed JSON), never a path the server opens; an output path is never a request
+    option."""
     import uasnav.mission.request as request_mod
     import uasnav.web.app as web_app
     from uasnav.mission.request import SelectOption
@@ -444,30 +445,30 @@ def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
         SelectOption("summary", "output", None, "Write the authorisation summary here."),
     )
     monkeypatch.setattr(request_mod, "SELECT_OPTIONS", request_mod.SELECT_OPTIONS + extra)
-    seen: list[tuple[str, bytes]] = []
+    seen: list[object] = []
     real = web_app.run_select
 
     def spy(values, **kw):  # type: ignore[no-untyped-def]
-        if "area" in values:
-            p = Path(values["area"])
-            seen.append((str(p), p.read_bytes()))
-        return real({k: v for k, v in values.items() if k != "area"}, **kw)
+        seen.append(values.get("area"))
+        return real({k: v for k, v in values.items() if k not in ("area", "summary")}, **kw)
 
     monkeypatch.setattr(web_app, "run_select", spy)
     html = client.get("/").text
     assert 'type="file" id="f-area" name="area"' in html and 'name="summary"' not in html
     r = client.post("/api/select", json={"area": "/etc/passwd"})
     assert r.status_code == 200, r.text
-    path, content = seen[-1]
-    assert content == b"/etc/passwd" and path != "/etc/passwd" and not Path(path).exists()
-    r = client.post("/api/select", json={"area": {"type": "FeatureCollection", "features": []}})
-    assert json.loads(seen[-1][1]) == {"type": "FeatureCollection", "features": []}
+    area = seen[-1]
+    assert getattr(area, "data", area) == b"/etc/passwd"  # the text itself, as bytes: not a path
+    client.post("/api/select", json={"area": {"type": "FeatureCollection", "features": []}})
+    assert seen[-1] == {"type": "FeatureCollection", "features": []}
     assert client.post("/api/select", json={"area": 5}).json()["field"] == "area"
     r = client.post("/api/select", json={"summary": "/tmp/summary.html"})
     assert r.status_code == 422 and r.json()["field"] == "summary"
     assert client.get("/select/export.json?area=/etc/passwd").json()["field"] == "area"
     page = client.post(
-        "/select", files={"area": ("zone.geojson", b'{"type": "Polygon"}')}, data={"range": "300"}
+        "/select", files={"area": ("../../zone.geojson", b'{"type": "Polygon"}')}, data={"range": "300"}
     )
-    assert page.status_code == 200 and seen[-1][1] == b'{"type": "Polygon"}'
-    assert not Path(seen[-1][0]).exists()  # the upload's temporary directory is gone
+    assert page.status_code == 200
+    assert getattr(seen[-1], "data", seen[-1]) == b'{"type": "Polygon"}'
+    big = client.post("/select", files={"area": ("a.geojson", b" " * (forms.MAX_OPTION_FILE_BYTES + 1))})
+    assert big.status_code == 422 and "area: file over" in big.text

@@ -56,7 +56,19 @@ GROUPS = (
     ("Mission", ("mission",)),
     ("Requirements", ()),
     ("Weather", ("wind", "rain", "night", "temperature", "visibility")),
-    ("Regulations", ("jurisdiction", "category")),
+    ("Area and zones", ("area", "area_buffer", "zones", "when")),
+    (
+        "Regulations",
+        (
+            "jurisdiction",
+            "category",
+            "airspace",
+            "over_people",
+            "population_density",
+            "mitigations",
+            "sora_edition",
+        ),
+    ),
     ("Scoring", ("order_by", "weights", "targets", "top")),
 )
 GENERIC_500 = "internal server error: the details are in the server log"
@@ -184,7 +196,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         }
         return templates.TemplateResponse(request, "select.html", ctx, status_code=status)
 
-    def run_view(values: dict[str, Any], files: dict[str, str]) -> dict[str, Any]:
+    def run_view(values: dict[str, Any], files: dict[str, Any]) -> dict[str, Any]:
         sel = _run_select(values, docs, files)
         req = parse_select_options({**values, **files})
         equipment: dict[str, list[dict[str, Any]]] = {}
@@ -216,23 +228,22 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         values = forms.values_from_form(form, form.getlist)
         errors = forms.field_errors(values)
         result = None
-        with forms.UploadDir() as uploads:
-            files = {}
-            for opt in forms.form_fields(choices):
-                up = form.get(opt.name)
-                if opt.widget == "file" and isinstance(up, UploadFile) and up.filename:
-                    try:
-                        data = await up.read(forms.MAX_OPTION_FILE_BYTES + 1)
-                        files[opt.name] = uploads.store(opt.name, data)
-                    except OptionError as e:
-                        errors[e.option] = str(e)
-            if not errors:
+        files: dict[str, Any] = {}
+        for opt in forms.form_fields(choices):
+            up = form.get(opt.name)
+            if opt.widget == "file" and isinstance(up, UploadFile) and up.filename:
+                data = await up.read(forms.MAX_OPTION_FILE_BYTES + 1)
                 try:
-                    result = run_view(values, files)
-                except (OptionError, ApiError) as e:
-                    errors[_field_of(e) or "form"] = getattr(e, "message", str(e))
-                except UasnavError as e:
-                    errors["form"] = str(e)
+                    files[opt.name] = forms.file_value(opt.name, up.filename, data)
+                except OptionError as e:
+                    errors[e.option] = str(e)
+        if not errors:
+            try:
+                result = run_view(values, files)
+            except (OptionError, ApiError) as e:
+                errors[_field_of(e) or "form"] = getattr(e, "message", str(e))
+            except UasnavError as e:
+                errors["form"] = str(e)
         return selection_page(request, values, errors, result, 422 if errors else 200)
 
     @app.get("/select/export.{fmt}", include_in_schema=False)
@@ -363,14 +374,12 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         body = await _json_body(request)
         if not isinstance(body, dict):
             raise ApiError(422, "body", "body: expected a JSON object of selector options")
-        # a file option carries the file's content (text or JSON), never a path: the server
-        # writes it to its own temporary directory and passes that path to the parser
-        with forms.UploadDir() as uploads:
-            files = {}
-            for opt in select_request.SELECT_OPTIONS:
-                if opt.name in body and forms.is_field(opt) and forms.widget(opt) == "file":
-                    files[opt.name] = uploads.store(opt.name, _content_bytes(opt.name, body.pop(opt.name)))
-            return JSONResponse(_run_select(body, docs, files))
+        # a file option carries the document itself (text or JSON), never a path
+        files: dict[str, Any] = {}
+        for opt in select_request.SELECT_OPTIONS:
+            if opt.name in body and forms.is_field(opt) and forms.widget(opt) == "file":
+                files[opt.name] = _file_content(opt.name, body.pop(opt.name))
+        return JSONResponse(_run_select(body, docs, files))
 
     @app.get(
         "/api/options", tags=["mission"], summary="The selector's options (names, kinds, units, defaults)"
@@ -511,13 +520,13 @@ async def _json_body(request: Request) -> Any:
         raise ApiError(400, "body", str(e)) from None
 
 
-def _content_bytes(name: str, value: Any) -> bytes:
-    """The content of a file option given in a JSON body: text as UTF-8, an object or array as
-    JSON."""
+def _file_content(name: str, value: Any) -> Any:
+    """A file option's document given in a JSON body: text (passed as UTF-8 bytes, so that no
+    parser can take it for a path) or a parsed JSON object/array (passed as it is)."""
     if isinstance(value, str):
-        return value.encode("utf-8")
+        return forms.file_value(name, name, value.encode("utf-8"))
     if isinstance(value, dict | list):
-        return json.dumps(value).encode("utf-8")
+        return value
     raise ApiError(
         422, name, f"{name}: expected the file's content (text or JSON), got {type(value).__name__}"
     )
@@ -528,13 +537,14 @@ def _data_uri(mime: str, text: str) -> str:
 
 
 def _run_select(
-    values: dict[str, Any], docs: Documents, files: dict[str, str] | None = None
+    values: dict[str, Any], docs: Documents, files: dict[str, Any] | None = None
 ) -> dict[str, Any]:
     """``run_select`` on the server's documents, as the JSON ``uasnav select --json`` prints;
     a bad value is an :class:`ApiError` 422 naming the option.
 
     ``values`` come from the request and may not name a data source or a file; ``files`` maps
-    file options to paths the server itself wrote (uploads in a temporary directory).
+    file options to the documents the request carried (bytes, an ``Upload`` or parsed JSON),
+    never to a path.
     """
     for key in values:
         opt = next((o for o in select_request.SELECT_OPTIONS if o.name == key), None)
@@ -544,7 +554,7 @@ def _run_select(
             )
             raise ApiError(422, key, f"{key}: {what}, not part of a request")
         if opt is not None and forms.widget(opt) == "file":
-            raise ApiError(422, key, f"{key}: upload the file (form) or give its content (JSON), not a path")
+            raise ApiError(422, key, f"{key}: upload the file (form) or give its content (JSON body)")
     values = {**values, **(files or {})}
     mission = values.get("mission")
     if isinstance(mission, str) and mission.strip() and mission.strip() not in docs.matrices.missions:

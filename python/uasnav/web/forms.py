@@ -5,17 +5,17 @@ one form field, named as the API key, with its label, unit, default and help; th
 builds its options from the same table, so the form, ``POST /api/select`` and ``uasnav select``
 cannot drift apart. Kinds are handled generically: a kind this module does not know is a text
 field (its value goes to :func:`~uasnav.mission.request.parse_select_options` as typed), a file
-kind is an upload field, and data sources and output paths are never fields.
+kind is an upload field (the document goes to the parser as bytes, never as a path), and data
+sources and output paths are never fields.
 """
 
 from __future__ import annotations
 
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
+from uasnav.mission import request as select_request
 from uasnav.mission.request import OptionError, SelectOption, parse_select_options, request_options
 from uasnav.mission.scoring import PARAMETERS
 
@@ -143,37 +143,26 @@ def field_errors(values: Mapping[str, Any]) -> dict[str, str]:
     return errors
 
 
-class UploadDir:
-    """A temporary directory holding a request's uploaded option files, removed on exit."""
-
-    def __init__(self) -> None:
-        self._tmp: tempfile.TemporaryDirectory[str] | None = None
-
-    def store(self, option: str, data: bytes) -> str:
-        """Write ``data`` under a fixed name of ours; returns the path passed to the parser."""
-        if len(data) > MAX_OPTION_FILE_BYTES:
-            raise OptionError(option, f"{option}: file over {MAX_OPTION_FILE_BYTES} bytes")
-        if self._tmp is None:
-            self._tmp = tempfile.TemporaryDirectory(prefix="uasnav-upload-")
-        p = Path(self._tmp.name) / f"{option}.upload"
-        p.write_bytes(data)
-        return str(p)
-
-    def __enter__(self) -> UploadDir:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if self._tmp is not None:
-            self._tmp.cleanup()
+def file_value(option: str, filename: str, data: bytes) -> Any:
+    """A file option's uploaded document as the parser takes it: an ``Upload(name, data)``
+    where :mod:`uasnav.mission.request` defines one, else the bytes. Never written to disk,
+    never a path."""
+    if len(data) > MAX_OPTION_FILE_BYTES:
+        raise OptionError(option, f"{option}: file over {MAX_OPTION_FILE_BYTES} bytes")
+    upload = getattr(select_request, "Upload", None)
+    # the client's file name is only a label for messages: its last part, printable
+    base = filename.replace("\\", "/").rsplit("/", 1)[-1]
+    label = "".join(ch for ch in base if ch.isprintable())[:100]
+    return upload(label or option, data) if upload is not None else data
 
 
 __all__ = [
     "FILE_KINDS",
     "NOT_FIELDS",
     "FormField",
-    "UploadDir",
     "field_errors",
     "field_names",
+    "file_value",
     "form_fields",
     "is_field",
     "pair_values",
