@@ -441,34 +441,40 @@ def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
     from uasnav.mission.request import SelectOption
 
     extra = (
-        SelectOption("area", "file", None, "Operation area (GeoJSON).", label="Area"),
-        SelectOption("summary", "output", None, "Write the authorisation summary here."),
+        SelectOption("fake_area", "file", None, "An operation area (GeoJSON).", label="Area"),
+        SelectOption("fake_summary", "output", None, "Write a summary here."),
     )
     monkeypatch.setattr(request_mod, "SELECT_OPTIONS", request_mod.SELECT_OPTIONS + extra)
     seen: list[object] = []
     real = web_app.run_select
 
+    real_parse = web_app.parse_select_options
+    fake = ("fake_area", "fake_summary")
+
     def spy(values, **kw):  # type: ignore[no-untyped-def]
-        seen.append(values.get("area"))
-        return real({k: v for k, v in values.items() if k not in ("area", "summary")}, **kw)
+        seen.append(values.get("fake_area"))
+        return real({k: v for k, v in values.items() if k not in fake}, **kw)
 
     monkeypatch.setattr(web_app, "run_select", spy)
+    monkeypatch.setattr(
+        web_app, "parse_select_options", lambda v: real_parse({k: x for k, x in v.items() if k not in fake})
+    )
     html = client.get("/").text
-    assert 'type="file" id="f-area" name="area"' in html and 'name="summary"' not in html
-    r = client.post("/api/select", json={"area": "/etc/passwd"})
+    assert 'type="file" id="f-fake_area" name="fake_area"' in html and 'name="fake_summary"' not in html
+    r = client.post("/api/select", json={"fake_area": "/etc/passwd"})
     assert r.status_code == 200, r.text
     area = seen[-1]
     assert getattr(area, "data", area) == b"/etc/passwd"  # the text itself, as bytes: not a path
-    client.post("/api/select", json={"area": {"type": "FeatureCollection", "features": []}})
+    client.post("/api/select", json={"fake_area": {"type": "FeatureCollection", "features": []}})
     assert seen[-1] == {"type": "FeatureCollection", "features": []}
-    assert client.post("/api/select", json={"area": 5}).json()["field"] == "area"
-    r = client.post("/api/select", json={"summary": "/tmp/summary.html"})
-    assert r.status_code == 422 and r.json()["field"] == "summary"
-    assert client.get("/select/export.json?area=/etc/passwd").json()["field"] == "area"
+    assert client.post("/api/select", json={"fake_area": 5}).json()["field"] == "fake_area"
+    r = client.post("/api/select", json={"fake_summary": "/tmp/summary.html"})
+    assert r.status_code == 422 and r.json()["field"] == "fake_summary"
+    assert client.get("/select/export.json?fake_area=/etc/passwd").json()["field"] == "fake_area"
     page = client.post(
-        "/select", files={"area": ("../../zone.geojson", b'{"type": "Polygon"}')}, data={"range": "300"}
+        "/select", files={"fake_area": ("../../zone.geojson", b'{"type": "Polygon"}')}, data={"range": "300"}
     )
     assert page.status_code == 200
     assert getattr(seen[-1], "data", seen[-1]) == b'{"type": "Polygon"}'
-    big = client.post("/select", files={"area": ("a.geojson", b" " * (forms.MAX_OPTION_FILE_BYTES + 1))})
-    assert big.status_code == 422 and "area: file over" in big.text
+    big = client.post("/select", files={"fake_area": ("a.geojson", b" " * (forms.MAX_OPTION_FILE_BYTES + 1))})
+    assert big.status_code == 422 and "fake_area: file over" in big.text
