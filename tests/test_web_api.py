@@ -478,3 +478,28 @@ def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
     assert getattr(seen[-1], "data", seen[-1]) == b'{"type": "Polygon"}'
     big = client.post("/select", files={"fake_area": ("a.geojson", b" " * (forms.MAX_OPTION_FILE_BYTES + 1))})
     assert big.status_code == 422 and "fake_area: file over" in big.text
+
+
+def test_authorisation_summary_is_the_compliance_document(client, monkeypatch) -> None:
+    """Where ``uasnav.mission.summary`` exists (the compliance issue), the page offers that
+    document for download, made from the same selection; without it, no second one."""
+    import base64
+    import sys
+    import types
+
+    import uasnav.web.app as web_app
+
+    r = client.post("/select", data={"range": "300"})
+    assert "authorisation-summary" in r.text or web_app._summary_module() is None
+    fake = types.ModuleType("uasnav.mission.summary")
+    fake.summary_html = lambda sel: f"<html>{sel.mission_name}: {len(sel.ranking)} configurations</html>"  # type: ignore[attr-defined]
+    fake.summary_dict = lambda sel: {"mission": sel.mission_name}  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "uasnav.mission.summary", fake)
+    monkeypatch.setattr(web_app, "_summary_module", lambda: fake)
+    r = client.post("/select", data={"range": "300", "top": "4"})
+    m = re.search(
+        r'href="data:text/html;charset=utf-8;base64,([^"]+)" download="authorisation-summary.html"', r.text
+    )
+    assert (
+        m and base64.b64decode(m.group(1)).decode() == "<html>Precision Agriculture: 4 configurations</html>"
+    )

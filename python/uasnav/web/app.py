@@ -197,7 +197,8 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         return templates.TemplateResponse(request, "select.html", ctx, status_code=status)
 
     def run_view(values: dict[str, Any], files: dict[str, Any]) -> dict[str, Any]:
-        sel = _run_select(values, docs, files)
+        selection = _selection(values, docs, files)
+        sel = to_jsonable(selection.to_dict())
         req = parse_select_options({**values, **files})
         equipment: dict[str, list[dict[str, Any]]] = {}
         for e in sel["equipment"]:
@@ -208,6 +209,12 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             "ranking": _data_uri("text/csv", selection_view.ranking_csv(sel)),
             "rejections": _data_uri("text/csv", selection_view.rejections_csv(sel)),
         }
+        summary = _summary_module()
+        if summary is not None:
+            downloads["summary_html"] = _data_uri("text/html", summary.summary_html(selection))
+            downloads["summary_json"] = _data_uri(
+                "application/json", json.dumps(to_jsonable(summary.summary_dict(selection)), indent=2)
+            )
         return {
             "sel": sel,
             "equipment": equipment,
@@ -539,8 +546,14 @@ def _data_uri(mime: str, text: str) -> str:
 def _run_select(
     values: dict[str, Any], docs: Documents, files: dict[str, Any] | None = None
 ) -> dict[str, Any]:
-    """``run_select`` on the server's documents, as the JSON ``uasnav select --json`` prints;
-    a bad value is an :class:`ApiError` 422 naming the option.
+    """``run_select`` on the server's documents, as the JSON ``uasnav select --json`` prints
+    (:func:`_selection`)."""
+    return to_jsonable(_selection(values, docs, files).to_dict())
+
+
+def _selection(values: dict[str, Any], docs: Documents, files: dict[str, Any] | None = None) -> Any:
+    """``run_select`` on the server's documents; a bad value is an :class:`ApiError` 422
+    naming the option.
 
     ``values`` come from the request and may not name a data source or a file; ``files`` maps
     file options to the documents the request carried (bytes, an ``Upload`` or parsed JSON),
@@ -570,7 +583,18 @@ def _run_select(
         raise ApiError(422, e.option, str(e)) from None
     except UasnavError as e:
         raise ApiError(422, None, str(e)) from None
-    return to_jsonable(sel.to_dict())
+    return sel
+
+
+def _summary_module() -> Any:
+    """The compliance issue's authorisation summary (``uasnav.mission.summary``) if this
+    version has it: the page then offers that document rather than a second one."""
+    import importlib
+    import importlib.util
+
+    if importlib.util.find_spec("uasnav.mission.summary") is None:
+        return None
+    return importlib.import_module("uasnav.mission.summary")
 
 
 def _download(resp: Response, filename: str) -> Response:
