@@ -486,12 +486,15 @@ def select_schema() -> dict[str, Any]:
         if not forms.is_field(o):
             continue
         s: dict[str, Any] = {"description": o.help + (f" Unit: {o.unit}." if o.unit else "")}
-        kind_types = {
+        kind_types: dict[str, Any] = {
             "real": "number",
             "int": "integer",
             "flag": "boolean",
             "choice": "string",
             "text": "string",
+            "size": ["string", "array"],
+            "pairs": ["string", "object"],
+            "file": ["string", "object"],
         }
         if o.kind in kind_types:
             s["type"] = kind_types[o.kind]
