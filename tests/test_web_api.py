@@ -503,3 +503,47 @@ def test_authorisation_summary_is_the_compliance_document(client, monkeypatch) -
     assert (
         m and base64.b64decode(m.group(1)).decode() == "<html>Precision Agriculture: 4 configurations</html>"
     )
+
+
+def test_4d_plan_check_is_the_predictors_rule(client, tmp_path) -> None:
+    """Required waypoint times: each within the tolerance, as `trajectory predict --required`."""
+    p = _plan_csv(tmp_path).read_bytes()
+    base = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p)}).json()
+    times = base["waypoint_times_s"]
+    late = [t + (30.0 if i == 2 else 1.0) for i, t in enumerate(times)]
+    form = {"required": ",".join(f"{t:.3f}" for t in late), "tolerance": "5"}
+    r = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p)}, data=form).json()
+    assert r["feasible"] is False
+    assert r["waypoint_ok"] == [i != 2 for i in range(len(times))]
+    ok = {"required": ",".join(f"{t:.3f}" for t in times)}
+    assert client.post("/api/trajectory/predict", files={"plan": ("a.csv", p)}, data=ok).json()["feasible"]
+    page = client.post("/trajectory", files={"plan": ("a.csv", p)}, data=form)
+    assert "4D plan not feasible" in page.text and page.text.count("late/early") == 1
+    for bad in ["1,2", "nan," * (len(times) - 1) + "1", "a,b"]:
+        r = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p)}, data={"required": bad})
+        assert r.status_code == 422 and r.json()["field"] == "required", bad
+    r = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p)}, data={**ok, "tolerance": "-1"})
+    assert r.json()["field"] == "tolerance"
+
+
+def test_predict_api_is_what_the_cli_prints(client, tmp_path) -> None:
+    """The same model file, plan, wind and 4D times through `uasnav trajectory predict --json`."""
+    model = tmp_path / "m.json"
+    default_model().save(model)
+    plan = _plan_csv(tmp_path)
+    required = "0,20,40,60,80"
+    argv = ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "3@250"]
+    cli = CliRunner().invoke(main, [*argv, "--required", required, "--tolerance", "4", "--json"])
+    assert cli.exit_code == 0, cli.output
+    ref = json.loads(cli.output)
+    form = {"wind_speed": "3", "wind_from": "250", "required": required, "tolerance": "4"}
+    files = {"plan": ("a.csv", plan.read_bytes()), "model": ("m.json", model.read_bytes())}
+    api = client.post("/api/trajectory/predict", files=files, data=form).json()
+    assert api["eta_s"] == pytest.approx(ref["eta_s"])
+    assert api["waypoint_times_s"] == pytest.approx(ref["waypoint_times_s"])
+    assert api["feasible"] == ref["feasible"] and api["waypoint_ok"] == ref["waypoint_ok"]
+    keys = ("element", "kind", "class", "low_confidence", "flags")
+    assert [{k: e[k] for k in keys} for e in api["elements"]] == [
+        {k: e[k] for k in keys} for e in ref["elements"]
+    ]
+    assert [e["time_s"] for e in api["elements"]] == pytest.approx([e["time_s"] for e in ref["elements"]])

@@ -334,7 +334,14 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             if str(speed_text).strip()
             else None
         )
+        tolerance = prediction.parse_number("tolerance", form.get("tolerance") or "5", 0.0, 3600.0)
         up_plan = prediction.read_uploaded_plan(plan.filename, data)
+        required_text = str(form.get("required") or "")
+        required = (
+            prediction.parse_required(required_text, up_plan.route_ne.shape[0])
+            if required_text.strip()
+            else None
+        )
         up = form.get("model")
         if isinstance(up, UploadFile) and up.filename:
             model = prediction.read_uploaded_model(await up.read(prediction.MAX_UPLOAD_MODEL_BYTES + 1))
@@ -348,7 +355,16 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             speed, name = up_plan.cruise_ms, f"{name}; speed from the plan"
         try:
             return await run_in_threadpool(
-                prediction.predict_plan, model, up_plan.route_ne, up_plan.origin, wind, wdir, speed, name
+                prediction.predict_plan,
+                model,
+                up_plan.route_ne,
+                up_plan.origin,
+                wind,
+                wdir,
+                speed,
+                name,
+                required,
+                tolerance,
             )
         except UasnavError as e:
             raise prediction.FieldError("plan", f"plan: {e}") from None
@@ -473,6 +489,13 @@ PREDICT_SCHEMA: dict[str, Any] = {
             "wind_speed": {"type": "number", "minimum": 0, "maximum": 100, "description": "m/s"},
             "wind_from": {"type": "number", "description": "deg from north, where the wind comes from"},
             "speed": {"type": "number", "exclusiveMinimum": 0, "description": "commanded speed, m/s"},
+            "required": {"type": "string", "description": "4D plan: required time per waypoint, s (T0,T1,…)"},
+            "tolerance": {
+                "type": "number",
+                "minimum": 0,
+                "default": 5,
+                "description": "4D time tolerance, s",
+            },
             "format": {"type": "string", "enum": ["json", "csv", "geojson"]},
         },
     }

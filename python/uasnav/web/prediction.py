@@ -24,7 +24,7 @@ import numpy as np
 from uasnav.errors import DataFormatError, InputError, UasnavError
 from uasnav.io.plans import MAX_PLAN_BYTES, PLAN_EXTENSIONS, plan_cruise_speed, plan_route, read_plan
 from uasnav.trajectory.features import wind_vector
-from uasnav.trajectory.predictor import MAX_MODEL_BYTES, TrajectoryPredictor
+from uasnav.trajectory.predictor import MAX_MODEL_BYTES, Feasibility, TrajectoryPredictor
 
 #: Plan formats accepted, by file-name suffix (the readers of :mod:`uasnav.io.plans`):
 #: QGroundControl ``.plan``, Mission Planner ``.waypoints``/``.txt``, uasnav's ``.csv``.
@@ -137,9 +137,19 @@ class RoutePrediction:
     speed_ms: float
     model: str
     notes: list[str] = field(default_factory=list)
+    #: 4D plan check (required time per waypoint within a tolerance), if asked for.
+    feasibility: Feasibility | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return {
+        extra: dict[str, Any] = {}
+        if self.feasibility is not None:
+            # the keys of `uasnav trajectory predict --required … --json`
+            extra = {
+                "feasible": self.feasibility.feasible,
+                "waypoint_ok": [bool(x) for x in self.feasibility.ok],
+                "tolerance_s": self.feasibility.tolerance_s,
+            }
+        return extra | {
             "eta_s": self.eta_s,
             "waypoint_times_s": [w["time_s"] for w in self.waypoints],
             "waypoints": self.waypoints,
@@ -152,6 +162,19 @@ class RoutePrediction:
         }
 
 
+def parse_required(text: str, n_waypoints: int) -> np.ndarray:
+    """``"0,15,30"`` → the required time (s from the start) of each of ``n_waypoints``."""
+    try:
+        vals = np.array([float(x) for x in text.split(",") if x.strip()])
+    except ValueError:
+        raise FieldError("required", f"required: expected comma-separated times in s, got {text!r}") from None
+    if vals.shape != (n_waypoints,) or not np.isfinite(vals).all():
+        raise FieldError(
+            "required", f"required: need one finite time per waypoint ({n_waypoints}), got {vals.size}"
+        )
+    return vals
+
+
 def predict_plan(
     model: TrajectoryPredictor,
     plan_ne: np.ndarray,
@@ -160,9 +183,16 @@ def predict_plan(
     wind_from_deg: float,
     speed_ms: float | None,
     model_name: str,
+    required_s: np.ndarray | None = None,
+    tolerance_s: float = 5.0,
 ) -> RoutePrediction:
-    """Element times (eq. 47), ETA and 4D waypoint times of a plan, as plain rows."""
+    """Element times (eq. 47), ETA and 4D waypoint times of a plan, as plain rows; with
+    ``required_s``, each waypoint's time checked within ``tolerance_s`` (the CLI's rule,
+    :class:`~uasnav.trajectory.predictor.Feasibility`)."""
     p = model.predict(plan_ne, wind_vector(wind_speed_ms, wind_from_deg), speed_ms)
+    feas = None
+    if required_s is not None:
+        feas = Feasibility(np.asarray(required_s, dtype=float), p.waypoint_times_s, float(tolerance_s))
     el, f = p.elements, p.features
     latlon = None
     if origin is not None:
@@ -181,6 +211,9 @@ def predict_plan(
         if latlon is not None:
             w["lat_deg"] = float(latlon[i, 0])
             w["lon_deg"] = float(latlon[i, 1])
+        if feas is not None:
+            w["required_s"] = float(feas.required_s[i])
+            w["ok"] = bool(feas.ok[i])
         waypoints.append(w)
     elements = [
         {
@@ -212,12 +245,15 @@ def predict_plan(
         wind={"speed_ms": wind_speed_ms, "from_deg": wind_from_deg},
         speed_ms=float(model.cruise_ms_ if speed_ms is None else speed_ms),
         model=model_name,
+        feasibility=feas,
     )
 
 
 def waypoints_csv(r: RoutePrediction) -> str:
     """The 4D waypoint times as CSV: waypoint, north_m, east_m[, lat_deg, lon_deg], time_s."""
     cols = ["waypoint", "north_m", "east_m"] + (["lat_deg", "lon_deg"] if r.origin else []) + ["time_s"]
+    if r.feasibility is not None:
+        cols += ["required_s", "ok"]
     out = io.StringIO()
     w = csv.DictWriter(out, cols, extrasaction="ignore", lineterminator="\n")
     w.writeheader()
@@ -322,6 +358,7 @@ __all__ = [
     "RoutePrediction",
     "UploadedPlan",
     "parse_number",
+    "parse_required",
     "predict_plan",
     "read_uploaded_model",
     "read_uploaded_plan",
