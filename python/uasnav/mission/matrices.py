@@ -33,6 +33,21 @@ class Equipment:
     always_necessary: bool
     note: str
     table20_name: str | None = None
+    #: Operation rules: (facts, reason) — necessary when the operation has any of the facts.
+    operation_rules: tuple[tuple[frozenset[str], str], ...] = ()
+    #: Database token of the per-UAS equipment that provides this item (None: not recorded).
+    onboard: str | None = None
+    #: Whether the item can be fitted to a UAS that lacks it (a module, not a design feature).
+    retrofit: bool = False
+
+
+@dataclass(frozen=True)
+class EquipmentStatus:
+    """The status of one item for one mission flown as one operation, and why."""
+
+    id: str
+    status: str
+    reason: str
 
 
 @dataclass(frozen=True)
@@ -85,6 +100,39 @@ class Matrices:
             if cells and all(c in item.incompatible_when for c in cells):
                 incompatible = True
         return INCOMPATIBLE if incompatible else OPTIONAL
+
+    def status_for(
+        self,
+        equipment_id: str,
+        features: dict[str, tuple[str, ...]],
+        facts: frozenset[str] = frozenset(),
+    ) -> EquipmentStatus:
+        """Status of one item for a mission's ``features`` (Table 18 levels, possibly narrowed
+        to the operation) and the operation's ``facts``, with the rule that decided it.
+
+        The Table 19 rule of the module docstring, then the operation rules: an operation rule
+        makes an item necessary even where a feature level alone would exclude it (the
+        operation is what is flown; e.g. a BLOS link for a BVLOS flight).
+        """
+        item = self.equipment[equipment_id]
+        if item.always_necessary:
+            return EquipmentStatus(item.id, NECESSARY, "always necessary (" + item.note + ")")
+        for tokens, reason in item.operation_rules:
+            if tokens & facts:
+                return EquipmentStatus(item.id, NECESSARY, "operation " + reason)
+        incompatible = None
+        for feat, levels in features.items():
+            cells = [(feat, lv) for lv in levels]
+            hit = next((c for c in cells if c in item.necessary_when), None)
+            if hit is not None:
+                return EquipmentStatus(
+                    item.id, NECESSARY, f"Table 19: {self.feature_names.get(feat, feat)} {hit[1]} needs it"
+                )
+            if cells and all(c in item.incompatible_when for c in cells) and incompatible is None:
+                incompatible = f"Table 19: not used at {self.feature_names.get(feat, feat)} {' '.join(levels)}"
+        if incompatible is not None:
+            return EquipmentStatus(item.id, INCOMPATIBLE, incompatible)
+        return EquipmentStatus(item.id, OPTIONAL, "no rule of Table 19 or of the operation needs it")
 
     def derive(self, mission_id: str) -> dict[str, str]:
         """Missions × equipment for one mission: equipment id → status (thesis step 4)."""
@@ -166,6 +214,11 @@ def load_matrices(source: str | os.PathLike | None = None, **fetch_kw) -> Matric
             always_necessary=it.get("always") == "necessary",
             note=(it.findtext("note") or "").strip(),
             table20_name=it.get("table20"),
+            operation_rules=tuple(
+                (frozenset(op.get("necessary").split()), op.get("reason")) for op in it.iterfind("operation")
+            ),
+            onboard=it.get("onboard"),
+            retrofit=it.get("retrofit") in ("true", "1"),
         )
     order = list(missions)
     rows = []
