@@ -202,6 +202,26 @@ def uas_tests(u: UasTable, req: Requirements, max_mtom_g: float) -> list[TestRes
     return out
 
 
+def equipment_tests(u: UasTable, gnss_autopilot: bool, need: list[tuple[str, str]]) -> list[TestResult]:
+    """Equipment the UAS must carry: ``gnss-autopilot`` when ``gnss_autopilot``, and each
+    (database token, item name) of ``need``. A UAS without an equipment record fails (what the
+    database does not record cannot be claimed). The test's ``unit`` holds the item name."""
+    n = len(u)
+    full = np.full(n, 1.0)
+    items = ([("gnss-autopilot", "GNSS-based autopilot (thesis Table 22)")] if gnss_autopilot else []) + [
+        t for t in need if t[0] != "gnss-autopilot"
+    ]
+    out = []
+    seen = set()
+    for token, name in items:
+        if token in seen:
+            continue
+        seen.add(token)
+        ok = u.has(token)
+        out.append(TestResult("equipment:" + token, ok, ok.astype(float), full, name, "=="))
+    return out
+
+
 def camera_tests(c: CameraTable, req: Requirements, height_m: float) -> list[TestResult]:
     """Camera tests: imagery type, HFOV (eq. 60) and ground resolution at ``height_m``.
 
@@ -238,6 +258,8 @@ def describe(test: TestResult, i, label: str) -> str:
     v, lim = float(test.value[i]), float(test.limit[i])
     if test.name == "imagery":
         return f"{label}: imagery is not {test.unit}"
+    if test.name.startswith("equipment:"):
+        return f"{label}: lacks {test.unit}, necessary for this operation (no '{test.name[10:]}' in its equipment record)"
     if test.name == "rain":
         return f"{label}: not rated for rain (needs IPX3 or better)"
     if test.name == "endurance":

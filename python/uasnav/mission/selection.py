@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,19 +19,43 @@ from uasnav.mission.feasibility import (
     required_hfov_deg,
     uas_tests,
 )
-from uasnav.mission.matrices import INCOMPATIBLE, Matrices, load_matrices
+from uasnav.mission.feasibility import equipment_tests as _equipment_tests
+from uasnav.mission.matrices import INCOMPATIBLE, NECESSARY, Matrices, load_matrices
+from uasnav.mission.operation import (
+    Operation,
+    ScenarioCheck,
+    derive_operation,
+    eu_scenarios,
+    faa_checks,
+    narrowed_features,
+)
 from uasnav.mission.regulations import Regulations, load_regulations
 from uasnav.mission.scoring import ScoreMatrix, Targets, Weights, rank, score_matrix
+from uasnav.mission.sora import SoraResult, assess
+
+if TYPE_CHECKING:
+    import datetime as dt
+
+    from uasnav.io.ed269 import Zone
+    from uasnav.mission.zones import MissionArea, ZoneCheck
 
 
 @dataclass(frozen=True)
 class EquipmentNeed:
-    """One equipment item suggested for the mission."""
+    """One equipment item for the mission flown as the derived operation.
+
+    ``reason`` names the Table 19 cell or the operation rule that set the status;
+    ``onboard`` is the database token that provides it on a UAS (None: not recorded per UAS)
+    and ``retrofit`` whether it can be fitted to a UAS that lacks it.
+    """
 
     id: str
     name: str
     group: str
     necessary: bool
+    reason: str = ""
+    onboard: str | None = None
+    retrofit: bool = False
 
 
 @dataclass(frozen=True)
@@ -54,6 +79,8 @@ class RankedPair:
     mass_g: float
     cost_usd: float
     open_subcategory: str | None
+    #: SORA SAIL of this configuration in the specific category (None elsewhere, or certified).
+    sail: str | None = None
 
 
 @dataclass
@@ -75,6 +102,40 @@ class Selection:
     scores: ScoreMatrix
     database: Database
     notes: list[str] = field(default_factory=list)
+    #: The derived operation (visibility, height, people, category …) with its derivation.
+    operation: Operation | None = None
+    #: SORA of the best configuration (EASA specific category), else None.
+    sora: SoraResult | None = None
+    #: Geographical zones the mission area enters (when an area and zones were given).
+    zones: ZoneCheck | None = None
+    #: EU STS/PDRA checks or FAA waivers/authorisations for the best configuration.
+    scenarios: tuple[ScenarioCheck, ...] = ()
+
+    @property
+    def chosen(self) -> RankedPair | None:
+        """The best-ranked configuration, if any."""
+        return self.ranking[0] if self.ranking else None
+
+    def equipment_on(self, uas_id: str) -> list[dict]:
+        """Each necessary item against the equipment record of UAS ``uas_id``: ``present``,
+        ``missing`` (``to be fitted`` when it is a module) or ``not recorded``."""
+        u = self.database.uas
+        i = u.ids.index(uas_id)
+        rec = u.equipment[i] if u.equipment else None
+        out = []
+        for e in self.equipment:
+            if not e.necessary:
+                continue
+            if e.onboard is None:
+                state = "not recorded per UAS"
+            elif rec is not None and e.onboard in rec:
+                state = "present"
+            elif e.retrofit:
+                state = "missing: to be fitted"
+            else:
+                state = "missing"
+            out.append({"id": e.id, "name": e.name, "state": state, "reason": e.reason})
+        return out
 
     @property
     def feasible_uas(self) -> list[str]:
@@ -99,9 +160,10 @@ class Selection:
             "equipment": [e.__dict__ for e in self.equipment],
             "regulations": {
                 "jurisdiction": r.jurisdiction,
-                "category": r.category,
+                "category": self.operation.category if self.operation else r.category,
                 "max_height_m": self.regulatory_height_m,
                 "vlos_required": self.vlos_required,
+                "legal_basis": self.operation.legal_basis if self.operation else None,
             },
             "required_hfov_deg": self.required_hfov_deg,
             "feasible_uas": self.feasible_uas,
@@ -110,7 +172,19 @@ class Selection:
             "ranking": [c.__dict__ for c in self.ranking],
             "weights": self.scores.weights.__dict__,
             "notes": self.notes,
+            "operation": self.operation.to_dict() if self.operation else None,
+            "sora": self.sora.to_dict() if self.sora else None,
+            "zones": self.zones.to_dict() if self.zones else None,
+            "scenarios": [x.__dict__ | {"reasons": list(x.reasons)} for x in self.scenarios],
+            "chosen_equipment": self.equipment_on(self.chosen.uas_id) if self.chosen else [],
         }
+
+
+def equipment_tests(u, req: Requirements, equipment: list[EquipmentNeed]) -> list[TestResult]:
+    """Equipment tests on the UAS: the GNSS autopilot when required (thesis Table 22) and every
+    necessary item that is a design feature of the aircraft (not a module that can be fitted)."""
+    need = [(e.onboard, e.name) for e in equipment if e.necessary and e.onboard and not e.retrofit]
+    return _equipment_tests(u, req.gnss_autopilot, need)
 
 
 def _reject(tests: list[TestResult], kind: str, labels, ids) -> tuple[np.ndarray, list[Rejection]]:
@@ -142,6 +216,10 @@ def select(
     targets: Targets | None = None,
     weights: Weights | None = None,
     top: int = 10,
+    area: MissionArea | None = None,
+    zones: tuple[Zone, ...] | None = None,
+    zones_source: str = "zones",
+    when: dt.datetime | None = None,
 ) -> Selection:
     """Run the whole selection for ``req``.
 
@@ -154,6 +232,13 @@ def select(
         Scoring parameters (Table 23, eq. 61 by default).
     top : int
         Number of ranked configurations returned.
+    area, zones : optional
+        Mission area (:func:`uasnav.mission.zones.parse_area`) and ED-269 zones: the zones the
+        area enters are reported (both needed).
+    zones_source : str
+        Name of the zone file in the output.
+    when : datetime, optional
+        Take-off time (aware) for the zones' schedules.
 
     Returns
     -------
@@ -165,20 +250,43 @@ def select(
     mx = matrices if matrices is not None else load_matrices()
     regs = regulations if regulations is not None else load_regulations()
     mission = mx.mission(req.mission)
-    status = mx.derive(req.mission)
-    equipment = [
-        EquipmentNeed(e.id, e.name, e.group, status[e.id] == "necessary")
-        for e in mx.equipment.values()
-        if status[e.id] != INCOMPATIBLE
-    ]
-    cat = regs.category(req.jurisdiction, req.category)
-    h_reg = regs.max_height_m(req.jurisdiction, req.category)
+    op = derive_operation(req)
+    feats = narrowed_features(dict(mission.features), op)
+    equipment = []
+    for e in mx.equipment.values():
+        st = mx.status_for(e.id, feats, op.facts)
+        if st.status != INCOMPATIBLE:
+            equipment.append(
+                EquipmentNeed(e.id, e.name, e.group, st.status == NECESSARY, st.reason, e.onboard, e.retrofit)
+            )
+    category = op.category
+    cat = regs.category(req.jurisdiction, category)
+    h_reg = regs.max_height_m(req.jurisdiction, category)
     mtom_lim = cat.limit("mtom")
     max_mtom = mtom_lim.value_si if mtom_lim is not None else np.inf
     notes = []
     rejections: list[Rejection] = []
-    height_checks = regs.check(req.jurisdiction, req.category, height_m=req.altitude_m)
+    height_checks = regs.check(req.jurisdiction, category, height_m=req.altitude_m)
     mission_ok = all(c.ok for c in height_checks)
+    notes += list(op.notes)
+    if cat.vlos_required and op.bvlos and req.jurisdiction == "faa":
+        # Part 107's VLOS rule is waivable (§107.205): the flight needs a waiver, listed with
+        # the FAA checks, it is not refused.
+        notes.append(f"faa/{category}: BVLOS needs a waiver of 14 CFR §107.31 (§107.205)")
+    elif cat.vlos_required and op.bvlos:
+        mission_ok = False
+        rejections.append(
+            Rejection(
+                "mission",
+                req.mission,
+                "regulation-vlos",
+                op.max_distance_m,
+                op.vlos_distance_m,
+                "m",
+                f"{req.jurisdiction}/{category} requires VLOS ({cat.source}); the pilot-UA distance "
+                f"{op.max_distance_m:g} m exceeds the {op.vlos_distance_m:g} m kept in sight",
+            )
+        )
     for chk in height_checks:
         if not chk.ok:
             rejections.append(
@@ -192,16 +300,16 @@ def select(
                     f"required altitude {req.altitude_m:g} m exceeds {chk.limit.describe()}",
                 )
             )
-    if cat.vlos_required:
+    if cat.vlos_required and not op.bvlos:
         notes.append(
-            f"{req.jurisdiction}/{req.category}: VLOS required ({cat.source}); "
-            f"range {req.range_m:g} m must stay in sight"
+            f"{req.jurisdiction}/{category}: VLOS required ({cat.source}); "
+            f"{op.max_distance_m:g} m from the pilot, within the {op.vlos_distance_m:g} m kept in sight"
         )
     # eq. 60 at the highest height the regulations allow (thesis §5.2.3.4); if the category sets
     # no height limit the required altitude is used instead.
     h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
     u, c = db.uas, db.cameras
-    uas_ok, rej = _reject(uas_tests(u, req, max_mtom), "uas", u.label, u.ids)
+    uas_ok, rej = _reject(uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids)
     rejections += rej
     cam_ok, rej = _reject(camera_tests(c, req, h_cam), "camera", c.label, c.ids)
     rejections += rej
@@ -224,6 +332,46 @@ def select(
     scores = score_matrix(
         u.max_range_m, u.mass_g, u.cost_usd, c.mass_g, c.cost_usd, c.ifov_deg, targets, weights, pair_ok
     )
+    is_open = req.jurisdiction == "easa" and category == "open"
+    if is_open:
+        # The open subcategory follows the class label, the mass and the distances to people;
+        # a pair the open category cannot admit under this operation is rejected.
+        for i, j in zip(*np.nonzero(pair_ok), strict=True):
+            m = float(u.mass_g[i] + c.mass_g[j])
+            if regs.open_subcategory(m, u.eu_class[i], over_people=op.over_people, urban=op.urban) is None:
+                pair_ok[i, j] = False
+                rejections.append(
+                    Rejection(
+                        "pair",
+                        f"{u.ids[i]}+{c.ids[j]}",
+                        "open-subcategory",
+                        m,
+                        float("nan"),
+                        "g",
+                        f"{u.label(i)} + {c.label(j)}: no open subcategory (A1/A2/A3) admits class "
+                        f"{u.eu_class[i] or 'none'} at {m:.0f} g over people '{op.over_people}'"
+                        f"{' in an urban area' if op.urban else ''}",
+                    )
+                )
+        scores = score_matrix(
+            u.max_range_m, u.mass_g, u.cost_usd, c.mass_g, c.cost_usd, c.ifov_deg, targets, weights, pair_ok
+        )
+    is_specific = req.jurisdiction == "easa" and category == "specific"
+
+    def sora_of(i: int, m: float) -> SoraResult:
+        return assess(
+            dimension_m=float(u.span_m[i]),
+            speed_ms=float(u.max_speed_ms[i]),
+            population=op.population,
+            bvlos=op.bvlos,
+            mass_g=m,
+            height_m=req.altitude_m,
+            airspace=req.airspace,
+            urban=op.urban,
+            mitigations=dict(req.mitigations),
+            edition=req.sora_edition,
+        )
+
     ranking = []
     for i, j in rank(scores.total, top):
         m = float(scores.mass_g[i, j])
@@ -240,9 +388,43 @@ def select(
                 float(scores.resolution[0, j]),
                 m,
                 float(scores.cost_usd[i, j]),
-                regs.open_subcategory(m, u.eu_class[i]) if "easa" in regs.jurisdictions else None,
+                regs.open_subcategory(m, u.eu_class[i], over_people=op.over_people, urban=op.urban)
+                if "easa" in regs.jurisdictions
+                else None,
+                sora_of(i, m).sail if is_specific else None,
             )
         )
+    sora = None
+    scenarios: tuple[ScenarioCheck, ...] = ()
+    if ranking:
+        best = ranking[0]
+        bi = u.ids.index(best.uas_id)
+        if is_specific:
+            sora = sora_of(bi, best.mass_g)
+        if req.jurisdiction == "easa":
+            scenarios = eu_scenarios(
+                op,
+                eu_class=u.eu_class[bi],
+                mtom_g=best.mass_g,
+                dimension_m=float(u.span_m[bi]),
+                speed_ms=float(u.max_speed_ms[bi]),
+            )
+        elif req.jurisdiction == "faa":
+            scenarios = faa_checks(op, mtom_g=best.mass_g)
+    zone_check = None
+    if area is not None and zones is not None:
+        from uasnav.mission.zones import check_zones
+
+        zone_check = check_zones(
+            zones,
+            area,
+            height_m=req.altitude_m,
+            ground_elevation_m=req.ground_elevation_m,
+            when=when,
+            source=zones_source,
+        )
+        for h in zone_check.hits:
+            notes.append(f"zone {h.identifier} ({h.restriction}): {h.requires}")
     return Selection(
         req,
         mission.name,
@@ -259,4 +441,8 @@ def select(
         scores,
         db,
         notes,
+        op,
+        sora,
+        zone_check,
+        scenarios,
     )
