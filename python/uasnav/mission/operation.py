@@ -354,7 +354,7 @@ def eu_scenarios(
 FAA_CAT1_LB = 0.55
 
 
-def faa_checks(op: Operation, *, mtom_g: float) -> tuple[ScenarioCheck, ...]:
+def faa_checks(op: Operation, *, mtom_g: float | None) -> tuple[ScenarioCheck, ...]:
     """Waivers and authorisations a Part 107 operation needs, and its Subpart D category.
 
     Sources: 14 CFR §107.31 (VLOS), §107.29 (night, as amended 2021: anti-collision lighting
@@ -383,7 +383,7 @@ def faa_checks(op: Operation, *, mtom_g: float) -> tuple[ScenarioCheck, ...]:
             )
         )
     if op.over_people != "none":
-        lb = mtom_g / 453.59237
+        lb = math.inf if mtom_g is None else mtom_g / 453.59237
         if op.over_people == "assemblies":
             cat = "category 4 (airworthiness certificate) or waiver §107.39; categories 1–2 allow open-air assemblies only with Remote ID, category 3 never"
         elif lb <= FAA_CAT1_LB:

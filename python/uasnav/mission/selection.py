@@ -411,6 +411,8 @@ def select(
             )
         elif req.jurisdiction == "faa":
             scenarios = faa_checks(op, mtom_g=best.mass_g)
+    elif req.jurisdiction == "faa":
+        scenarios = faa_checks(op, mtom_g=None)
     zone_check = None
     if area is not None and zones is not None:
         from uasnav.mission.zones import check_zones

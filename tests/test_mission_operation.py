@@ -1,0 +1,153 @@
+"""The operation drives the category and the equipment (issue 18): the thesis' requirements at
+300 m (VLOS, open) and at 1500 m (BVLOS, specific with a SORA result), each equipment item with
+its reason, per-UAS equipment rejections, open subcategories, FAA Part 107 checks."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from click.testing import CliRunner
+
+from uasnav.cli import main
+from uasnav.mission import Requirements, load_database, load_regulations, select
+from uasnav.mission.operation import derive_operation, range_level
+
+THESIS = (
+    "select --mission precision-agriculture --resolution 0.05 --image-size 70x70 --altitude 50 "
+    "--imagery multispectral --wind 5 --order-by cost --json --range"
+).split()
+SA = {"ads-b", "taws", "blos-c2", "airspeed-sensor", "contingency-management", "utm-monitoring"}
+
+
+def _run(*extra: str) -> dict:
+    res = CliRunner().invoke(main, [*THESIS, *extra])
+    assert res.exit_code == 0, res.output
+    return json.loads(res.output)
+
+
+def test_rural_vlos_flight_is_open_with_only_what_it_needs() -> None:
+    out = _run("300")
+    op = out["operation"]
+    assert op["visibility"] == "VLOS" and op["category"] == "open" and op["environment"] == "rural"
+    assert out["regulations"]["category"] == "open" and "Art. 4" in out["regulations"]["legal_basis"]
+    assert out["sora"] is None
+    necessary = {e["id"] for e in out["equipment"] if e["necessary"]}
+    assert not necessary & SA, necessary & SA
+    assert {"standard-gnss", "c2-link", "barometric-altimeter"} <= necessary
+    assert all(e["reason"] for e in out["equipment"])
+    # every derived fact says which requirement and which rule produced it
+    vis = next(f for f in op["derivation"] if f["name"] == "visibility")
+    assert "300 m" in vis["requirement"] and "CAP 722" in vis["rule"]
+    assert out["ranking"] and all(r["open_subcategory"] in ("A1", "A2", "A3") for r in out["ranking"])
+
+
+def test_thesis_scenario_is_bvlos_specific_with_sora_and_blos_link() -> None:
+    out = _run("1500")
+    op = out["operation"]
+    assert op["visibility"] == "BVLOS" and op["category"] == "specific"
+    assert "Art. 5" in op["legal_basis"]
+    s = out["sora"]
+    assert s["edition"] == "2.5" and s["sail"] in ("I", "II", "III", "IV", "V", "VI")
+    assert s["final_grc"] is not None and s["initial_arc"] in "abcd" and s["residual_arc"] in "abcd"
+    blos = next(e for e in out["equipment"] if e["id"] == "blos-c2")
+    assert blos["necessary"] and "BVLOS" in blos["reason"]
+    lost = next(e for e in out["equipment"] if e["id"] == "lost-link-mode")
+    assert lost["necessary"]
+    # the chosen UAS's equipment: the BLOS link is a module to fit, not carried
+    chosen = {x["id"]: x["state"] for x in out["chosen_equipment"]}
+    assert chosen["blos-c2"] == "missing: to be fitted" and chosen["lost-link-mode"] == "present"
+    assert out["ranking"][0]["sail"] == s["sail"]
+    # and the 2.0 edition when asked
+    s20 = _run("1500", "--sora-edition", "2.0", "--mitigations", "M3=medium")["sora"]
+    assert s20["edition"] == "2.0" and len(s20["osos"]) == 24
+
+
+def test_max_and_vlos_distance_decide_visibility() -> None:
+    assert derive_operation(Requirements(range_m=1500.0, max_distance_m=400.0)).visibility == "VLOS"
+    assert derive_operation(Requirements(range_m=300.0, vlos_distance_m=200.0)).visibility == "BVLOS"
+    assert derive_operation(Requirements(range_m=500.0)).visibility == "VLOS"  # on the 500 m default
+    assert derive_operation(Requirements(range_m=500.001)).visibility == "BVLOS"
+    assert [range_level(x) for x in (999.9, 1000.0, 4999.0, 5000.0)] == ["lt1km", "1to5km", "1to5km", "gt5km"]
+    high = derive_operation(Requirements(range_m=300.0, altitude_m=120.5))
+    assert high.category == "specific" and "Art. 4(1)(e)" in high.legal_basis
+    crowd = derive_operation(Requirements(range_m=300.0, over_people="assemblies"))
+    assert crowd.category == "specific" and "assemblies" in crowd.legal_basis
+
+
+def test_operation_facts_make_items_necessary() -> None:
+    base = {e.id for e in select(Requirements(range_m=300.0)).equipment if e.necessary}
+    ctl = select(Requirements(range_m=300.0, airspace="controlled"))
+    assert "ads-b" not in base and "ads-b" in {e.id for e in ctl.equipment if e.necessary}
+    urban = select(Requirements(range_m=300.0, population_density=3000.0))
+    assert urban.operation.urban and "obstacle-sensors" in {e.id for e in urban.equipment if e.necessary}
+
+
+def test_uas_lacking_a_necessary_item_is_rejected_with_the_reason() -> None:
+    sel = select(Requirements(range_m=300.0))
+    frames = [r for r in sel.rejections if r.item == "skywalker-x8" and r.test == "equipment:gnss-autopilot"]
+    assert frames and "GNSS-based autopilot" in frames[0].message
+    free = select(Requirements(range_m=300.0, gnss_autopilot=False))
+    assert not [r for r in free.rejections if r.test == "equipment:gnss-autopilot"]
+    # BVLOS needs a lost-link behaviour, a design feature: an aircraft without one goes
+    db = load_database()
+    u = db.uas
+    bvlos = select(Requirements(), database=db)
+    no_ll = [u.ids[i] for i in range(len(u)) if u.equipment[i] is None or "lost-link" not in u.equipment[i]]
+    rejected = {r.item for r in bvlos.rejections if r.test == "equipment:lost-link"}
+    assert no_ll and set(no_ll) <= rejected
+    assert all(u.equipment_sources[i] for i in range(len(u)) if u.equipment[i] is not None)
+
+
+def test_open_subcategory_follows_class_and_people() -> None:
+    regs = load_regulations()
+    assert regs.open_subcategory(249.0, None, over_people="uninvolved") == "A1"  # legacy < 250 g
+    assert regs.open_subcategory(800.0, "C1", over_people="uninvolved") is None  # C1 may not
+    assert regs.open_subcategory(200.0, "C0", over_people="uninvolved") == "A1"
+    assert regs.open_subcategory(3000.0, "C2", urban=True) == "A2"
+    assert regs.open_subcategory(5000.0, "C3", urban=True) is None  # A3: 150 m from residential
+    assert regs.open_subcategory(5000.0, "C3") == "A3"
+    assert regs.open_subcategory(200.0, "C0", over_people="assemblies") is None
+    sel = select(Requirements(range_m=300.0, over_people="uninvolved"))
+    assert sel.operation.category == "open" and not sel.ranking  # nothing in the db is C0 / < 250 g
+    assert any(r.test == "open-subcategory" for r in sel.rejections)
+
+
+def test_faa_part107_checks() -> None:
+    sel = select(Requirements(jurisdiction="faa", night=True, over_people="uninvolved"))
+    ids = {x.id for x in sel.scenarios}
+    assert {"waiver §107.31", "night §107.29", "over people Subpart D"} <= ids
+    assert "waiver §107.51(b)" not in ids
+    assert sel.operation.category == "part107" and sel.ranking  # BVLOS is waivable, not refused
+    high = select(Requirements(jurisdiction="faa", altitude_m=130.0))
+    assert not high.ranking and "waiver §107.51(b)" in {x.id for x in high.scenarios}
+    cat = next(x for x in sel.scenarios if x.id == "over people Subpart D")
+    assert "category 2 or 3" in cat.reasons[0]
+
+
+def test_eu_scenarios_for_the_thesis_case() -> None:
+    sel = select(Requirements())
+    by = {x.id: x for x in sel.scenarios}
+    assert not by["STS-02"].applies and any("C6" in r for r in by["STS-02"].reasons)
+    assert by["PDRA-G01"].applies  # BVLOS, small multirotor, lightly populated, < 150 m, class G
+
+
+@pytest.mark.parametrize(
+    ("argv", "option"),
+    [
+        (["--population-density", "crowded"], "--population-density"),
+        (["--population-density", "-3"], "--population-density"),
+        (["--mitigations", "M1A=high"], "--mitigations"),
+        (["--mitigations", "M9=low"], "--mitigations"),
+        (["--flight-time", "tomorrow"], "--flight-time"),
+        (["--flight-time", "2026-05-01T10:00"], "--flight-time"),
+        (["--airspace", "space"], "--airspace"),
+        (["--over-people", "some"], "--over-people"),
+        (["--max-distance", "0"], "--max-distance"),
+        (["--summary", "out.txt"], "--summary"),
+    ],
+)
+def test_new_options_refuse_bad_values(argv, option) -> None:
+    res = CliRunner().invoke(main, ["select", *argv])
+    assert res.exit_code == 2, res.output
+    assert option in res.stderr

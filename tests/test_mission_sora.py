@@ -1,0 +1,225 @@
+"""SORA tables at every boundary, against the tables as printed in the JARUS documents.
+
+The expected values are written out here as the documents print them (row by row), separately
+from the encoding in uasnav.mission.sora, and every boundary is probed on both sides: a
+dimension or speed exactly on a column bound and just above it, a density just below and on a
+row bound, every SAIL cell, every branch of the ARC tree, each mitigation level and the floor.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from uasnav.errors import InputError
+from uasnav.mission import sora
+
+# JARUS SORA 2.5 Main Body, Table 2 (iGRC), as printed: rows by population density.
+PRINTED_25 = {
+    "controlled": (1, 1, 2, 3, 3),
+    "remote": (2, 3, 4, 5, 6),
+    "lightly": (3, 4, 5, 6, 7),
+    "sparsely": (4, 5, 6, 7, 8),
+    "suburban": (5, 6, 7, 8, 9),
+    "high-density": (6, 7, 8, 9, 10),
+    "assemblies": (7, 8, None, None, None),
+}
+COLS_25 = [(1, 25), (3, 35), (8, 75), (20, 120), (40, 200)]
+# JARUS SORA 2.0, Table 5 / SORA 2.5 Main Body Table 7 (SAIL), rows GRC ≤2..7, columns ARC a..d.
+PRINTED_SAIL = [
+    ("I", "II", "IV", "VI"),
+    ("II", "II", "IV", "VI"),
+    ("III", "III", "IV", "VI"),
+    ("IV", "IV", "IV", "VI"),
+    ("V", "V", "V", "VI"),
+    ("VI", "VI", "VI", "VI"),
+]
+
+
+@pytest.mark.parametrize("row", list(PRINTED_25))
+@pytest.mark.parametrize("col", range(5))
+def test_igrc_25_every_cell_on_and_above_its_bounds(row, col) -> None:
+    d, v = COLS_25[col]
+    assert sora.igrc_25(d, v, row) == PRINTED_25[row][col]  # exactly on both bounds: this column
+    if col < 4:
+        # just above the dimension bound, or just above the speed bound: the next column
+        assert sora.igrc_25(d * (1 + 1e-9), v * 0.5, row) == PRINTED_25[row][col + 1]
+        assert sora.igrc_25(d * 0.5, v * (1 + 1e-9), row) == PRINTED_25[row][col + 1]
+
+
+def test_igrc_25_beyond_the_table_and_the_250_g_rule() -> None:
+    with pytest.raises(InputError, match="certified"):
+        sora.igrc_25(40.01, 10.0, "remote")
+    with pytest.raises(InputError, match="certified"):
+        sora.igrc_25(1.0, 200.01, "remote")
+    # Table 2 note: ≤ 250 g and ≤ 25 m/s → iGRC 1 whatever the population
+    assert sora.igrc_25(0.2, 25.0, "high-density", mass_g=250.0) == 1
+    assert sora.igrc_25(0.2, 25.0, "high-density", mass_g=250.1) == 6
+    assert sora.igrc_25(0.2, 25.1, "high-density", mass_g=249.0) == 7
+
+
+@pytest.mark.parametrize(
+    ("density", "row"),
+    [
+        (0.0, "remote"),
+        (4.999, "remote"),
+        (5.0, "lightly"),
+        (49.999, "lightly"),
+        (50.0, "sparsely"),
+        (499.9, "sparsely"),
+        (500.0, "suburban"),
+        (4999.0, "suburban"),
+        (5000.0, "high-density"),
+        (49999.0, "high-density"),
+        (50000.0, "assemblies"),
+    ],
+)
+def test_density_rows_at_their_bounds(density, row) -> None:
+    assert sora.density_class(density) == row
+
+
+@pytest.mark.parametrize("bad", [-1.0, math.nan, math.inf])
+def test_density_refuses_nonsense(bad) -> None:
+    with pytest.raises(InputError):
+        sora.density_class(bad)
+
+
+@pytest.mark.parametrize("grc", range(1, 9))
+@pytest.mark.parametrize("arc", "abcd")
+def test_sail_every_cell(grc, arc) -> None:
+    want = None if grc > 7 else PRINTED_SAIL[max(grc, 2) - 2]["abcd".index(arc)]
+    assert sora.sail(grc, arc) == want
+
+
+def test_sail_and_tmpr_are_the_same_in_both_editions() -> None:
+    """The 2.0 and 2.5 SAIL tables are identical (some public encodings swap or alter one); the
+    editions differ in the iGRC table, the mitigations, the GRC > 7 rule and the OSO list."""
+    r25 = sora.assess(dimension_m=0.5, speed_ms=15.0, mass_g=1500.0, population="sparsely", bvlos=True)
+    r20 = sora.assess(
+        dimension_m=0.5, speed_ms=15.0, mass_g=1500.0, population="sparsely", bvlos=True, edition="2.0"
+    )
+    # 2.5: iGRC 4 (sparsely, 1 m column). 2.0: BVLOS sparsely, 1 m / 169 J → 3, +1 without ERP.
+    assert (r25.igrc, r25.final_grc, r25.sail) == (4, 4, "III")
+    assert (r20.igrc, r20.final_grc, r20.sail) == (3, 4, "III")
+    assert len(r25.osos) == 17 and len(r20.osos) == 24
+    assert {o.id for o in r25.osos} < {o.id for o in r20.osos}
+
+
+@pytest.mark.parametrize(
+    ("mitigations", "final"),
+    [
+        ({}, 5),
+        ({"M1A": "low"}, 4),
+        ({"M1A": "medium"}, 3),
+        ({"M1B": "medium"}, 4),
+        ({"M1B": "high"}, 3),
+        ({"M1C": "low"}, 4),
+        ({"M2": "medium"}, 4),
+        ({"M2": "high"}, 3),
+        ({"M1A": "medium", "M1B": "high", "M2": "high"}, 1),  # floor: the column's controlled value
+    ],
+)
+def test_mitigations_25(mitigations, final) -> None:
+    r = sora.assess(dimension_m=2.0, speed_ms=30.0, population="sparsely", bvlos=True, mitigations=mitigations)
+    assert r.igrc == 5 and r.final_grc == final
+
+
+def test_mitigation_floor_follows_the_column() -> None:
+    r = sora.assess(
+        dimension_m=10.0, speed_ms=50.0, population="remote", bvlos=True, mitigations={"M1B": "high", "M2": "high"}
+    )
+    assert r.igrc == 5 and r.final_grc == 3  # 20 m column: controlled ground area = 3
+
+
+@pytest.mark.parametrize(("name", "level"), [("M1A", "high"), ("M1B", "low"), ("M1C", "medium"), ("M2", "low")])
+def test_mitigation_levels_the_table_does_not_offer(name, level) -> None:
+    with pytest.raises(InputError, match="cannot be claimed"):
+        sora.final_grc(5, {name: level}, "2.5", 1)
+
+
+@pytest.mark.parametrize(
+    ("mitigations", "final"),
+    [
+        ({"M3": "medium"}, 3),
+        ({}, 4),  # no ERP: +1
+        ({"M3": "low"}, 4),
+        ({"M3": "high"}, 2),
+        ({"M1": "low", "M3": "medium"}, 2),
+        ({"M1": "medium", "M3": "medium"}, 1),
+        ({"M1": "high", "M3": "medium"}, 1),  # floor 1
+        ({"M2": "low", "M3": "medium"}, 3),
+        ({"M2": "medium", "M3": "medium"}, 2),
+        ({"M2": "high", "M3": "medium"}, 1),
+    ],
+)
+def test_mitigations_20(mitigations, final) -> None:
+    # 2.0 Table 2: BVLOS sparsely populated, 1 m column → iGRC 3
+    r = sora.assess(
+        dimension_m=0.5, speed_ms=10.0, mass_g=1000.0, population="lightly", bvlos=True,
+        mitigations=mitigations, edition="2.0",
+    )
+    assert r.igrc == 3 and r.final_grc == final
+
+
+@pytest.mark.parametrize(
+    ("dim", "energy", "col"),
+    [(1.0, 699.9, 0), (1.0, 700.0, 1), (1.01, 1.0, 1), (3.0, 33999.0, 1), (3.0, 34000.0, 2), (8.0, 1083999.0, 2),
+     (8.0, 1084000.0, 3), (8.01, 1.0, 3)],
+)
+def test_igrc_20_columns_at_their_bounds(dim, energy, col) -> None:
+    printed = {  # SORA 2.0 Table 2, as printed
+        "controlled": (1, 2, 3, 4),
+        "vlos-sparsely": (2, 3, 4, 5),
+        "bvlos-sparsely": (3, 4, 5, 6),
+        "vlos-populated": (4, 5, 6, 8),
+        "bvlos-populated": (5, 6, 8, 10),
+        "vlos-assemblies": (7, None, None, None),
+        "bvlos-assemblies": (8, None, None, None),
+    }
+    for scen, row in printed.items():
+        assert sora.igrc_20(dim, energy, scen) == row[col], scen
+
+
+@pytest.mark.parametrize(
+    ("airspace", "height", "urban", "arc"),
+    [
+        ("atypical", 50, False, "a"),
+        ("airport-bcd", 50, False, "d"),
+        ("airport-efg", 50, False, "c"),
+        ("tmz", 152.5, False, "d"),
+        ("controlled", 152.5, False, "d"),
+        ("uncontrolled", 152.5, True, "c"),
+        ("uncontrolled", 152.5, False, "c"),
+        ("tmz", 152.4, False, "c"),
+        ("controlled", 100, False, "c"),
+        ("uncontrolled", 100, True, "c"),
+        ("uncontrolled", 152.4, False, "b"),  # 500 ft exactly is still "below 500 ft"
+    ],
+)
+def test_initial_arc_tree(airspace, height, urban, arc) -> None:
+    assert sora.initial_arc(airspace, height, urban) == arc
+
+
+def test_tmpr_vlos_and_residual_arc() -> None:
+    vlos = sora.assess(dimension_m=0.5, speed_ms=10.0, population="lightly", bvlos=False, airspace="controlled")
+    assert vlos.initial_arc == "c" and vlos.tmpr == "none"
+    for arc, tm in zip("abcd", ("none", "low", "medium", "high"), strict=True):
+        assert sora.TMPR[arc] == tm
+    r = sora.assess(dimension_m=0.5, speed_ms=10.0, population="lightly", bvlos=True, airspace="controlled",
+                    residual_arc="b")
+    assert (r.initial_arc, r.residual_arc, r.tmpr, r.sail) == ("c", "b", "low", "II")
+    with pytest.raises(InputError, match="residual ARC"):
+        sora.assess(dimension_m=0.5, speed_ms=10.0, population="lightly", bvlos=True, residual_arc="d")
+
+
+def test_certified_category_and_oso_robustness() -> None:
+    r = sora.assess(dimension_m=30.0, speed_ms=150.0, population="high-density", bvlos=True)
+    assert r.igrc == 10 and r.certified and r.sail is None  # 40 m column
+    grey = sora.assess(dimension_m=5.0, speed_ms=50.0, population="assemblies", bvlos=True)
+    assert grey.igrc is None and grey.certified
+    # Table 14: OSO#01 is O L M H H H over SAIL I..VI
+    want = ["optional", "low", "medium", "high", "high", "high"]
+    assert [next(o for o in sora.osos(s, "2.5") if o.id == "OSO#01").robustness for s in sora.SAILS] == want
+    assert next(o for o in sora.osos("VI", "2.0") if o.id == "OSO#04").robustness == "high"
+    assert next(o for o in sora.osos("I", "2.0") if o.id == "OSO#04").robustness == "optional"
