@@ -162,6 +162,45 @@ class Matrices:
         return out
 
 
+def explain_table20(mx: Matrices) -> list[dict]:
+    """Every cell where the derivation and the printed Table 20 disagree, each with the reason.
+
+    Kinds: ``blank-is-not-relevant`` (we derive optional, Table 20 leaves it blank: Table 20 uses
+    blank for "not relevant", Table 19 allows the item); ``mission-objective`` (Table 20 asks
+    for an item that no feature rule of Table 19 / §5.2.2.3 asks for — §5.2.2.4 motivates such
+    items by the mission's objective, which the features cannot express); ``rule-applied`` (a
+    rule of §5.2.2.3, named by its Table 19 cell, makes the item necessary where Table 20 does
+    not; we follow the stated rule); ``incompatible-cell`` (a Table 19 incompatibility with a
+    physical reason excludes an item Table 20 lists).
+    """
+    out = []
+    for d in mx.compare_table20():
+        mission = mx.mission(d["mission"])
+        st = mx.status_for(d["equipment"], dict(mission.features))
+        derived, printed = d["derived"], d["table20"]
+        if derived == OPTIONAL and printed == INCOMPATIBLE:
+            kind = "blank-is-not-relevant"
+            why = "Table 20 leaves blank (not relevant) what Table 19 allows; no feature excludes it"
+        elif printed == NECESSARY:
+            kind = "mission-objective"
+            why = "Table 20 requires it but no rule of §5.2.2.3 names a feature level of this mission (objective-driven, §5.2.2.4)"
+        elif derived == NECESSARY:
+            kind = "rule-applied"
+            why = f"{st.reason}; Table 20 does not apply this rule"
+            span = [f for f, lv in mission.features.items() if len(lv) > 1 and mx.feature_names.get(f, f) in st.reason]
+            if span:
+                f = span[0]
+                why += (
+                    f" (the mission spans {f} {' '.join(mission.features[f])}: with the operation known, "
+                    "only the flown level counts — uasnav.mission.operation)"
+                )
+        else:
+            kind = "incompatible-cell"
+            why = f"{st.reason} (Table 19 blank kept for its physical reason: see the item's note)"
+        out.append({**d, "kind": kind, "reason": why})
+    return out
+
+
 def _cells(text: str, features: dict[str, tuple[str, ...]], where: str, line: int | None) -> frozenset:
     cells = set()
     for tok in text.split():
