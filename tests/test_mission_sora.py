@@ -121,18 +121,26 @@ def test_sail_and_tmpr_are_the_same_in_both_editions() -> None:
     ],
 )
 def test_mitigations_25(mitigations, final) -> None:
-    r = sora.assess(dimension_m=2.0, speed_ms=30.0, population="sparsely", bvlos=True, mitigations=mitigations)
+    r = sora.assess(
+        dimension_m=2.0, speed_ms=30.0, population="sparsely", bvlos=True, mitigations=mitigations
+    )
     assert r.igrc == 5 and r.final_grc == final
 
 
 def test_mitigation_floor_follows_the_column() -> None:
     r = sora.assess(
-        dimension_m=10.0, speed_ms=50.0, population="remote", bvlos=True, mitigations={"M1B": "high", "M2": "high"}
+        dimension_m=10.0,
+        speed_ms=50.0,
+        population="remote",
+        bvlos=True,
+        mitigations={"M1B": "high", "M2": "high"},
     )
     assert r.igrc == 5 and r.final_grc == 3  # 20 m column: controlled ground area = 3
 
 
-@pytest.mark.parametrize(("name", "level"), [("M1A", "high"), ("M1B", "low"), ("M1C", "medium"), ("M2", "low")])
+@pytest.mark.parametrize(
+    ("name", "level"), [("M1A", "high"), ("M1B", "low"), ("M1C", "medium"), ("M2", "low")]
+)
 def test_mitigation_levels_the_table_does_not_offer(name, level) -> None:
     with pytest.raises(InputError, match="cannot be claimed"):
         sora.final_grc(5, {name: level}, "2.5", 1)
@@ -156,16 +164,29 @@ def test_mitigation_levels_the_table_does_not_offer(name, level) -> None:
 def test_mitigations_20(mitigations, final) -> None:
     # 2.0 Table 2: BVLOS sparsely populated, 1 m column → iGRC 3
     r = sora.assess(
-        dimension_m=0.5, speed_ms=10.0, mass_g=1000.0, population="lightly", bvlos=True,
-        mitigations=mitigations, edition="2.0",
+        dimension_m=0.5,
+        speed_ms=10.0,
+        mass_g=1000.0,
+        population="lightly",
+        bvlos=True,
+        mitigations=mitigations,
+        edition="2.0",
     )
     assert r.igrc == 3 and r.final_grc == final
 
 
 @pytest.mark.parametrize(
     ("dim", "energy", "col"),
-    [(1.0, 699.9, 0), (1.0, 700.0, 1), (1.01, 1.0, 1), (3.0, 33999.0, 1), (3.0, 34000.0, 2), (8.0, 1083999.0, 2),
-     (8.0, 1084000.0, 3), (8.01, 1.0, 3)],
+    [
+        (1.0, 699.9, 0),
+        (1.0, 700.0, 1),
+        (1.01, 1.0, 1),
+        (3.0, 33999.0, 1),
+        (3.0, 34000.0, 2),
+        (8.0, 1083999.0, 2),
+        (8.0, 1084000.0, 3),
+        (8.01, 1.0, 3),
+    ],
 )
 def test_igrc_20_columns_at_their_bounds(dim, energy, col) -> None:
     printed = {  # SORA 2.0 Table 2, as printed
@@ -202,12 +223,20 @@ def test_initial_arc_tree(airspace, height, urban, arc) -> None:
 
 
 def test_tmpr_vlos_and_residual_arc() -> None:
-    vlos = sora.assess(dimension_m=0.5, speed_ms=10.0, population="lightly", bvlos=False, airspace="controlled")
+    vlos = sora.assess(
+        dimension_m=0.5, speed_ms=10.0, population="lightly", bvlos=False, airspace="controlled"
+    )
     assert vlos.initial_arc == "c" and vlos.tmpr == "none"
     for arc, tm in zip("abcd", ("none", "low", "medium", "high"), strict=True):
         assert sora.TMPR[arc] == tm
-    r = sora.assess(dimension_m=0.5, speed_ms=10.0, population="lightly", bvlos=True, airspace="controlled",
-                    residual_arc="b")
+    r = sora.assess(
+        dimension_m=0.5,
+        speed_ms=10.0,
+        population="lightly",
+        bvlos=True,
+        airspace="controlled",
+        residual_arc="b",
+    )
     assert (r.initial_arc, r.residual_arc, r.tmpr, r.sail) == ("c", "b", "low", "II")
     with pytest.raises(InputError, match="residual ARC"):
         sora.assess(dimension_m=0.5, speed_ms=10.0, population="lightly", bvlos=True, residual_arc="d")

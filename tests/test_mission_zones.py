@@ -19,7 +19,9 @@ UTC = dt.timezone.utc
 # A 70 m x 55 m field inside the sample polygon (Geneva) and one 3 km north-east of it.
 INSIDE = {
     "type": "Polygon",
-    "coordinates": [[[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]],
+    "coordinates": [
+        [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+    ],
 }
 OUTSIDE = {"type": "Feature", "geometry": {"type": "Point", "coordinates": [6.20, 46.235]}}
 
@@ -81,8 +83,13 @@ def test_altitude_limits_and_references(doc) -> None:
     def with_limits(lo, lo_ref, hi, hi_ref, unit="M"):
         d = copy.deepcopy(doc)
         g = d["UASZoneList"][0]["geometry"][0]
-        g.update(lowerLimit=lo, lowerVerticalReference=lo_ref, upperLimit=hi, upperVerticalReference=hi_ref,
-                 uomDimensions=unit)
+        g.update(
+            lowerLimit=lo,
+            lowerVerticalReference=lo_ref,
+            upperLimit=hi,
+            upperVerticalReference=hi_ref,
+            uomDimensions=unit,
+        )
         return zones_from_json(d)
 
     above = with_limits(120, "AGL", 300, "AGL")
@@ -97,26 +104,34 @@ def test_altitude_limits_and_references(doc) -> None:
     assert check_zones(amsl, area, height_m=50.0, ground_elevation_m=560.0).hits[0].certain
 
 
+CIRCLE = {"type": "Circle", "center": [0, 0], "radius": 5}
+
+
+def _zone(hp=None, geometry=None, **zone) -> str:
+    """One-zone ED-269 text with the given overrides (a valid circle zone by default)."""
+    g = {"horizontalProjection": hp or CIRCLE, **(geometry or {})}
+    z = {"identifier": "A", "restriction": "PROHIBITED", "geometry": [g], **zone}
+    return json.dumps({"UASZoneList": [z]})
+
+
 @pytest.mark.parametrize(
     ("text", "match"),
     [
         ("[]", "expected an object"),
         ('{"UASZoneList": {}}', "expected an array"),
-        ('{"UASZoneList": [{"identifier": "A", "restriction": "MAYBE", "geometry": []}]}', "restriction"),
-        ('{"UASZoneList": [{"identifier": "A", "restriction": "PROHIBITED", "geometry": [{"horizontalProjection":'
-         ' {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1]]]}}]}]}', "last equal to the first"),
-        ('{"UASZoneList": [{"identifier": "A", "restriction": "PROHIBITED", "geometry": [{"horizontalProjection":'
-         ' {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 100], [0, 0]]]}}]}]}', "WGS84"),
-        ('{"UASZoneList": [{"identifier": "A", "restriction": "PROHIBITED", "geometry": [{"lowerLimit": "NaN",'
-         ' "horizontalProjection": {"type": "Circle", "center": [0, 0], "radius": 5}}]}]}', "finite"),
-        ('{"UASZoneList": [{"identifier": "A", "restriction": "PROHIBITED", "geometry": [{"uomDimensions": "FURLONG",'
-         ' "horizontalProjection": {"type": "Circle", "center": [0, 0], "radius": 5}}]}]}', "uomDimensions"),
-        ('{"UASZoneList": [{"identifier": "A", "restriction": "PROHIBITED", "applicability": [{"permanent": "NO"}],'
-         ' "geometry": [{"horizontalProjection": {"type": "Circle", "center": [0, 0], "radius": 5}}]}]}',
-         "no schedule"),
-        ('{"UASZoneList": [{"identifier": "A", "restriction": "PROHIBITED", "applicability": [{"permanent": "NO",'
-         ' "startDateTime": "2026-01-01T00:00:00"}], "geometry": [{"horizontalProjection": {"type": "Circle",'
-         ' "center": [0, 0], "radius": 5}}]}]}', "time zone"),
+        (_zone(restriction="MAYBE"), "restriction"),
+        (
+            _zone({"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1]]]}),
+            "last equal to the first",
+        ),
+        (_zone({"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 100], [0, 0]]]}), "WGS84"),
+        (_zone(geometry={"lowerLimit": "NaN"}), "finite"),
+        (_zone(geometry={"uomDimensions": "FURLONG"}), "uomDimensions"),
+        (_zone(applicability=[{"permanent": "NO"}]), "no schedule"),
+        (_zone(applicability=[{"permanent": "NO", "startDateTime": "2026-01-01T00:00:00"}]), "time zone"),
+        (_zone(applicability=[{"permanent": "NO", "dailyPeriod": [{"day": ["FUNDAY"]}]}]), "day"),
+        (_zone({"type": "Circle", "center": [0, 0], "radius": -5}), "radius"),
+        (_zone({"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1]]]}), "at least 4"),
         ("[" * 100000 + "]" * 100000, "nested"),
         ('{"UASZoneList": [1e999]}', "finite|expected an object"),
         ("\ufeff{not json", "not valid JSON"),
@@ -150,7 +165,17 @@ def test_self_intersecting_zone_polygon_is_refused(doc) -> None:
 def test_summary_from_the_cli(tmp_path, sample) -> None:
     area = tmp_path / "field.geojson"
     area.write_text(json.dumps(INSIDE))
-    base = ["select", "--range", "1500", "--area", str(area), "--zones", str(sample), "--population-density", "40"]
+    base = [
+        "select",
+        "--range",
+        "1500",
+        "--area",
+        str(area),
+        "--zones",
+        str(sample),
+        "--population-density",
+        "40",
+    ]
     html_out, json_out = tmp_path / "s.html", tmp_path / "s.json"
     res = CliRunner().invoke(main, [*base, "--summary", str(html_out)])
     assert res.exit_code == 0, res.output

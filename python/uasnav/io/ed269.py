@@ -190,15 +190,21 @@ def _ring(coords: Any, path: str, budget: list[int]) -> tuple[tuple[float, float
             raise jc.fail(pp, f"[{lon:g}, {lat:g}] is not a WGS84 [lon, lat] in degrees")
         pts.append((lon, lat))
     if len(pts) < 4 or pts[0] != pts[-1]:
-        raise jc.fail(jc.at(path, 0), "a polygon ring needs at least 4 positions, the last equal to the first")
+        raise jc.fail(
+            jc.at(path, 0), "a polygon ring needs at least 4 positions, the last equal to the first"
+        )
     return tuple(pts)
 
 
 def _volume(g: Any, path: str, budget: list[int]) -> Volume:
     g = jc.obj(g, path)
     unit = jc.string(g.get("uomDimensions", "M"), jc.at(path, "uomDimensions"), ("M", "FT"))
-    lo_ref = jc.string(g.get("lowerVerticalReference", "AGL"), jc.at(path, "lowerVerticalReference"), REFERENCES)
-    hi_ref = jc.string(g.get("upperVerticalReference", "AGL"), jc.at(path, "upperVerticalReference"), REFERENCES)
+    lo_ref = jc.string(
+        g.get("lowerVerticalReference", "AGL"), jc.at(path, "lowerVerticalReference"), REFERENCES
+    )
+    hi_ref = jc.string(
+        g.get("upperVerticalReference", "AGL"), jc.at(path, "upperVerticalReference"), REFERENCES
+    )
     lo = _limit(g.get("lowerLimit"), jc.at(path, "lowerLimit"), unit, 0.0)
     hi = _limit(g.get("upperLimit"), jc.at(path, "upperLimit"), unit, float("inf"))
     if lo_ref == hi_ref and not lo < hi:
@@ -207,7 +213,14 @@ def _volume(g: Any, path: str, budget: list[int]) -> Volume:
     hpath = jc.at(path, "horizontalProjection")
     kind = jc.string(jc.field(hp, "type", hpath), jc.at(hpath, "type"), ("Polygon", "Circle"))
     if kind == "Polygon":
-        return Volume(_ring(jc.field(hp, "coordinates", hpath), jc.at(hpath, "coordinates"), budget), None, lo, lo_ref, hi, hi_ref)
+        return Volume(
+            _ring(jc.field(hp, "coordinates", hpath), jc.at(hpath, "coordinates"), budget),
+            None,
+            lo,
+            lo_ref,
+            hi,
+            hi_ref,
+        )
     c = jc.vector(jc.field(hp, "center", hpath), jc.at(hpath, "center"), length=2)
     if not (-180.0 <= c[0] <= 180.0 and -90.0 <= c[1] <= 90.0):
         raise jc.fail(jc.at(hpath, "center"), "not a WGS84 [lon, lat] in degrees")

@@ -152,9 +152,7 @@ def load_database(source: str | os.PathLike | None = None, **fetch_kw) -> Databa
         equipment=[
             frozenset(q.get("has").split()) if (q := e.find("equipment")) is not None else None for e in us
         ],
-        equipment_sources=[
-            q.get("source") if (q := e.find("equipment")) is not None else None for e in us
-        ],
+        equipment_sources=[q.get("source") if (q := e.find("equipment")) is not None else None for e in us],
     )
     cams = CameraTable(
         **common(cs),

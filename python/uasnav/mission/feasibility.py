@@ -119,7 +119,9 @@ class Requirements:
         if self.population_density is not None and (
             not math.isfinite(self.population_density) or self.population_density < 0
         ):
-            raise InputError(f"requirement population_density={self.population_density}: must be finite and >= 0")
+            raise InputError(
+                f"requirement population_density={self.population_density}: must be finite and >= 0"
+            )
         if self.ground_elevation_m is not None and not math.isfinite(self.ground_elevation_m):
             raise InputError(f"requirement ground_elevation_m={self.ground_elevation_m}: must be finite")
         if not 0.0 <= self.reserve < 1.0:
@@ -259,7 +261,10 @@ def describe(test: TestResult, i, label: str) -> str:
     if test.name == "imagery":
         return f"{label}: imagery is not {test.unit}"
     if test.name.startswith("equipment:"):
-        return f"{label}: lacks {test.unit}, necessary for this operation (no '{test.name[10:]}' in its equipment record)"
+        token = test.name.removeprefix("equipment:")
+        return (
+            f"{label}: lacks {test.unit}, necessary for this operation (no '{token}' in its equipment record)"
+        )
     if test.name == "rain":
         return f"{label}: not rated for rain (needs IPX3 or better)"
     if test.name == "endurance":

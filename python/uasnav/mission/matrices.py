@@ -129,7 +129,9 @@ class Matrices:
                     item.id, NECESSARY, f"Table 19: {self.feature_names.get(feat, feat)} {hit[1]} needs it"
                 )
             if cells and all(c in item.incompatible_when for c in cells) and incompatible is None:
-                incompatible = f"Table 19: not used at {self.feature_names.get(feat, feat)} {' '.join(levels)}"
+                incompatible = (
+                    f"Table 19: not used at {self.feature_names.get(feat, feat)} {' '.join(levels)}"
+                )
         if incompatible is not None:
             return EquipmentStatus(item.id, INCOMPATIBLE, incompatible)
         return EquipmentStatus(item.id, OPTIONAL, "no rule of Table 19 or of the operation needs it")
@@ -183,11 +185,18 @@ def explain_table20(mx: Matrices) -> list[dict]:
             why = "Table 20 leaves blank (not relevant) what Table 19 allows; no feature excludes it"
         elif printed == NECESSARY:
             kind = "mission-objective"
-            why = "Table 20 requires it but no rule of §5.2.2.3 names a feature level of this mission (objective-driven, §5.2.2.4)"
+            why = (
+                "Table 20 requires it but no rule of §5.2.2.3 names a feature level of this mission "
+                "(objective-driven, §5.2.2.4)"
+            )
         elif derived == NECESSARY:
             kind = "rule-applied"
             why = f"{st.reason}; Table 20 does not apply this rule"
-            span = [f for f, lv in mission.features.items() if len(lv) > 1 and mx.feature_names.get(f, f) in st.reason]
+            span = [
+                f
+                for f, lv in mission.features.items()
+                if len(lv) > 1 and mx.feature_names.get(f, f) in st.reason
+            ]
             if span:
                 f = span[0]
                 why += (

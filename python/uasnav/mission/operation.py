@@ -144,11 +144,14 @@ def derive_operation(req: Requirements) -> Operation:
             "visibility",
             vis,
             f"{dist_req} = {dist:g} m",
-            f"kept in sight up to {vlos_d:g} m ({vlos_src}); VLOS per (EU) 2019/947 Art. 2(7), 14 CFR §107.31",
+            f"kept in sight up to {vlos_d:g} m ({vlos_src}); "
+            "VLOS per (EU) 2019/947 Art. 2(7), 14 CFR §107.31",
         )
     )
     lvl = range_level(dist)
-    facts.append(Fact("range level", lvl, f"{dist_req} = {dist:g} m", "thesis Table 18 levels <1 km, 1–5 km, >5 km"))
+    facts.append(
+        Fact("range level", lvl, f"{dist_req} = {dist:g} m", "thesis Table 18 levels <1 km, 1–5 km, >5 km")
+    )
     facts.append(
         Fact(
             "height",
@@ -173,8 +176,9 @@ def derive_operation(req: Requirements) -> Operation:
         Fact(
             "population",
             f"{pop} ({density:g} ppl/km²)",
-            "--population-density" if req.population_density is not None or req.population_class else
-            f"default ({DEFAULT_POPULATION}: agricultural area)",
+            "--population-density"
+            if req.population_density is not None or req.population_class
+            else f"default ({DEFAULT_POPULATION}: agricultural area)",
             "JARUS SORA 2.5 Main Body Table 2 rows (< 5, < 50, < 500, < 5000, < 50000 ppl/km²)",
         )
     )
@@ -234,7 +238,9 @@ def derive_operation(req: Requirements) -> Operation:
         if req.category is not None and req.category != derived:
             notes.append(f"category {req.category} was given; the operation derives {derived}: {basis}")
         if req.night:
-            notes.append("night: the UA's green flashing light must be on ((EU) 2019/947 UAS.OPEN.060, as amended)")
+            notes.append(
+                "night: the UA's green flashing light must be on ((EU) 2019/947 UAS.OPEN.060, as amended)"
+            )
     elif req.jurisdiction == "faa":
         category = req.category if req.category is not None else "part107"
         basis = "14 CFR Part 107 (small UAS < 55 lb)"
@@ -311,7 +317,9 @@ def eu_scenarios(
     if eu_class != "C6":
         why.append(f"UA class {eu_class or 'none'}, STS-02 needs C6")
     if op.max_distance_m > 2000.0:
-        why.append(f"{op.max_distance_m:g} m from the pilot, STS-02 allows 1 km (2 km with airspace observers)")
+        why.append(
+            f"{op.max_distance_m:g} m from the pilot, STS-02 allows 1 km (2 km with airspace observers)"
+        )
     if DENSITY_CLASSES[op.population] >= 500.0:
         why.append("not a sparsely populated area")
     if op.height_m > EU_MAX_HEIGHT_M:
@@ -366,7 +374,9 @@ def faa_checks(op: Operation, *, mtom_g: float | None) -> tuple[ScenarioCheck, .
     if op.bvlos:
         out.append(ScenarioCheck("waiver §107.31", True, ("BVLOS",), "14 CFR §107.31, §107.205(b)"))
     if op.height_m > 121.92:
-        out.append(ScenarioCheck("waiver §107.51(b)", True, ("above 400 ft AGL",), "14 CFR §107.51(b), §107.205"))
+        out.append(
+            ScenarioCheck("waiver §107.51(b)", True, ("above 400 ft AGL",), "14 CFR §107.51(b), §107.205")
+        )
     if op.night:
         out.append(
             ScenarioCheck(
@@ -379,16 +389,24 @@ def faa_checks(op: Operation, *, mtom_g: float | None) -> tuple[ScenarioCheck, .
     if op.airspace != "uncontrolled":
         out.append(
             ScenarioCheck(
-                "ATC authorisation §107.41", True, (f"airspace {op.airspace}",), "14 CFR §107.41 (LAANC / DroneZone)"
+                "ATC authorisation §107.41",
+                True,
+                (f"airspace {op.airspace}",),
+                "14 CFR §107.41 (LAANC / DroneZone)",
             )
         )
     if op.over_people != "none":
         lb = math.inf if mtom_g is None else mtom_g / 453.59237
         if op.over_people == "assemblies":
-            cat = "category 4 (airworthiness certificate) or waiver §107.39; categories 1–2 allow open-air assemblies only with Remote ID, category 3 never"
+            cat = (
+                "category 4 (airworthiness certificate) or waiver §107.39; categories 1–2 allow "
+                "open-air assemblies only with Remote ID, category 3 never"
+            )
         elif lb <= FAA_CAT1_LB:
             cat = "category 1 (≤ 0.55 lb, no exposed rotating parts that could lacerate)"
         else:
-            cat = "category 2 or 3 (manufacturer's declaration of compliance, §107.120/§107.130) or category 4"
+            cat = (
+                "category 2 or 3 (manufacturer's declaration of compliance, §107.120/§107.130) or category 4"
+            )
         out.append(ScenarioCheck("over people Subpart D", True, (cat,), "14 CFR §107.39, §§107.105–107.140"))
     return tuple(out)

@@ -190,7 +190,10 @@ class Regulations:
             legacy = eu_class is None and sub.legacy_mtom_lt_g is not None and mtom_g < sub.legacy_mtom_lt_g
             if not (legacy or (eu_class is not None and eu_class in sub.classes)):
                 continue
-            if over_people == "uninvolved" and ("legacy" if legacy else eu_class) not in sub.overfly_uninvolved:
+            if (
+                over_people == "uninvolved"
+                and ("legacy" if legacy else eu_class) not in sub.overfly_uninvolved
+            ):
                 continue
             if urban and sub.residential_distance_m is not None:
                 continue

@@ -35,10 +35,10 @@ if TYPE_CHECKING:
 
     from uasnav.io.ed269 import Zone
     from uasnav.mission.database import Database
-    from uasnav.mission.zones import MissionArea
     from uasnav.mission.matrices import Matrices
     from uasnav.mission.regulations import Regulations
     from uasnav.mission.selection import Selection
+    from uasnav.mission.zones import MissionArea
 
 
 class OptionError(InputError):
@@ -199,7 +199,12 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         label="SORA mitigations",
     ),
     SelectOption(
-        "sora_edition", "choice", "2.5", "JARUS SORA edition: 2.5 | 2.0.", choices=EDITIONS, label="SORA edition"
+        "sora_edition",
+        "choice",
+        "2.5",
+        "JARUS SORA edition: 2.5 | 2.0.",
+        choices=EDITIONS,
+        label="SORA edition",
     ),
     SelectOption(
         "area",
@@ -218,7 +223,11 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         label="Area buffer",
     ),
     SelectOption(
-        "zones", "file", None, "ED-269 geographical zones (JSON): path or http(s) URL.", label="Zones (ED-269)"
+        "zones",
+        "file",
+        None,
+        "ED-269 geographical zones (JSON): path or http(s) URL.",
+        label="Zones (ED-269)",
     ),
     SelectOption(
         "ground_elevation",
@@ -284,13 +293,18 @@ def _density(opt: SelectOption, value: Any) -> tuple[float | None, str | None]:
     """(density, None) for a number, (None, class) for a class name."""
     if isinstance(value, str) and value.strip() in DENSITY_CLASSES:
         return None, value.strip()
-    x = _real(
-        SelectOption(opt.name, "real", None, "", minimum=0.0),
-        value,
-    ) if not (isinstance(value, str) and not _is_number(value)) else None
+    x = (
+        _real(
+            SelectOption(opt.name, "real", None, "", minimum=0.0),
+            value,
+        )
+        if not (isinstance(value, str) and not _is_number(value))
+        else None
+    )
     if x is None:
         raise OptionError(
-            opt.name, f"{opt.name}: {value!r} is neither a number >= 0 nor one of {', '.join(DENSITY_CLASSES)}"
+            opt.name,
+            f"{opt.name}: {value!r} is neither a number >= 0 nor one of {', '.join(DENSITY_CLASSES)}",
         )
     return x, None
 
@@ -329,10 +343,14 @@ def parse_mitigations(value: Any, edition: str) -> tuple[tuple[str, str], ...]:
                 "mitigations", f"mitigations: {k!r} is not a SORA {edition} mitigation ({', '.join(table)})"
             )
         if not isinstance(v, str) or v.strip().lower() not in ROBUSTNESS:
-            raise OptionError("mitigations", f"mitigations: {k}={v!r}: robustness is one of {', '.join(ROBUSTNESS)}")
+            raise OptionError(
+                "mitigations", f"mitigations: {k}={v!r}: robustness is one of {', '.join(ROBUSTNESS)}"
+            )
         rob = v.strip().lower()
         if table[k.upper()][rob] is None:
-            raise OptionError("mitigations", f"mitigations: {k} cannot be claimed at {rob} robustness in SORA {edition}")
+            raise OptionError(
+                "mitigations", f"mitigations: {k} cannot be claimed at {rob} robustness in SORA {edition}"
+            )
         out.append((k.upper(), rob))
     return tuple(out)
 

@@ -309,7 +309,9 @@ def select(
     # no height limit the required altitude is used instead.
     h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
     u, c = db.uas, db.cameras
-    uas_ok, rej = _reject(uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids)
+    uas_ok, rej = _reject(
+        uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids
+    )
     rejections += rej
     cam_ok, rej = _reject(camera_tests(c, req, h_cam), "camera", c.label, c.ids)
     rejections += rej

@@ -44,7 +44,13 @@ ARCS = ("a", "b", "c", "d")
 
 #: SORA 2.5 Main Body Table 2 columns: (max characteristic dimension m, max speed m/s). A UA
 #: goes in the first column whose dimension AND speed both bound it.
-IGRC25_COLUMNS: tuple[tuple[float, float], ...] = ((1.0, 25.0), (3.0, 35.0), (8.0, 75.0), (20.0, 120.0), (40.0, 200.0))
+IGRC25_COLUMNS: tuple[tuple[float, float], ...] = (
+    (1.0, 25.0),
+    (3.0, 35.0),
+    (8.0, 75.0),
+    (20.0, 120.0),
+    (40.0, 200.0),
+)
 #: SORA 2.5 Main Body Table 2 rows: (name, population density upper bound ppl/km² (exclusive),
 #: iGRC per column; None = grey cell, out of the SORA's scope).
 IGRC25_ROWS: tuple[tuple[str, float, tuple[int | None, ...]], ...] = (
@@ -80,7 +86,12 @@ MITIGATIONS25: dict[str, dict[str, int | None]] = {
 # --- SORA 2.0 ------------------------------------------------------------------------------
 
 #: SORA 2.0 Table 2 columns: (max characteristic dimension m, typical kinetic energy J).
-IGRC20_COLUMNS: tuple[tuple[float, float], ...] = ((1.0, 700.0), (3.0, 34e3), (8.0, 1084e3), (math.inf, math.inf))
+IGRC20_COLUMNS: tuple[tuple[float, float], ...] = (
+    (1.0, 700.0),
+    (3.0, 34e3),
+    (8.0, 1084e3),
+    (math.inf, math.inf),
+)
 #: SORA 2.0 Table 2 rows: operational scenario → iGRC per column (None = grey, not SORA).
 IGRC20_ROWS: dict[str, tuple[int | None, ...]] = {
     "controlled": (1, 2, 3, 4),
@@ -243,7 +254,8 @@ def _column25(dimension_m: float, speed_ms: float) -> int:
         if dimension_m <= d and speed_ms <= v:
             return i
     raise InputError(
-        f"SORA 2.5: UA of {dimension_m:g} m / {speed_ms:g} m/s exceeds Table 2 (40 m, 200 m/s): certified category"
+        f"SORA 2.5: UA of {dimension_m:g} m / {speed_ms:g} m/s exceeds Table 2 (40 m, 200 m/s): "
+        "certified category"
     )
 
 
@@ -281,7 +293,7 @@ def igrc_20(dimension_m: float, energy_j: float, scenario: str) -> int | None:
     The column is the first whose dimension bound (≤ 1, 3, 8 m) and kinetic-energy bound
     (< 700 J, < 34 kJ, < 1084 kJ) both hold. None: grey cell (outside the SORA).
     """
-    col = next(i for i, (d, e) in enumerate(IGRC20_COLUMNS) if dimension_m <= d and energy_j < e or i == 3)
+    col = next(i for i, (d, e) in enumerate(IGRC20_COLUMNS) if (dimension_m <= d and energy_j < e) or i == 3)
     try:
         return IGRC20_ROWS[scenario][col]
     except KeyError:
@@ -417,9 +429,7 @@ def assess(
             )
             scen = f"{'bvlos' if bvlos else 'vlos'}-{where}"
         ig = igrc_20(dimension_m, e, scen)
-        col = next(
-            i for i, (d, en) in enumerate(IGRC20_COLUMNS) if dimension_m <= d and e < en or i == 3
-        )
+        col = next(i for i, (d, en) in enumerate(IGRC20_COLUMNS) if (dimension_m <= d and e < en) or i == 3)
         floor = IGRC20_ROWS["controlled"][col] or 1
         steps.append(f"iGRC {ig} (SORA 2.0 Table 2: {dimension_m:g} m, {e:.0f} J, scenario {scen})")
     arc0 = initial_arc(airspace, height_m, urban)
@@ -433,14 +443,25 @@ def assess(
     grc = final_grc(ig, mit, edition, floor)
     table = "Table 5" if edition == "2.5" else "Table 3"
     steps.append(f"final GRC {grc} (mitigations {mit or 'none'}, {table}; floor {floor})")
-    steps.append(f"initial ARC-{arc0} (airspace {airspace}, {height_m:g} m AGL, {'urban' if urban else 'rural'})")
-    steps.append(f"residual ARC-{arc}" + (" (no strategic mitigation claimed)" if residual_arc is None else ""))
     steps.append(
-        f"TMPR {tm}" + (" (VLOS: see-and-avoid by the remote crew)" if not bvlos else f" ({'Table 6' if edition == '2.5' else 'Table 4'})")
+        f"initial ARC-{arc0} (airspace {airspace}, {height_m:g} m AGL, {'urban' if urban else 'rural'})"
+    )
+    steps.append(
+        f"residual ARC-{arc}" + (" (no strategic mitigation claimed)" if residual_arc is None else "")
+    )
+    steps.append(
+        f"TMPR {tm}"
+        + (
+            " (VLOS: see-and-avoid by the remote crew)"
+            if not bvlos
+            else f" ({'Table 6' if edition == '2.5' else 'Table 4'})"
+        )
     )
     s = sail(grc, arc)
     if s is None:
         steps.append(f"final GRC {grc} > 7: certified category")
         return SoraResult(edition, population, ig, grc, mit, arc0, arc, tm, None, True, (), tuple(steps))
     steps.append(f"SAIL {s} ({'Table 7' if edition == '2.5' else 'Table 5'})")
-    return SoraResult(edition, population, ig, grc, mit, arc0, arc, tm, s, False, osos(s, edition), tuple(steps))
+    return SoraResult(
+        edition, population, ig, grc, mit, arc0, arc, tm, s, False, osos(s, edition), tuple(steps)
+    )

@@ -93,26 +93,44 @@ def summary_html(sel: Selection) -> str:
             f"airspace {e(op['airspace'])}.</p>"
         )
     parts.append(
-        f"<p>Category: <b>{e(str(cat['jurisdiction']))} / {e(str(cat['category']))}</b> — {e(str(cat['legal_basis']))}"
+        f"<p>Category: <b>{e(str(cat['jurisdiction']))} / {e(str(cat['category']))}</b> — "
+        f"{e(str(cat['legal_basis']))}"
         + (f"; open subcategory <b>{e(cat['open_subcategory'])}</b>" if cat["open_subcategory"] else "")
         + "</p>"
     )
     if op:
-        parts.append(_table(["fact", "value", "from", "rule"], [[f["name"], f["value"], f["requirement"], f["rule"]] for f in op["derivation"]]))
+        parts.append(
+            _table(
+                ["fact", "value", "from", "rule"],
+                [[f["name"], f["value"], f["requirement"], f["rule"]] for f in op["derivation"]],
+            )
+        )
     if sora:
         parts.append(f"<h2>SORA {e(sora['edition'])}</h2>")
         parts.append(
             _table(
                 ["iGRC", "final GRC", "initial ARC", "residual ARC", "TMPR", "SAIL"],
-                [[sora["igrc"], sora["final_grc"], sora["initial_arc"], sora["residual_arc"], sora["tmpr"],
-                  sora["sail"] or "certified category"]],
+                [
+                    [
+                        sora["igrc"],
+                        sora["final_grc"],
+                        sora["initial_arc"],
+                        sora["residual_arc"],
+                        sora["tmpr"],
+                        sora["sail"] or "certified category",
+                    ]
+                ],
             )
         )
         parts.append("<p class='muted'>" + e("; ".join(sora["steps"])) + "</p>")
         if sora["osos"]:
             parts.append(
                 "<p class='muted'>OSOs: "
-                + e(", ".join(f"{o['id']} {o['robustness']}" for o in sora["osos"] if o["robustness"] != "optional"))
+                + e(
+                    ", ".join(
+                        f"{o['id']} {o['robustness']}" for o in sora["osos"] if o["robustness"] != "optional"
+                    )
+                )
                 + "</p>"
             )
     if d["scenarios"]:
@@ -120,7 +138,10 @@ def summary_html(sel: Selection) -> str:
         parts.append(
             _table(
                 ["", "applies / needed", "conditions", "source"],
-                [[s["id"], "yes" if s["applies"] else "no", "; ".join(s["reasons"]), s["source"]] for s in d["scenarios"]],
+                [
+                    [s["id"], "yes" if s["applies"] else "no", "; ".join(s["reasons"]), s["source"]]
+                    for s in d["scenarios"]
+                ],
             )
         )
     parts.append("<h2>Geographical zones</h2>")
@@ -133,7 +154,16 @@ def summary_html(sel: Selection) -> str:
         parts.append(
             _table(
                 ["zone", "restriction", "requires", "message", "why"],
-                [[f"{h['identifier']} {h['name']}", h["restriction"], h["requires"], h["message"], "; ".join(h["why"])] for h in z["hits"]],
+                [
+                    [
+                        f"{h['identifier']} {h['name']}",
+                        h["restriction"],
+                        h["requires"],
+                        h["message"],
+                        "; ".join(h["why"]),
+                    ]
+                    for h in z["hits"]
+                ],
             )
         )
     parts.append("<h2>Equipment</h2>")
@@ -150,7 +180,16 @@ def summary_html(sel: Selection) -> str:
         parts.append(
             _table(
                 ["UAS", "camera", "score (eq. 61, lower is better)", "mass g", "cost $", "SAIL"],
-                [[chosen["uas"], chosen["camera"], f"{chosen['score']:.3f}", f"{chosen['mass_g']:.0f}", f"{chosen['cost_usd']:.0f}", chosen["sail"]]],
+                [
+                    [
+                        chosen["uas"],
+                        chosen["camera"],
+                        f"{chosen['score']:.3f}",
+                        f"{chosen['mass_g']:.0f}",
+                        f"{chosen['cost_usd']:.0f}",
+                        chosen["sail"],
+                    ]
+                ],
             )
         )
     else:

@@ -18,7 +18,6 @@ take-off time); without ``when`` a scheduled zone counts as hit and the hit says
 from __future__ import annotations
 
 import datetime as dt
-
 import math
 import os
 from dataclasses import dataclass
@@ -109,8 +108,17 @@ def _geom(g: Any, path: str, buffer_m: float) -> list[Any]:
     if t in ("Point", "LineString"):
         if not buffer_m > 0:
             raise jc.fail(path, f"a {t} needs a buffer > 0 m to make an area")
-        return [("line" if t == "LineString" else "point", pts(coords, cpath) if t == "LineString" else pts([coords], cpath))]
-    raise jc.fail(jc.at(path, "type"), f"expected a Polygon, MultiPolygon, Point, LineString, Feature or FeatureCollection, got {jc.show(t)}")
+        return [
+            (
+                "line" if t == "LineString" else "point",
+                pts(coords, cpath) if t == "LineString" else pts([coords], cpath),
+            )
+        ]
+    raise jc.fail(
+        jc.at(path, "type"),
+        "expected a Polygon, MultiPolygon, Point, LineString, Feature or FeatureCollection, "
+        f"got {jc.show(t)}",
+    )
 
 
 @dataclass(frozen=True)
@@ -142,7 +150,9 @@ class MissionArea:
         if self.buffer_m > 0:
             g = g.buffer(self.buffer_m)
         if not g.is_valid:
-            raise DataFormatError(f"mission area is not a valid polygon: {explain_validity(g)}", path=self.where)
+            raise DataFormatError(
+                f"mission area is not a valid polygon: {explain_validity(g)}", path=self.where
+            )
         return g
 
 
@@ -211,9 +221,13 @@ def _vertical(v: Volume, height_m: float, ground_m: float | None) -> tuple[bool,
     hi = to_agl(v.upper_m, v.upper_ref)
     if lo is None or hi is None:
         refs = sorted({r for r, x in ((v.lower_ref, lo), (v.upper_ref, hi)) if x is None})
-        return True, False, (
-            f"{'/'.join(refs)} limit ({v.lower_m:g}–{v.upper_m:g} m) cannot be compared with a flight "
-            "given above ground without --ground-elevation: counted as hit"
+        return (
+            True,
+            False,
+            (
+                f"{'/'.join(refs)} limit ({v.lower_m:g}–{v.upper_m:g} m) cannot be compared with a flight "
+                "given above ground without --ground-elevation: counted as hit"
+            ),
         )
     enters = height_m > lo and hi > 0.0
     return enters, True, f"zone {lo:g}–{hi:g} m AGL, flight 0–{height_m:g} m AGL"
@@ -243,7 +257,9 @@ def check_zones(
         for v in z.volumes:
             shape = _volume_shape(v, lon0, lat0)
             if not shape.is_valid:
-                raise DataFormatError(f"zone {z.identifier}: polygon is not valid ({explain_validity(shape)})", path=source)
+                raise DataFormatError(
+                    f"zone {z.identifier}: polygon is not valid ({explain_validity(shape)})", path=source
+                )
             if not shape.intersects(a):
                 continue
             ok, sure, w = _vertical(v, height_m, ground_elevation_m)
@@ -262,7 +278,16 @@ def check_zones(
             else:
                 why.append(f"the zone's schedule is active at {when.isoformat()}")
         hits.append(
-            ZoneHit(z.identifier, z.name, z.restriction, z.message, z.reasons, REQUIRES[z.restriction], certain, tuple(why))
+            ZoneHit(
+                z.identifier,
+                z.name,
+                z.restriction,
+                z.message,
+                z.reasons,
+                REQUIRES[z.restriction],
+                certain,
+                tuple(why),
+            )
         )
     return ZoneCheck(source, len(zones), tuple(hits))
 
@@ -289,4 +314,3 @@ __all__ = [
     "parse_when",
     "read_area",
 ]
-

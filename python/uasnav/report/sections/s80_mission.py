@@ -260,7 +260,11 @@ def _operation_section(w: SectionWriter, res) -> None:
     w.table(
         ["", "before (mission type only)", "after (operation derived from the requirements)"],
         [
-            ["operation", "not derived (VLOS note at 1500 m)", f"{op.visibility}: {op.max_distance_m:g} m > {op.vlos_distance_m:g} m in sight"],
+            [
+                "operation",
+                "not derived (VLOS note at 1500 m)",
+                f"{op.visibility}: {op.max_distance_m:g} m > {op.vlos_distance_m:g} m in sight",
+            ],
             ["category", "easa/open", f"easa/{op.category} — {op.legal_basis}"],
             ["necessary equipment", ", ".join(res.before_necessary), ", ".join(after)],
         ],
@@ -284,8 +288,12 @@ def _operation_section(w: SectionWriter, res) -> None:
             [[e.name, e.reason] for e in vlos.equipment if e.necessary],
             caption=(
                 f"{vo.visibility}, {vo.category} category ({vo.legal_basis}); best configuration "
-                + (f"{vlos.ranking[0].uas} + {vlos.ranking[0].camera}, open subcategory "
-                   f"{vlos.ranking[0].open_subcategory}" if vlos.ranking else "none")
+                + (
+                    f"{vlos.ranking[0].uas} + {vlos.ranking[0].camera}, open subcategory "
+                    f"{vlos.ranking[0].open_subcategory}"
+                    if vlos.ranking
+                    else "none"
+                )
                 + ". No ADS-B, TAWS or BLOS link is necessary for a rural VLOS flight below 120 m."
             ),
         )
@@ -295,7 +303,17 @@ def _operation_section(w: SectionWriter, res) -> None:
         best = sel.ranking[0]
         w.table(
             ["configuration", "iGRC", "final GRC", "initial ARC", "residual ARC", "TMPR", "SAIL"],
-            [[f"{best.uas} + {best.camera}", s.igrc, s.final_grc, s.initial_arc, s.residual_arc, s.tmpr, s.sail]],
+            [
+                [
+                    f"{best.uas} + {best.camera}",
+                    s.igrc,
+                    s.final_grc,
+                    s.initial_arc,
+                    s.residual_arc,
+                    s.tmpr,
+                    s.sail,
+                ]
+            ],
             caption="; ".join(s.steps)
             + ". Population: lightly populated (default for an agricultural area); no mitigation claimed.",
         )
