@@ -252,3 +252,34 @@ def test_certified_category_and_oso_robustness() -> None:
     assert [next(o for o in sora.osos(s, "2.5") if o.id == "OSO#01").robustness for s in sora.SAILS] == want
     assert next(o for o in sora.osos("VI", "2.0") if o.id == "OSO#04").robustness == "high"
     assert next(o for o in sora.osos("I", "2.0") if o.id == "OSO#04").robustness == "optional"
+
+
+@pytest.mark.parametrize("col", range(5))
+def test_igrc_25_table_against_annex_f_computed_by_casex(col) -> None:
+    """An independent check of the transcription: the SORA 2.5 Table 2 cells are the Annex F
+    quantitative model (casex, by the Annex F authors: Annex F's reference UA per column, 35°
+    impact, obstacle reduction, 0.3 conservative compensation) evaluated inside each density
+    row, rounded up."""
+    from casex import AircraftSpecs, AnnexFParms, CriticalAreaModels, enums
+
+    afp = AnnexFParms()
+    p = afp.CA_parms[col]
+    ac = AircraftSpecs(enums.AircraftType.GENERIC, p.wingspan, p.mass)
+    ac.set_friction_coefficient(afp.friction_coefficient)
+    ac.set_fuel_type(enums.FuelType.GASOLINE)
+    ac.set_fuel_quantity(0)
+    angle = AnnexFParms.scenario_angles[1]
+    ac.set_coefficient_of_restitution(AnnexFParms.CoR_from_impact_angle(angle))
+    ca = CriticalAreaModels().critical_area(ac, p.cruise_speed, angle, use_obstacle_reduction=True)[0]
+    # Annex F's 20 m reference UA cruises at 150 m/s; the Main Body column header reads 120 m/s
+    assert (p.wingspan, p.cruise_speed) == (COLS_25[col][0], COLS_25[col][1] if col != 3 else 150)
+    for name, bound, _ in sora.IGRC25_ROWS[1:6]:
+        # a density inside the row (rows span a decade below their bound)
+        raw = afp.iGRC(bound / 3.0, ca, width=p.wingspan, use_conservative_compensation=True)[1]
+        assert math.ceil(raw) == PRINTED_25[name][col], (name, col, raw)
+
+
+def test_annex_f_igrc_is_reported_beside_the_table() -> None:
+    r = sora.assess(dimension_m=0.35, speed_ms=16.0, mass_g=1330.0, population="lightly", bvlos=True)
+    assert r.annex_f is not None and r.annex_f[0] == r.igrc == 3 and r.annex_f[2] > 0
+    assert sora.assess(dimension_m=0.35, speed_ms=16.0, population="lightly", bvlos=True).annex_f is None

@@ -207,3 +207,35 @@ def test_api_takes_uploaded_documents(sample) -> None:
     )
     assert sel.operation.category == "open" and [h.identifier for h in sel.zones.hits] == ["LSXX"]
     assert sel.to_dict()["zones"]["source"] == "z.json"
+
+
+def test_zones_by_url_are_checked_before_caching(sample, tmp_path) -> None:
+    import http.server
+    import threading
+
+    bodies = {"/good.json": sample.read_bytes(), "/bad.json": _zone(restriction="MAYBE").encode()}
+
+    class Handler(http.server.BaseHTTPRequestHandler):
+        def log_message(self, *args) -> None:
+            pass
+
+        def do_GET(self) -> None:
+            body = bodies.get(self.path)
+            self.send_response(200 if body else 404)
+            self.send_header("Content-Length", str(len(body or b"")))
+            self.end_headers()
+            self.wfile.write(body or b"")
+
+    srv = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    try:
+        base = f"http://127.0.0.1:{srv.server_address[1]}"
+        zones, where = load_zones(base + "/good.json", cache_dir=tmp_path, timeout_s=5.0)
+        assert [z.identifier for z in zones] == ["LSXX"] and where.endswith("good.json")
+        cached = set(tmp_path.iterdir())
+        with pytest.raises(DataFormatError, match="restriction"):
+            load_zones(base + "/bad.json", cache_dir=tmp_path, timeout_s=5.0)
+        assert set(tmp_path.iterdir()) == cached  # a refused document is never cached
+    finally:
+        srv.shutdown()
+        srv.server_close()

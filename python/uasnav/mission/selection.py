@@ -360,7 +360,7 @@ def select(
         )
     is_specific = req.jurisdiction == "easa" and category == "specific"
 
-    def sora_of(i: int, m: float) -> SoraResult:
+    def sora_of(i: int, m: float, quantitative: bool = False) -> SoraResult:
         return assess(
             dimension_m=float(u.span_m[i]),
             speed_ms=float(u.max_speed_ms[i]),
@@ -372,6 +372,8 @@ def select(
             urban=op.urban,
             mitigations=dict(req.mitigations),
             edition=req.sora_edition,
+            density_ppl_km2=op.population_density,
+            quantitative=quantitative,
         )
 
     ranking = []
@@ -402,7 +404,7 @@ def select(
         best = ranking[0]
         bi = u.ids.index(best.uas_id)
         if is_specific:
-            sora = sora_of(bi, best.mass_g)
+            sora = sora_of(bi, best.mass_g, quantitative=True)
         if req.jurisdiction == "easa":
             scenarios = eu_scenarios(
                 op,

@@ -219,6 +219,9 @@ class SoraResult:
     certified: bool
     osos: tuple[Oso, ...]
     steps: tuple[str, ...] = field(default_factory=tuple)
+    #: SORA 2.5's quantitative alternative (Annex F, computed with ``casex``): (iGRC, raw iGRC,
+    #: critical area m²) for this UA and density; None when not computed.
+    annex_f: tuple[int, float, float] | None = None
 
     def to_dict(self) -> dict:
         """Plain JSON."""
@@ -235,6 +238,9 @@ class SoraResult:
             "certified": self.certified,
             "osos": [o.__dict__ for o in self.osos],
             "steps": list(self.steps),
+            "annex_f": None
+            if self.annex_f is None
+            else {"igrc": self.annex_f[0], "raw_igrc": self.annex_f[1], "critical_area_m2": self.annex_f[2]},
         }
 
 
@@ -280,6 +286,31 @@ def igrc_25(dimension_m: float, speed_ms: float, population: str, mass_g: float 
     if row is None:
         raise InputError(f"unknown population class {population!r}; known: {', '.join(DENSITY_CLASSES)}")
     return row[2][col]
+
+
+def annex_f_igrc(
+    *, dimension_m: float, speed_ms: float, mass_g: float, density_ppl_km2: float
+) -> tuple[int, float, float]:
+    """JARUS SORA Annex F quantitative iGRC with ``casex`` (the Annex F authors' package).
+
+    Critical area of a generic UA of width ``dimension_m`` (m) and mass ``mass_g`` (g) impacting
+    at ``speed_ms`` (m/s) at Annex F's 35° scenario angle, with the obstacle reduction and the
+    0.3 conservative compensation Annex F applies to build Table 2; then
+    iGRC = ⌈log10(CA·density) + offset⌉ (casex ``AnnexFParms.iGRC``, TLOS 1e-6/h).
+    Returns (iGRC, raw iGRC, critical area m²).
+    """
+    from casex import AircraftSpecs, AnnexFParms, CriticalAreaModels, enums
+
+    afp = AnnexFParms()
+    ac = AircraftSpecs(enums.AircraftType.GENERIC, dimension_m, mass_g / 1000.0)
+    ac.set_friction_coefficient(afp.friction_coefficient)
+    ac.set_fuel_type(enums.FuelType.GASOLINE)
+    ac.set_fuel_quantity(0)
+    angle = AnnexFParms.scenario_angles[1]
+    ac.set_coefficient_of_restitution(AnnexFParms.CoR_from_impact_angle(angle))
+    ca = float(CriticalAreaModels().critical_area(ac, speed_ms, angle, use_obstacle_reduction=True)[0])
+    ig, raw = afp.iGRC(max(density_ppl_km2, 1e-9), ca, width=dimension_m, use_conservative_compensation=True)
+    return int(ig), float(raw), ca
 
 
 def kinetic_energy_j(mass_g: float, speed_ms: float) -> float:
@@ -375,6 +406,8 @@ def assess(
     mitigations: Mapping[str, str] | None = None,
     residual_arc: str | None = None,
     edition: str = "2.5",
+    density_ppl_km2: float | None = None,
+    quantitative: bool = True,
 ) -> SoraResult:
     """The whole SORA for one UA and operation.
 
@@ -398,6 +431,11 @@ def assess(
         Residual ARC after strategic mitigations, when the operator claims one (must not be
         above the initial ARC); default: the initial ARC (no strategic mitigation assumed).
     edition : {"2.5", "2.0"}
+    density_ppl_km2 : float, optional
+        Population density (ppl/km²) for the Annex F quantitative iGRC (2.5, with ``mass_g``),
+        reported beside the table's; default: the class's representative density.
+    quantitative : bool
+        Compute the Annex F iGRC (``annex_f``) too (about 2 ms with casex).
     """
     if edition not in EDITIONS:
         raise InputError(f"SORA edition {edition!r}: known {', '.join(EDITIONS)}")
@@ -457,11 +495,19 @@ def assess(
             else f" ({'Table 6' if edition == '2.5' else 'Table 4'})"
         )
     )
+    af = None
+    if quantitative and edition == "2.5" and mass_g is not None and population != "controlled":
+        dens = density_ppl_km2 if density_ppl_km2 is not None else DENSITY_CLASSES[population]
+        af = annex_f_igrc(dimension_m=dimension_m, speed_ms=speed_ms, mass_g=mass_g, density_ppl_km2=dens)
+        steps.append(
+            f"Annex F quantitative iGRC {af[0]} (raw {af[1]:.2f}, critical area {af[2]:.1f} m², casex; "
+            "the table value above is the one used)"
+        )
     s = sail(grc, arc)
     if s is None:
         steps.append(f"final GRC {grc} > 7: certified category")
-        return SoraResult(edition, population, ig, grc, mit, arc0, arc, tm, None, True, (), tuple(steps))
+        return SoraResult(edition, population, ig, grc, mit, arc0, arc, tm, None, True, (), tuple(steps), af)
     steps.append(f"SAIL {s} ({'Table 7' if edition == '2.5' else 'Table 5'})")
     return SoraResult(
-        edition, population, ig, grc, mit, arc0, arc, tm, s, False, osos(s, edition), tuple(steps)
+        edition, population, ig, grc, mit, arc0, arc, tm, s, False, osos(s, edition), tuple(steps), af
     )
