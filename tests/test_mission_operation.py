@@ -151,3 +151,16 @@ def test_new_options_refuse_bad_values(argv, option) -> None:
     res = CliRunner().invoke(main, ["select", *argv])
     assert res.exit_code == 2, res.output
     assert option in res.stderr
+
+
+def test_observers_make_evlos_in_the_specific_category() -> None:
+    op = derive_operation(Requirements(range_m=1400.0, observers=2))  # 500 m × 3 = 1500 m
+    assert op.visibility == "EVLOS" and op.category == "specific" and "EVLOS" in op.legal_basis
+    assert derive_operation(Requirements(range_m=1501.0, observers=2)).visibility == "BVLOS"
+    sel = select(Requirements(range_m=1400.0, observers=2))
+    need = {e.id for e in sel.equipment if e.necessary}
+    assert {"blos-c2", "lost-link-mode"} <= need
+    # SORA counts EVLOS as VLOS (observers give the see-and-avoid): no TMPR
+    assert sel.sora is not None and sel.sora.tmpr == "none"
+    sts02 = next(x for x in sel.scenarios if x.id == "STS-02")
+    assert not any("allows 1 km" in r for r in sts02.reasons)  # 1.4 km ≤ 2 km with observers

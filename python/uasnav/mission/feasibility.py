@@ -68,6 +68,8 @@ class Requirements:
     sora_edition : {"2.5", "2.0"}
     ground_elevation_m : float or None
         Ground elevation above mean sea level (m), to compare AMSL zone limits.
+    observers : int
+        Airspace observers along the route (EVLOS).
     """
 
     mission: str = "precision-agriculture"
@@ -94,6 +96,7 @@ class Requirements:
     mitigations: tuple[tuple[str, str], ...] = ()
     sora_edition: str = "2.5"
     ground_elevation_m: float | None = None
+    observers: int = 0
 
     def __post_init__(self) -> None:
         checks = {
@@ -124,6 +127,8 @@ class Requirements:
             )
         if self.ground_elevation_m is not None and not math.isfinite(self.ground_elevation_m):
             raise InputError(f"requirement ground_elevation_m={self.ground_elevation_m}: must be finite")
+        if not 0 <= self.observers <= 100:
+            raise InputError(f"requirement observers={self.observers}: must be in 0..100")
         if not 0.0 <= self.reserve < 1.0:
             raise InputError(f"reserve={self.reserve}: must be in [0, 1)")
 

@@ -86,10 +86,12 @@ class Operation:
     facts: frozenset[str]
     derivation: tuple[Fact, ...]
     notes: tuple[str, ...] = field(default_factory=tuple)
+    observers: int = 0
 
     @property
     def bvlos(self) -> bool:
-        return self.visibility == "BVLOS"
+        """Beyond the remote pilot's own sight (BVLOS or EVLOS)."""
+        return self.visibility != "VLOS"
 
     def to_dict(self) -> dict:
         """Plain JSON."""
@@ -111,6 +113,7 @@ class Operation:
             "facts": sorted(self.facts),
             "derivation": [f.__dict__ for f in self.derivation],
             "notes": list(self.notes),
+            "observers": self.observers,
         }
 
 
@@ -138,14 +141,21 @@ def derive_operation(req: Requirements) -> Operation:
         vlos_d, vlos_src = req.vlos_distance_m, "--vlos-distance"
     else:
         vlos_d, vlos_src = DEFAULT_VLOS_DISTANCE_M, VLOS_SOURCE
-    vis = "VLOS" if dist <= vlos_d else "BVLOS"
+    if dist <= vlos_d:
+        vis = "VLOS"
+    elif req.observers > 0 and dist <= vlos_d * (req.observers + 1):
+        # Observers posted along the route each keep the UA in sight over the same distance.
+        vis = "EVLOS"
+    else:
+        vis = "BVLOS"
     facts.append(
         Fact(
             "visibility",
             vis,
-            f"{dist_req} = {dist:g} m",
+            f"{dist_req} = {dist:g} m, --observers = {req.observers}",
             f"kept in sight up to {vlos_d:g} m ({vlos_src}); "
-            "VLOS per (EU) 2019/947 Art. 2(7), 14 CFR §107.31",
+            "VLOS per (EU) 2019/947 Art. 2(7), 14 CFR §107.31; EVLOS: kept in sight by airspace "
+            "observers posted along the route, each over the same distance (JARUS SORA glossary)",
         )
     )
     lvl = range_level(dist)
@@ -222,8 +232,10 @@ def derive_operation(req: Requirements) -> Operation:
     notes: list[str] = []
     if req.jurisdiction == "easa":
         why_not = []
-        if vis == "BVLOS":
-            why_not.append("BVLOS (open category requires VLOS: Art. 4(1)(d))")
+        if vis != "VLOS":
+            why_not.append(
+                f"{vis} (open category requires the remote pilot's own VLOS: Art. 4(1)(d), Art. 2(7))"
+            )
         if req.altitude_m > EU_MAX_HEIGHT_M:
             why_not.append(f"{req.altitude_m:g} m above 120 m (Art. 4(1)(e))")
         if req.over_people == "assemblies":
@@ -268,6 +280,7 @@ def derive_operation(req: Requirements) -> Operation:
         frozenset(tokens),
         tuple(facts),
         tuple(notes),
+        req.observers,
     )
 
 
@@ -275,7 +288,8 @@ def narrowed_features(features: dict[str, tuple[str, ...]], op: Operation) -> di
     """A mission's Table 18 levels narrowed to the flown operation: ``operations`` to VLOS or
     BVLOS and ``range`` to the level of the maximum distance (the other features stay)."""
     out = dict(features)
-    out["operations"] = (op.visibility.lower(),)
+    # Table 18 knows VLOS, BVLOS and BLOS: an EVLOS flight is beyond the pilot's own sight.
+    out["operations"] = ("vlos",) if op.visibility == "VLOS" else ("bvlos",)
     out["range"] = (op.range_level,)
     return out
 
@@ -312,11 +326,11 @@ def eu_scenarios(
         )
     )
     why = []
-    if op.visibility != "BVLOS":
+    if op.visibility == "VLOS":
         why.append("STS-02 is BVLOS (a VLOS flight needs none)")
     if eu_class != "C6":
         why.append(f"UA class {eu_class or 'none'}, STS-02 needs C6")
-    if op.max_distance_m > 2000.0:
+    if op.max_distance_m > (2000.0 if op.observers > 0 else 1000.0):
         why.append(
             f"{op.max_distance_m:g} m from the pilot, STS-02 allows 1 km (2 km with airspace observers)"
         )
@@ -333,7 +347,7 @@ def eu_scenarios(
         )
     )
     why = []
-    if op.visibility != "BVLOS":
+    if op.visibility == "VLOS":
         why.append("PDRA-G01 is BVLOS")
     if dimension_m > 3.0:
         why.append(f"dimension {dimension_m:g} m > 3 m")
@@ -372,7 +386,11 @@ def faa_checks(op: Operation, *, mtom_g: float | None) -> tuple[ScenarioCheck, .
     """
     out = []
     if op.bvlos:
-        out.append(ScenarioCheck("waiver §107.31", True, ("BVLOS",), "14 CFR §107.31, §107.205(b)"))
+        # Observers posted away from the remote pilot (daisy-chained) are not §107.33 visual
+        # observers: EVLOS needs the waiver too.
+        out.append(
+            ScenarioCheck("waiver §107.31", True, (op.visibility,), "14 CFR §107.31, §107.33, §107.205(b)")
+        )
     if op.height_m > 121.92:
         out.append(
             ScenarioCheck("waiver §107.51(b)", True, ("above 400 ft AGL",), "14 CFR §107.51(b), §107.205")

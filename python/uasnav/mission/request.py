@@ -165,6 +165,15 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         label="VLOS distance",
     ),
     SelectOption(
+        "observers",
+        "int",
+        0,
+        "Airspace observers posted along the route (EVLOS, specific category).",
+        minimum=0,
+        maximum=100,
+        label="Observers",
+    ),
+    SelectOption(
         "over_people",
         "choice",
         "none",
@@ -616,6 +625,7 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
         mitigations=mitigations,
         sora_edition=v["sora_edition"],
         ground_elevation_m=v["ground_elevation"],
+        observers=v["observers"],
     )
     area = zones = None
     zones_where = "zones"

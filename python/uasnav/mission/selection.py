@@ -365,7 +365,8 @@ def select(
             dimension_m=float(u.span_m[i]),
             speed_ms=float(u.max_speed_ms[i]),
             population=op.population,
-            bvlos=op.bvlos,
+            # SORA treats EVLOS like VLOS: the observers give the see-and-avoid (TMPR)
+            bvlos=op.visibility == "BVLOS",
             mass_g=m,
             height_m=req.altitude_m,
             airspace=req.airspace,

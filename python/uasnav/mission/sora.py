@@ -288,6 +288,10 @@ def igrc_25(dimension_m: float, speed_ms: float, population: str, mass_g: float 
     return row[2][col]
 
 
+#: casex warns that its models are not valid below 1 kg.
+CASEX_MIN_MASS_G = 1000.0
+
+
 def annex_f_igrc(
     *, dimension_m: float, speed_ms: float, mass_g: float, density_ppl_km2: float
 ) -> tuple[int, float, float]:
@@ -496,7 +500,9 @@ def assess(
         )
     )
     af = None
-    if quantitative and edition == "2.5" and mass_g is not None and population != "controlled":
+    if quantitative and edition == "2.5" and mass_g is not None and mass_g < CASEX_MIN_MASS_G:
+        steps.append("Annex F quantitative iGRC not computed: casex is not valid below 1 kg")
+    elif quantitative and edition == "2.5" and mass_g is not None and population != "controlled":
         dens = density_ppl_km2 if density_ppl_km2 is not None else DENSITY_CLASSES[population]
         af = annex_f_igrc(dimension_m=dimension_m, speed_ms=speed_ms, mass_g=mass_g, density_ppl_km2=dens)
         steps.append(
