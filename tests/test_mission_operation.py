@@ -10,8 +10,9 @@ import pytest
 from click.testing import CliRunner
 
 from uasnav.cli import main
+from uasnav.errors import InputError
 from uasnav.mission import Requirements, load_database, load_regulations, select
-from uasnav.mission.operation import derive_operation, range_level
+from uasnav.mission.operation import derive_operation, range_level, vlos_distance_of
 
 THESIS = (
     "select --mission precision-agriculture --resolution 0.05 --image-size 70x70 --altitude 50 "
@@ -38,8 +39,17 @@ def test_rural_vlos_flight_is_open_with_only_what_it_needs() -> None:
     assert all(e["reason"] for e in out["equipment"])
     # every derived fact says which requirement and which rule produced it
     vis = next(f for f in op["derivation"] if f["name"] == "visibility")
-    assert "300 m" in vis["requirement"] and "CAP 722" in vis["rule"]
+    assert "300 m" in vis["requirement"] and "§A.5.2.5" in vis["rule"]
     assert out["ranking"] and all(r["open_subcategory"] in ("A1", "A2", "A3") for r in out["ranking"])
+    # kept in sight at 300 m needs a UA the pilot can see that far (EASA ALOS from its size): the
+    # small Phantoms (0.35 m: 134 m) are rejected, a 0.9 m Matrice 300 (314 m) is not
+    rej = {(x["item"], x["test"]) for x in out["rejections"]}
+    assert ("dji-phantom-3-professional", "vlos-distance") in rej
+    assert ("dji-matrice-300-rtk", "vlos-distance") not in rej
+    db = load_database()
+    for r in out["ranking"]:
+        i = db.uas.ids.index(r["uas_id"])
+        assert vlos_distance_of(db.uas.span_m[i], db.uas.types[i]) >= 300.0
 
 
 def test_thesis_scenario_is_bvlos_specific_with_sora_and_blos_link() -> None:
@@ -64,10 +74,12 @@ def test_thesis_scenario_is_bvlos_specific_with_sora_and_blos_link() -> None:
 
 
 def test_max_and_vlos_distance_decide_visibility() -> None:
-    assert derive_operation(Requirements(range_m=1500.0, max_distance_m=400.0)).visibility == "VLOS"
+    assert derive_operation(Requirements(range_m=1500.0, max_distance_m=300.0)).visibility == "VLOS"
     assert derive_operation(Requirements(range_m=300.0, vlos_distance_m=200.0)).visibility == "BVLOS"
-    assert derive_operation(Requirements(range_m=500.0)).visibility == "VLOS"  # on the 500 m default
-    assert derive_operation(Requirements(range_m=500.001)).visibility == "BVLOS"
+    # no UA given: EASA's 1 m multirotor, 347 m
+    assert derive_operation(Requirements(range_m=347.0)).visibility == "VLOS"
+    assert derive_operation(Requirements(range_m=347.001)).visibility == "BVLOS"
+    assert derive_operation(Requirements(range_m=300.0), vlos_default=(250.0, "x")).visibility == "BVLOS"
     assert [range_level(x) for x in (999.9, 1000.0, 4999.0, 5000.0)] == ["lt1km", "1to5km", "1to5km", "gt5km"]
     high = derive_operation(Requirements(range_m=300.0, altitude_m=120.5))
     assert high.category == "specific" and "Art. 4(1)(e)" in high.legal_basis
@@ -139,6 +151,7 @@ def test_eu_scenarios_for_the_thesis_case() -> None:
         (["--population-density", "-3"], "--population-density"),
         (["--mitigations", "M1A=high"], "--mitigations"),
         (["--mitigations", "M9=low"], "--mitigations"),
+        (["--mitigations", "M1A=medium,M1B=high"], "--mitigations"),
         (["--flight-time", "tomorrow"], "--flight-time"),
         (["--flight-time", "2026-05-01T10:00"], "--flight-time"),
         (["--airspace", "space"], "--airspace"),
@@ -154,13 +167,58 @@ def test_new_options_refuse_bad_values(argv, option) -> None:
 
 
 def test_observers_make_evlos_in_the_specific_category() -> None:
-    op = derive_operation(Requirements(range_m=1400.0, observers=2))  # 500 m × 3 = 1500 m
+    op = derive_operation(Requirements(range_m=1000.0, observers=2))  # 347 m × 3 = 1041 m
     assert op.visibility == "EVLOS" and op.category == "specific" and "EVLOS" in op.legal_basis
-    assert derive_operation(Requirements(range_m=1501.0, observers=2)).visibility == "BVLOS"
+    assert derive_operation(Requirements(range_m=1042.0, observers=2)).visibility == "BVLOS"
     sel = select(Requirements(range_m=1400.0, observers=2))
+    assert sel.operation is not None and sel.operation.visibility == "EVLOS"
+    # each ranked UA is kept in sight by the pilot or an observer over its own distance
+    u = sel.database.uas
+    for r in sel.ranking:
+        i = u.ids.index(r.uas_id)
+        assert 3 * vlos_distance_of(u.span_m[i], u.types[i]) >= 1400.0
     need = {e.id for e in sel.equipment if e.necessary}
     assert {"blos-c2", "lost-link-mode"} <= need
     # SORA counts EVLOS as VLOS (observers give the see-and-avoid): no TMPR
     assert sel.sora is not None and sel.sora.tmpr == "none"
     sts02 = next(x for x in sel.scenarios if x.id == "STS-02")
     assert not any("allows 1 km" in r for r in sts02.reasons)  # 1.4 km ≤ 2 km with observers
+
+
+# EASA AMC1 Art. 11 Annex A §A.5.2.6 (ED Decision 2025/018/R p. 81), the worked table, GV >= 5 km:
+# characteristic dimension (m) → (rotary wing, fixed wing) maximum VLOS distance (m).
+PRINTED_VLOS = {
+    1.0: (347.0, 520.0),
+    2.0: (674.0, 1010.0),
+    3.0: (1000.0, 1500.0),  # the formula gives 1001 m for the rotary wing: the table rounds
+    3.5: (1164.5, 1500.0),
+    4.0: (1328.0, 1500.0),
+    4.53: (1500.0, 1500.0),
+    6.0: (1500.0, 1500.0),
+}
+
+
+@pytest.mark.parametrize("cd", list(PRINTED_VLOS))
+def test_vlos_distance_from_size_matches_easa_worked_table(cd) -> None:
+    rotor, fixed = PRINTED_VLOS[cd]
+    assert vlos_distance_of(cd, "multirotor") == pytest.approx(rotor, abs=1.01)
+    assert vlos_distance_of(cd, "fixed-wing") == pytest.approx(fixed, abs=0.01)
+    assert vlos_distance_of(cd, "vtol") == vlos_distance_of(cd, "multirotor")  # the smaller line
+
+
+def test_vlos_distance_is_capped_by_ground_visibility_and_refuses_nonsense() -> None:
+    assert vlos_distance_of(4.0, "multirotor", 2000.0) == pytest.approx(600.0)  # DLOS = 0.3 GV
+    assert vlos_distance_of(4.0, "multirotor", 50_000.0) == pytest.approx(1328.0)  # GV capped at 5 km
+    # independent field data (Li et al., Applied Ergonomics 81: a 0.35 m Phantom 4 is detected by
+    # half the observers at 245 m): the ALOS, which also asks for the attitude, is shorter
+    assert vlos_distance_of(0.35) < 245.0
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(InputError):
+            vlos_distance_of(bad)
+
+
+def test_a_given_vlos_distance_overrides_the_size_rule() -> None:
+    sel = select(Requirements(range_m=300.0, vlos_distance_m=400.0), top=50)
+    assert sel.operation is not None and sel.operation.vlos_distance_m == 400.0
+    assert not any(r.test == "vlos-distance" for r in sel.rejections)
+    assert any(r.uas_id.startswith("dji-phantom") for r in sel.ranking)

@@ -1,4 +1,6 @@
-"""SORA tables at every boundary, against the tables as printed in the JARUS documents.
+"""SORA tables at every boundary, against the tables as printed in the primary documents
+(SORA 2.5: EASA AMC1 Article 11, Issue 1 Amendment 3, ED Decision 2025/018/R — pages below;
+SORA 2.0: JARUS JAR-DEL-WG6-D.04, not re-read this session).
 
 The expected values are written out here as the documents print them (row by row), separately
 from the encoding in uasnav.mission.sora, and every boundary is probed on both sides: a
@@ -15,7 +17,7 @@ import pytest
 from uasnav.errors import InputError
 from uasnav.mission import sora
 
-# JARUS SORA 2.5 Main Body, Table 2 (iGRC), as printed: rows by population density.
+# SORA 2.5 iGRC table as printed in EASA AMC1 Art. 11 (Issue 1 Amdt 3) p. 24: rows by density.
 PRINTED_25 = {
     "controlled": (1, 1, 2, 3, 3),
     "remote": (2, 3, 4, 5, 6),
@@ -26,7 +28,8 @@ PRINTED_25 = {
     "assemblies": (7, 8, None, None, None),
 }
 COLS_25 = [(1, 25), (3, 35), (8, 75), (20, 120), (40, 200)]
-# JARUS SORA 2.0, Table 5 / SORA 2.5 Main Body Table 7 (SAIL), rows GRC ≤2..7, columns ARC a..d.
+# SAIL as printed in EASA AMC1 Art. 11 (Issue 1 Amdt 3) p. 38 (JARUS 2.5 Table 7; 2.0 Table 5),
+# rows GRC ≤2..7, columns ARC a..d.
 PRINTED_SAIL = [
     ("I", "II", "IV", "VI"),
     ("II", "II", "IV", "VI"),
@@ -117,7 +120,7 @@ def test_sail_and_tmpr_are_the_same_in_both_editions() -> None:
         ({"M1C": "low"}, 4),
         ({"M2": "medium"}, 4),
         ({"M2": "high"}, 3),
-        ({"M1A": "medium", "M1B": "high", "M2": "high"}, 1),  # floor: the column's controlled value
+        ({"M1A": "low", "M1B": "high", "M2": "high"}, 1),  # floor: the column's controlled value
     ],
 )
 def test_mitigations_25(mitigations, final) -> None:
@@ -283,3 +286,87 @@ def test_annex_f_igrc_is_reported_beside_the_table() -> None:
     r = sora.assess(dimension_m=0.35, speed_ms=16.0, mass_g=1330.0, population="lightly", bvlos=True)
     assert r.annex_f is not None and r.annex_f[0] == r.igrc == 3 and r.annex_f[2] > 0
     assert sora.assess(dimension_m=0.35, speed_ms=16.0, population="lightly", bvlos=True).annex_f is None
+
+
+def test_m1a_medium_cannot_be_combined_with_m1b() -> None:
+    """EASA AMC1 Art. 11 Annex B §B.2 (p. 85): M1(A) medium excludes every M1(B) claim; M1(A) low
+    may be combined."""
+    with pytest.raises(InputError, match="M1A at medium"):
+        sora.final_grc(5, {"M1A": "medium", "M1B": "medium"}, "2.5", 1)
+    assert sora.final_grc(5, {"M1A": "low", "M1B": "medium"}, "2.5", 1) == 3
+    assert sora.final_grc(5, {"M1A": "medium", "M1B": "none"}, "2.5", 1) == 3
+
+
+# SORA 2.5 Table 14 as printed in EASA AMC1 Art. 11 (Issue 1 Amdt 3) pp. 44-45, SAIL I..VI.
+PRINTED_OSO_25 = {
+    "OSO#01": "NR L M H H H",
+    "OSO#02": "NR NR L M H H",
+    "OSO#03": "L L M M H H",
+    "OSO#04": "NR NR NR M H H",
+    "OSO#05": "NR NR L M H H",
+    "OSO#06": "NR L L M H H",
+    "OSO#07": "L L M M H H",
+    "OSO#08": "L M H H H H",
+    "OSO#09": "L L M M H H",
+    "OSO#13": "L L M H H H",
+    "OSO#16": "L L M M H H",
+    "OSO#17": "L L M M H H",
+    "OSO#18": "NR NR L M H H",
+    "OSO#19": "NR NR L M M H",
+    "OSO#20": "NR L L M M H",
+    "OSO#23": "L L M M H H",
+    "OSO#24": "NR NR M H H H",
+}
+
+
+def test_oso_25_every_cell_as_printed() -> None:
+    word = {"NR": "optional", "L": "low", "M": "medium", "H": "high"}
+    assert set(sora.OSO25) == set(PRINTED_OSO_25)
+    for k, sail_level in enumerate(sora.SAILS):
+        got = {o.id: o.robustness for o in sora.osos(sail_level, "2.5")}
+        assert got == {oid: word[row.split()[k]] for oid, row in PRINTED_OSO_25.items()}, sail_level
+    # 2.0 keeps its own OSO #04 (O O O L M H) where EASA's 2.5 raised SAIL IV to medium
+    assert [o.robustness for s in sora.SAILS for o in sora.osos(s, "2.0") if o.id == "OSO#04"] == [
+        "optional",
+        "optional",
+        "optional",
+        "low",
+        "medium",
+        "high",
+    ]
+
+
+@pytest.mark.parametrize(
+    ("initial", "claimed", "bvlos", "residual", "rule"),
+    [
+        ("c", None, True, "c", "S.4.5.1(c)"),
+        ("c", "c", False, "c", "S.4.5.1(c)"),
+        ("c", "b", False, "b", "S.4.5.4"),  # VLOS: one class down
+        ("d", "c", False, "c", "S.4.5.4"),
+        ("c", "b", True, "b", "Annex C"),  # BVLOS without observers: an Annex C claim
+        ("d", "b", False, "b", "Annex C"),  # two classes: beyond the VLOS rule, an Annex C claim
+        ("b", "a", True, "a", "Annex C"),
+    ],
+)
+def test_residual_arc_rules(initial, claimed, bvlos, residual, rule) -> None:
+    arc, why = sora.residual_arc_of(initial, claimed, bvlos=bvlos)
+    assert arc == residual and rule in why
+
+
+def test_residual_arc_refusals() -> None:
+    with pytest.raises(InputError, match="only lower"):
+        sora.residual_arc_of("b", "c", bvlos=True)
+    with pytest.raises(InputError, match="cannot reduce the ARC to ARC-a"):
+        sora.residual_arc_of("b", "a", bvlos=False)
+    with pytest.raises(InputError, match="must be one of"):
+        sora.residual_arc_of("b", "x", bvlos=True)
+    r = sora.assess(
+        dimension_m=0.5,
+        speed_ms=10.0,
+        population="lightly",
+        bvlos=False,
+        airspace="controlled",
+        residual_arc="b",
+    )
+    assert r.residual_arc == "b" and "S.4.5.4" in r.residual_arc_rule and "S.4.5.4" in " ".join(r.steps)
+    assert "S.4.5.4" in r.to_dict()["residual_arc_rule"]

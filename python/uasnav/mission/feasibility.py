@@ -270,6 +270,11 @@ def describe(test: TestResult, i, label: str) -> str:
         return (
             f"{label}: lacks {test.unit}, necessary for this operation (no '{token}' in its equipment record)"
         )
+    if test.name == "vlos-distance":
+        return (
+            f"{label}: kept in sight only up to {v:.0f} m (its size, EASA AMC1 Art. 11 Annex A "
+            f"§A.5.2.5), the pilot-UA distance is {lim:g} m"
+        )
     if test.name == "rain":
         return f"{label}: not rated for rain (needs IPX3 or better)"
     if test.name == "endurance":

@@ -15,18 +15,55 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from uasnav.errors import InputError
 from uasnav.mission.feasibility import Requirements
 from uasnav.mission.sora import DENSITY_CLASSES, density_class
 
-#: Default distance (m) at which a small UA is kept in unaided sight when the user gives none.
-#: UK CAA CAP 722 (Unmanned Aircraft System Operations in UK Airspace) treats operations within
-#: 500 m horizontally and 400 ft vertically of the remote pilot as normally VLOS; EASA's
-#: GM1 Article 2(7) of (EU) 2019/947 gives no distance (it depends on UA size, light,
-#: weather). We use 500 m for every UA and say so: no primary document we could check gives a
-#: size-to-distance formula, so the default is not derived from the UA's dimension.
-DEFAULT_VLOS_DISTANCE_M = 500.0
-VLOS_SOURCE = "UK CAA CAP 722 (500 m horizontally normally VLOS); give --vlos-distance for this UA"
+#: The distance (m) up to which a UA is kept in unaided sight, from its size, when the user gives
+#: none: EASA AMC1 Article 11 Annex A §A.5.2.5 (Annex to ED Decision 2025/018/R, AMC & GM to
+#: (EU) 2019/947 Issue 1 Amendment 3, pp. 79–80; worked table §A.5.2.6, p. 81). The VLOS
+#: distance is the smaller of the attitude line of sight ALOS (the distance up to which the
+#: remote pilot can see the UA's position and orientation, "determined in practical tests"):
+#: ALOS = 327·CD + 20 m for rotorcraft and multirotors, 490·CD + 30 m for fixed wing, CD the
+#: maximum characteristic dimension (m); and the detection line of sight DLOS = 0.3·GV, the
+#: ground visibility GV being at most 5 km (so DLOS ≤ 1500 m). VTOL fixed wings take the
+#: rotorcraft line (the smaller: they hover near the pilot). Independent field data agree in
+#: order: Li et al. (Applied Ergonomics 81, a Phantom 4 seen by 50 % of observers at 245 m) and
+#: Li, Sun & Li (Appl. Sci. 10(16) 5501, 2020, doi:10.3390/app10165501, a Mavic Air at 307 m,
+#: visual angle 0.065°) — detection distances, longer than the ALOS of a 0.35 m UA (134 m),
+#: which asks for the attitude too.
+ALOS_ROTORCRAFT = (327.0, 20.0)
+ALOS_FIXED_WING = (490.0, 30.0)
+DLOS_FRACTION = 0.3
+MAX_GROUND_VISIBILITY_M = 5000.0
+VLOS_SOURCE = "EASA AMC1 Art. 11 Annex A §A.5.2.5 (ED Decision 2025/018/R, pp. 79-80): min(ALOS, DLOS)"
+#: The UA assumed when none is known (``derive_operation`` alone): a 1 m multirotor, the first
+#: row of EASA's worked table (347 m). The selector uses each UA's own size instead.
+REFERENCE_UA = (1.0, "multirotor")
+
+
+def vlos_distance_of(dimension_m, kind="multirotor", ground_visibility_m: float = MAX_GROUND_VISIBILITY_M):
+    """VLOS distance (m) of a UA of maximum characteristic dimension ``dimension_m`` (m, scalar or
+    array) and ``kind`` (``fixed-wing``, else rotorcraft; scalar or sequence): min(ALOS, DLOS),
+    see :data:`ALOS_ROTORCRAFT`.
+
+    >>> float(vlos_distance_of(1.0)), float(vlos_distance_of(2.0, "fixed-wing")), float(vlos_distance_of(5.0))
+    (347.0, 1010.0, 1500.0)
+    """
+    d = np.asarray(dimension_m, dtype=float)
+    if not np.all(np.isfinite(d)) or np.any(d <= 0):
+        raise InputError(f"UA characteristic dimension {dimension_m!r} m: must be finite and > 0")
+    if not (math.isfinite(ground_visibility_m) and ground_visibility_m > 0):
+        raise InputError(f"ground visibility {ground_visibility_m!r} m: must be finite and > 0")
+    fixed = np.asarray(kind) == "fixed-wing"
+    a = np.where(fixed, ALOS_FIXED_WING[0], ALOS_ROTORCRAFT[0])
+    b = np.where(fixed, ALOS_FIXED_WING[1], ALOS_ROTORCRAFT[1])
+    dlos = DLOS_FRACTION * min(ground_visibility_m, MAX_GROUND_VISIBILITY_M)
+    return np.minimum(a * d + b, dlos)
+
+
 #: 120 m above ground: the EU open-category limit (2019/947 Art. 4(1)(e)).
 EU_MAX_HEIGHT_M = 120.0
 #: Eurostat degree of urbanisation (DEGURBA): urban centres are grid cells of at least
@@ -132,15 +169,23 @@ def population_of(req: Requirements) -> tuple[str, float]:
     return name, DENSITY_CLASSES[name]
 
 
-def derive_operation(req: Requirements) -> Operation:
-    """Derive the operation from ``req``; see :class:`Operation`."""
+def derive_operation(req: Requirements, *, vlos_default: tuple[float, str] | None = None) -> Operation:
+    """Derive the operation from ``req``; see :class:`Operation`.
+
+    ``vlos_default`` is (distance m, source) used when ``req`` gives no VLOS distance — the
+    selector passes the largest :func:`vlos_distance_of` over its candidate UAS; without it the
+    :data:`REFERENCE_UA` is assumed.
+    """
     facts: list[Fact] = []
     dist = req.max_distance_m if req.max_distance_m is not None else req.range_m
     dist_req = "--max-distance" if req.max_distance_m is not None else "--range (no --max-distance given)"
     if req.vlos_distance_m is not None:
         vlos_d, vlos_src = req.vlos_distance_m, "--vlos-distance"
+    elif vlos_default is not None:
+        vlos_d, vlos_src = vlos_default
     else:
-        vlos_d, vlos_src = DEFAULT_VLOS_DISTANCE_M, VLOS_SOURCE
+        vlos_d = float(vlos_distance_of(REFERENCE_UA[0], REFERENCE_UA[1]))
+        vlos_src = f"{VLOS_SOURCE}, for a {REFERENCE_UA[0]:g} m {REFERENCE_UA[1]} (no UA given)"
     if dist <= vlos_d:
         vis = "VLOS"
     elif req.observers > 0 and dist <= vlos_d * (req.observers + 1):
@@ -297,16 +342,59 @@ def narrowed_features(features: dict[str, tuple[str, ...]], op: Operation) -> di
 # --- EU standard scenarios and PDRAs ------------------------------------------------------
 
 
+#: Density (ppl/km²) below which an area is "sparsely populated" for the STSs and PDRAs: the
+#: upper bound of SORA 2.5's "sparsely populated" row ([AMC-2.5] p. 26: < 500 ppl/km²).
+SPARSE_DENSITY = 500.0
+#: PDRA-G03's height above the surface overflown (m): from a secondary summary (see its source).
+PDRA_G03_MAX_HEIGHT_M = 30.0
+#: The document behind each scenario check. Page numbers are given only where the primary text
+#: was read with its pages; the EASA Easy Access Rules online (HTML) carry none.
+PDRA_SOURCES = {
+    "STS-01": (
+        "(EU) 2019/947 Annex Appendix 1, UAS.STS-01.010/020, inserted by (EU) 2020/639 (OJ L 150, "
+        "13.5.2020); primary text not re-read this session, no page"
+    ),
+    "STS-02": (
+        "(EU) 2019/947 Annex Appendix 1, UAS.STS-02.010/020, inserted by (EU) 2020/639 (OJ L 150, "
+        "13.5.2020); primary text not re-read this session, no page"
+    ),
+    "PDRA-G01": (
+        "AMC2 Article 11 of (EU) 2019/947, PDRA-G01 v1.3 (edition September 2023, ED Decision "
+        "2023/012/R), scope (a)(1)-(5); EASA Easy Access Rules online (HTML, no page)"
+    ),
+    "PDRA-S01": (
+        "AMC4 Article 11 of (EU) 2019/947, PDRA-S01 v1.2 (edition September 2023, ED Decision "
+        "2023/012/R), scope (a)(1)-(5); EASA Easy Access Rules online (HTML, no page)"
+    ),
+    "PDRA-S02": (
+        "AMC5 Article 11 of (EU) 2019/947, PDRA-S02 v1.1 (edition January 2022, ED Decision "
+        "2022/002/R), scope (a)(1)-(5); EASA Easy Access Rules online (HTML, no page)"
+    ),
+    "PDRA-G02": (
+        "AMC3 Article 11 of (EU) 2019/947, PDRA-G02 v1.2 (edition September 2023, ED Decision "
+        "2023/012/R), scope (a)(1)-(5); EASA Easy Access Rules online (HTML, no page)"
+    ),
+    "PDRA-G03": (
+        "PDRA-G03 (AMC to Article 11 of (EU) 2019/947): PRIMARY TEXT NOT REACHED; scope (<= 3 m, "
+        "<= 34 kJ, BVLOS, sparsely populated, atypical air at <= 30 m above the surface, "
+        "pre-programmed, within C2 range) from a secondary summary (eudroneport.com, 'PDRA G-03'), "
+        "to be checked against the EASA text"
+    ),
+}
+
+
 def eu_scenarios(
     op: Operation, *, eu_class: str | None, mtom_g: float, dimension_m: float, speed_ms: float
 ) -> tuple[ScenarioCheck, ...]:
-    """Which EU standard scenarios (STS-01, STS-02) and PDRAs (G01) fit the operation with one UA.
+    """Which EU standard scenarios (STS-01, STS-02) and PDRAs (G01, S01, S02, G02, G03) fit the
+    operation with one UA; each check names its document (:data:`PDRA_SOURCES`).
 
-    Sources: (EU) 2019/947 Appendix 1 as inserted by (EU) 2020/639 (UAS.STS-01.010/020,
-    UAS.STS-02.010/020); AMC2 Article 11 PDRA-G01 v1.3 (EASA ED Decision 2023/012/R), scope (a).
-    The controlled ground area the STSs need is not an input: it is listed as a condition.
+    Only the scope of each PDRA is checked (its section (a)); conditions that are not inputs
+    (a controlled ground area, a low probability of meeting manned aircraft, the C2 range) are
+    listed with the check.
     """
     ke = 0.5 * mtom_g / 1000.0 * speed_ms**2
+    sparse = DENSITY_CLASSES[op.population] < SPARSE_DENSITY
     out = []
     why = []
     if op.visibility != "VLOS":
@@ -322,7 +410,7 @@ def eu_scenarios(
             "STS-01",
             not why,
             (*why, "needs a controlled ground area under the UA"),
-            "(EU) 2019/947 Appendix 1 UAS.STS-01.010/020 ((EU) 2020/639)",
+            PDRA_SOURCES["STS-01"],
         )
     )
     why = []
@@ -334,7 +422,7 @@ def eu_scenarios(
         why.append(
             f"{op.max_distance_m:g} m from the pilot, STS-02 allows 1 km (2 km with airspace observers)"
         )
-    if DENSITY_CLASSES[op.population] >= 500.0:
+    if not sparse:
         why.append("not a sparsely populated area")
     if op.height_m > EU_MAX_HEIGHT_M:
         why.append("above 120 m")
@@ -343,7 +431,7 @@ def eu_scenarios(
             "STS-02",
             not why,
             (*why, "needs a controlled ground area under the UA"),
-            "(EU) 2019/947 Appendix 1 UAS.STS-02.010/020 ((EU) 2020/639)",
+            PDRA_SOURCES["STS-02"],
         )
     )
     why = []
@@ -353,18 +441,106 @@ def eu_scenarios(
         why.append(f"dimension {dimension_m:g} m > 3 m")
     if ke > 34e3:
         why.append(f"kinetic energy {ke / 1e3:.1f} kJ > 34 kJ")
-    if DENSITY_CLASSES[op.population] >= 500.0:
+    if not sparse:
         why.append("not a sparsely populated area")
     if op.height_m >= 150.0:
         why.append("not below 150 m")
     if op.airspace not in ("uncontrolled", "atypical"):
         why.append("not in uncontrolled airspace")
+    out.append(ScenarioCheck("PDRA-G01", not why, tuple(why), PDRA_SOURCES["PDRA-G01"]))
+    # PDRA-S01: STS-01's operation without the C5 label.
+    why = []
+    if op.visibility != "VLOS":
+        why.append("PDRA-S01 is VLOS")
+    if dimension_m > 3.0:
+        why.append(f"dimension {dimension_m:g} m > 3 m")
+    if op.height_m >= 150.0:
+        why.append("not below 150 m AGL")
+    if op.over_people == "assemblies":
+        why.append("over assemblies (the ground area must be controlled)")
+    if op.airspace in ("airport-bcd", "airport-efg", "tmz"):
+        why.append(f"airspace {op.airspace}: not a low probability of encountering manned aircraft")
     out.append(
         ScenarioCheck(
-            "PDRA-G01",
+            "PDRA-S01",
             not why,
-            tuple(why),
-            "AMC2 Article 11 (EU) 2019/947, PDRA-G01 v1.3 scope (a)(1)-(5) (ED Decision 2023/012/R)",
+            (
+                *why,
+                "needs a controlled ground area under the UA (may be in a populated area)",
+                "needs a low probability of encountering manned aircraft",
+            ),
+            PDRA_SOURCES["PDRA-S01"],
+        )
+    )
+    # PDRA-S02: STS-02's operation without the C6 label.
+    why = []
+    if op.visibility == "VLOS":
+        why.append("PDRA-S02 is BVLOS (a VLOS flight needs none)")
+    if dimension_m > 3.0:
+        why.append(f"dimension {dimension_m:g} m > 3 m")
+    if mtom_g > 25e3:
+        why.append(f"MTOM {mtom_g / 1e3:.1f} kg > 25 kg")
+    if op.max_distance_m > (2000.0 if op.observers > 0 else 1000.0):
+        why.append(
+            f"{op.max_distance_m:g} m from the pilot, PDRA-S02 allows 1 km (2 km with airspace observers)"
+        )
+    if not sparse:
+        why.append("not a sparsely populated area")
+    if op.height_m >= 150.0:
+        why.append("not below 150 m AGL")
+    if op.airspace in ("airport-bcd", "airport-efg", "tmz"):
+        why.append(f"airspace {op.airspace}: not a low probability of encountering manned aircraft")
+    out.append(
+        ScenarioCheck(
+            "PDRA-S02",
+            not why,
+            (
+                *why,
+                "needs a controlled ground area entirely in a sparsely populated area",
+                "needs a low probability of encountering manned aircraft",
+            ),
+            PDRA_SOURCES["PDRA-S02"],
+        )
+    )
+    # PDRA-G02: BVLOS in reserved/segregated airspace (ARC-a).
+    why = []
+    if op.visibility == "VLOS":
+        why.append("PDRA-G02 is BVLOS")
+    if dimension_m > 3.0:
+        why.append(f"dimension {dimension_m:g} m > 3 m")
+    if ke > 34e3:
+        why.append(f"kinetic energy {ke / 1e3:.1f} kJ > 34 kJ")
+    if not sparse:
+        why.append("not a sparsely populated area")
+    if op.airspace != "atypical":
+        why.append(f"airspace {op.airspace}: PDRA-G02 needs reserved or segregated airspace (ARC-a)")
+    out.append(
+        ScenarioCheck(
+            "PDRA-G02",
+            not why,
+            (*why, "within the direct C2 link's radio line of sight"),
+            PDRA_SOURCES["PDRA-G02"],
+        )
+    )
+    # PDRA-G03: linear inspections close to the surface (atypical, very low level) — the
+    # primary text was not reached: scope from a secondary summary, flagged in its source.
+    why = []
+    if op.visibility == "VLOS":
+        why.append("PDRA-G03 is BVLOS")
+    if dimension_m > 3.0:
+        why.append(f"dimension {dimension_m:g} m > 3 m")
+    if ke > 34e3:
+        why.append(f"kinetic energy {ke / 1e3:.1f} kJ > 34 kJ")
+    if not sparse:
+        why.append("not a sparsely populated area")
+    if op.height_m > PDRA_G03_MAX_HEIGHT_M:
+        why.append(f"{op.height_m:g} m above the surface: PDRA-G03 flies at most {PDRA_G03_MAX_HEIGHT_M:g} m")
+    out.append(
+        ScenarioCheck(
+            "PDRA-G03",
+            not why,
+            (*why, "pre-programmed flight within the direct C2 link's range"),
+            PDRA_SOURCES["PDRA-G03"],
         )
     )
     return tuple(out)

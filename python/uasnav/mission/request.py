@@ -158,7 +158,8 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "vlos_distance",
         "real",
         None,
-        "Distance up to which the UA is kept in sight (m); default 500 m (UK CAA CAP 722).",
+        "Distance up to which the UA is kept in sight (m); default: from each UA's size (EASA AMC1 "
+        "Art. 11 Annex A A.5.2.5: min(327 CD + 20 m rotorcraft, 490 CD + 30 m fixed wing; 1500 m)).",
         "m",
         0.0,
         True,
@@ -361,6 +362,12 @@ def parse_mitigations(value: Any, edition: str) -> tuple[tuple[str, str], ...]:
                 "mitigations", f"mitigations: {k} cannot be claimed at {rob} robustness in SORA {edition}"
             )
         out.append((k.upper(), rob))
+    got = dict(out)
+    if edition == "2.5" and got.get("M1A") == "medium" and got.get("M1B", "none") != "none":
+        raise OptionError(
+            "mitigations",
+            "mitigations: M1A=medium cannot be combined with M1B (EASA AMC1 Art. 11 Annex B B.2, p. 85)",
+        )
     return tuple(out)
 
 

@@ -22,12 +22,14 @@ from uasnav.mission.feasibility import (
 from uasnav.mission.feasibility import equipment_tests as _equipment_tests
 from uasnav.mission.matrices import INCOMPATIBLE, NECESSARY, Matrices, load_matrices
 from uasnav.mission.operation import (
+    VLOS_SOURCE,
     Operation,
     ScenarioCheck,
     derive_operation,
     eu_scenarios,
     faa_checks,
     narrowed_features,
+    vlos_distance_of,
 )
 from uasnav.mission.regulations import Regulations, load_regulations
 from uasnav.mission.scoring import ScoreMatrix, Targets, Weights, rank, score_matrix
@@ -187,6 +189,33 @@ def equipment_tests(u, req: Requirements, equipment: list[EquipmentNeed]) -> lis
     return _equipment_tests(u, req.gnss_autopilot, need)
 
 
+def _vlos_defaults(
+    u, req: Requirements, regs: Regulations
+) -> tuple[np.ndarray | None, tuple[float, str] | None]:
+    """Each UAS's VLOS distance from its size (:func:`~uasnav.mission.operation.vlos_distance_of`)
+    and the operation's default: the largest over the UAS that pass the aircraft tests of the
+    category a flight in sight would be in (a flight is VLOS when at least one candidate UA can be
+    kept in sight; the others are then rejected by the ``vlos-distance`` test). (None, None) when
+    the user gives ``--vlos-distance``."""
+    if req.vlos_distance_m is not None or len(u) == 0:
+        return None, None
+    per = np.asarray(vlos_distance_of(u.span_m, list(u.types)), dtype=float)
+    in_sight = derive_operation(req, vlos_default=(np.inf, ""))
+    lim = regs.category(req.jurisdiction, in_sight.category).limit("mtom")
+    ok = np.ones(len(u), dtype=bool)
+    for t in uas_tests(u, req, lim.value_si if lim is not None else np.inf) + _equipment_tests(
+        u, req.gnss_autopilot, []
+    ):
+        ok &= t.ok
+    pool = np.flatnonzero(ok) if ok.any() else np.arange(len(u))
+    k = int(pool[np.argmax(per[pool])])
+    src = (
+        f"{VLOS_SOURCE}; the largest of the candidate UAS: {u.label(k)}, {float(u.span_m[k]):g} m "
+        f"{u.types[k]}; each UAS is held to its own distance"
+    )
+    return per, (float(per[k]), src)
+
+
 def _reject(tests: list[TestResult], kind: str, labels, ids) -> tuple[np.ndarray, list[Rejection]]:
     ok = np.ones(len(ids), dtype=bool)
     out = []
@@ -250,7 +279,9 @@ def select(
     mx = matrices if matrices is not None else load_matrices()
     regs = regulations if regulations is not None else load_regulations()
     mission = mx.mission(req.mission)
-    op = derive_operation(req)
+    u, c = db.uas, db.cameras
+    per_ua_vlos, vlos_default = _vlos_defaults(u, req, regs)
+    op = derive_operation(req, vlos_default=vlos_default)
     feats = narrowed_features(dict(mission.features), op)
     equipment = []
     for e in mx.equipment.values():
@@ -308,9 +339,23 @@ def select(
     # eq. 60 at the highest height the regulations allow (thesis §5.2.3.4); if the category sets
     # no height limit the required altitude is used instead.
     h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
-    u, c = db.uas, db.cameras
+    sight = []
+    if per_ua_vlos is not None and op.visibility != "BVLOS":
+        # The operation is flown in sight (of the pilot, or of an observer each): a UA too small
+        # to be kept in sight at the pilot distance cannot fly it.
+        reach = per_ua_vlos * (op.observers + 1)
+        sight.append(
+            TestResult(
+                "vlos-distance",
+                reach >= op.max_distance_m,
+                reach,
+                np.full(len(u), op.max_distance_m),
+                "m",
+                ">=",
+            )
+        )
     uas_ok, rej = _reject(
-        uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids
+        uas_tests(u, req, max_mtom) + sight + equipment_tests(u, req, equipment), "uas", u.label, u.ids
     )
     rejections += rej
     cam_ok, rej = _reject(camera_tests(c, req, h_cam), "camera", c.label, c.ids)

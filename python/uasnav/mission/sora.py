@@ -1,23 +1,47 @@
 """Specific Operations Risk Assessment (JARUS SORA), editions 2.5 and 2.0.
 
-Every table is transcribed from the primary JARUS document and names it (edition, table).
-Public encodings of these tables disagree with each other (some swap the 2.0 and 2.5 SAIL
-tables, some give 2.5's iGRC rows with 2.0's kinetic-energy columns); the tests in
-``tests/test_mission_sora.py`` check every table boundary against the values below, each of
-which was read from the document named beside it. Page numbers are not given where we could not
-re-check them against a copy of the document in this session (the edition and the table number
-identify the cell unambiguously).
+Every table names its primary document: edition, table or section, and page. Public encodings
+of these tables disagree with each other (some swap the 2.0 and 2.5 SAIL tables, some give
+2.5's iGRC rows with 2.0's kinetic-energy columns); the tests in ``tests/test_mission_sora.py``
+check every table boundary against the values below.
 
 Sources
 -------
-* JARUS SORA 2.5: "JARUS guidelines on Specific Operations Risk Assessment (SORA)", edition 2.5,
-  JAR-DEL-SRM-SORA-MB-2.5, 13 May 2024 (Main Body): Table 2 (iGRC), Table 5 (ground risk
-  mitigations), Figure 6 (initial ARC decision tree), Table 6 (TMPR), Table 7 (SAIL),
-  Table 14 (OSOs).
-* JARUS SORA 2.0: "JARUS guidelines on SORA", edition 2.0, JAR-DEL-WG6-D.04, 30 January 2019
-  (the basis of EASA's AMC1 Article 11 of Regulation (EU) 2019/947, Easy Access Rules for
-  UAS): Table 2 (iGRC), Table 3 (mitigations), Figure 4 (ARC), Table 4 (TMPR), Table 5 (SAIL),
-  Table 6 (OSOs).
+``[AMC-2.5]`` — SORA 2.5, checked against its primary text in this session:
+    EASA, "Acceptable Means of Compliance and Guidance Material to Regulation (EU) 2019/947 —
+    Issue 1, Amendment 3", Annex to ED Decision 2025/018/R; AMC1 Article 11 "Specific
+    operations risk assessment (SORA) (source: JARUS SORA v2.5)", edition September 2025.
+    Pages are the document's own "Page N of 204" footers. This is JARUS SORA 2.5 as the EU
+    adopted it (EASA numbers some tables differently from the JARUS Main Body, noted below).
+
+    * iGRC table: S.4.2.3(d), p. 24 (captioned "Table 1", cited in the text as Table 2);
+      the ≤ 250 g / ≤ 25 m/s note, p. 24; "rightmost column matching both criteria", p. 25;
+      qualitative density descriptors, Table 2, p. 26.
+    * Ground-risk mitigations: Table 5, p. 29; the column floor (S.4.3.4(f)) and final GRC > 7
+      → certified category, p. 30; M1(A) medium cannot be combined with M1(B): Annex B §B.2,
+      p. 85.
+    * Initial ARC: Figure 6, p. 32 (a figure: its text could not be read from our copy);
+      atypical air environment → ARC-a, p. 33; residual = initial unless strategic mitigations
+      are claimed (S.4.5.1(c)), p. 33; VLOS (or BVLOS with airspace observers) lowers the
+      initial ARC by one class, never to ARC-a (S.4.5.4), p. 34.
+    * TMPR: Table 6, p. 35; VLOS / BVLOS with observers is an acceptable tactical mitigation for
+      all ARCs (S.4.6.4(a)), p. 35.
+    * SAIL: p. 38 (captioned "Table 3", cited in the text as Table 7).
+    * OSOs: Table 14, pp. 44–45 (17 OSOs). Differs from 2.0 in OSO #04 (NR NR NR M H H: EASA
+      raised SAIL IV to medium, matching its Annex E OSO #04 criteria, pp. 105–106).
+
+``[SORA-2.0]`` — SORA 2.0: JARUS, "JARUS guidelines on SORA", edition 2.0, JAR-DEL-WG6-D.04,
+    30 January 2019 (the basis of EASA's earlier AMC1 Article 11, ED Decision 2019/021/R):
+    Table 2 (iGRC), Table 3 (mitigations), Figure 4 (ARC), Table 4 (TMPR), Table 5 (SAIL),
+    Table 6 (OSOs). **The primary text could not be reached in this session** (neither the JARUS
+    PDF nor EASA's 2019 AMC), so no page numbers are given for 2.0: the values are the earlier
+    transcription, unchanged, and where 2.0 and 2.5 share a table (SAIL, TMPR, the OSOs other
+    than #04) they agree with ``[AMC-2.5]``.
+
+ARC height split: 500 ft AGL (152.4 m). ``[AMC-2.5]`` Figure 6 could not be read, but the same
+text speaks of "operations below 500 ft AGL" for the low TMPR (S.4.6.4(c), p. 36) and pairs
+500 ft with 152 m in its grid-size Table 4 (p. 28); some secondary encodings use 150 m for 2.5
+(JARUS Annex C Table C.1, not reached). The two differ by 2.4 m.
 
 The flow is the SORA's steps: #2 iGRC → #3 final GRC (mitigations, floor = the column's
 controlled-ground-area value) → #4 initial ARC → #5 residual ARC (strategic mitigations: given
@@ -42,8 +66,10 @@ ARCS = ("a", "b", "c", "d")
 
 # --- SORA 2.5 ------------------------------------------------------------------------------
 
-#: SORA 2.5 Main Body Table 2 columns: (max characteristic dimension m, max speed m/s). A UA
-#: goes in the first column whose dimension AND speed both bound it.
+#: SORA 2.5 iGRC table columns: (max characteristic dimension m, max speed m/s) — [AMC-2.5]
+#: S.4.2.3(d), p. 24 (the 20 m column is 120 m/s there; Annex F's 20 m reference UA cruises at
+#: 150 m/s). A UA goes in the first column whose dimension AND speed both bound it ("the
+#: rightmost column matching both criteria", p. 25, read from the UA's side).
 IGRC25_COLUMNS: tuple[tuple[float, float], ...] = (
     (1.0, 25.0),
     (3.0, 35.0),
@@ -51,8 +77,8 @@ IGRC25_COLUMNS: tuple[tuple[float, float], ...] = (
     (20.0, 120.0),
     (40.0, 200.0),
 )
-#: SORA 2.5 Main Body Table 2 rows: (name, population density upper bound ppl/km² (exclusive),
-#: iGRC per column; None = grey cell, out of the SORA's scope).
+#: SORA 2.5 iGRC table rows: (name, population density upper bound ppl/km² (exclusive), iGRC
+#: per column; None = grey cell, "not part of SORA") — [AMC-2.5] p. 24.
 IGRC25_ROWS: tuple[tuple[str, float, tuple[int | None, ...]], ...] = (
     ("controlled", 0.0, (1, 1, 2, 3, 3)),
     ("remote", 5.0, (2, 3, 4, 5, 6)),
@@ -62,7 +88,8 @@ IGRC25_ROWS: tuple[tuple[str, float, tuple[int | None, ...]], ...] = (
     ("high-density", 50000.0, (6, 7, 8, 9, 10)),
     ("assemblies", math.inf, (7, 8, None, None, None)),
 )
-#: Named density classes (SORA 2.5 Table 3 qualitative descriptors) → a representative density
+#: Named density classes (SORA 2.5 qualitative descriptors, [AMC-2.5] Table 2, p. 26; JARUS
+#: Main Body Table 3) → a representative density
 #: (ppl/km²) inside the class, used when the user names a class instead of a number.
 DENSITY_CLASSES: dict[str, float] = {
     "controlled": 0.0,
@@ -73,9 +100,10 @@ DENSITY_CLASSES: dict[str, float] = {
     "high-density": 10000.0,
     "assemblies": 100000.0,
 }
-#: SORA 2.5 Main Body Table 2, note: a UA of at most 250 g and at most 25 m/s has iGRC 1.
+#: [AMC-2.5] p. 24, note to the iGRC table: a UA of at most 250 g and at most 25 m/s has iGRC 1
+#: (unless over assemblies of people).
 SMALL_UA_MASS_G, SMALL_UA_SPEED_MS = 250.0, 25.0
-#: SORA 2.5 Main Body Table 5: GRC reduction per mitigation and robustness (None = N/A).
+#: SORA 2.5 Table 5: GRC reduction per mitigation and robustness (None = n/a) — [AMC-2.5] p. 29.
 MITIGATIONS25: dict[str, dict[str, int | None]] = {
     "M1A": {"none": 0, "low": -1, "medium": -2, "high": None},
     "M1B": {"none": 0, "low": None, "medium": -1, "high": -2},
@@ -85,14 +113,16 @@ MITIGATIONS25: dict[str, dict[str, int | None]] = {
 
 # --- SORA 2.0 ------------------------------------------------------------------------------
 
-#: SORA 2.0 Table 2 columns: (max characteristic dimension m, typical kinetic energy J).
+#: SORA 2.0 Table 2 columns: (max characteristic dimension m, typical kinetic energy J)
+#: — [SORA-2.0] (primary text not reached this session: no page).
 IGRC20_COLUMNS: tuple[tuple[float, float], ...] = (
     (1.0, 700.0),
     (3.0, 34e3),
     (8.0, 1084e3),
     (math.inf, math.inf),
 )
-#: SORA 2.0 Table 2 rows: operational scenario → iGRC per column (None = grey, not SORA).
+#: SORA 2.0 Table 2 rows: operational scenario → iGRC per column (None = grey, not SORA)
+#: — [SORA-2.0] (no page: not reached).
 IGRC20_ROWS: dict[str, tuple[int | None, ...]] = {
     "controlled": (1, 2, 3, 4),
     "vlos-sparsely": (2, 3, 4, 5),
@@ -102,7 +132,8 @@ IGRC20_ROWS: dict[str, tuple[int | None, ...]] = {
     "vlos-assemblies": (7, None, None, None),
     "bvlos-assemblies": (8, None, None, None),
 }
-#: SORA 2.0 Table 3: GRC correction per mitigation and robustness (M3: ERP, +1 if absent/low).
+#: SORA 2.0 Table 3: GRC correction per mitigation and robustness (M3: ERP, +1 if absent/low)
+#: — [SORA-2.0] (no page: not reached).
 MITIGATIONS20: dict[str, dict[str, int | None]] = {
     "M1": {"none": 0, "low": -1, "medium": -2, "high": -4},
     "M2": {"none": 0, "low": 0, "medium": -1, "high": -2},
@@ -115,8 +146,9 @@ SPARSE_LIMIT_20 = 500.0
 
 # --- both editions -------------------------------------------------------------------------
 
-#: SAIL from final GRC (rows ≤2, 3, 4, 5, 6, 7) and residual ARC (columns a–d). The tables are
-#: the same in 2.0 (Table 5) and 2.5 (Table 7); 2.5 sends GRC > 7 to the certified category.
+#: SAIL from final GRC (rows ≤2, 3, 4, 5, 6, 7) and residual ARC (columns a–d): [AMC-2.5]
+#: p. 38 (JARUS 2.5 Table 7). 2.0's Table 5 holds the same cells ([SORA-2.0], not re-read this
+#: session); GRC > 7 is the certified category.
 SAIL_TABLE: dict[int, tuple[str, str, str, str]] = {
     2: ("I", "II", "IV", "VI"),
     3: ("II", "II", "IV", "VI"),
@@ -125,13 +157,15 @@ SAIL_TABLE: dict[int, tuple[str, str, str, str]] = {
     6: ("V", "V", "V", "VI"),
     7: ("VI", "VI", "VI", "VI"),
 }
-#: TMPR and its robustness per residual ARC (2.0 Table 4, 2.5 Table 6); VLOS operations meet
-#: the TMPR by the pilot's (and observers') see-and-avoid (2.5 §4.6.2 / 2.0 §2.4.2 step 6).
+#: TMPR and its robustness per residual ARC: [AMC-2.5] Table 6, p. 35 (2.0 Table 4, same
+#: cells). VLOS, or BVLOS with airspace observers, meets the TMPR by see-and-avoid for every
+#: ARC ([AMC-2.5] S.4.6.4(a), p. 35).
 TMPR: dict[str, str] = {"a": "none", "b": "low", "c": "medium", "d": "high"}
 
 SAILS = ("I", "II", "III", "IV", "V", "VI")
-# OSO robustness per SAIL I..VI: O optional, L low, M medium, H high.
-#: SORA 2.0 Table 6 (24 OSOs).
+# OSO robustness per SAIL I..VI: O optional (2.0) / not required (2.5 "NR"), L low, M medium,
+# H high.
+#: SORA 2.0 Table 6 (24 OSOs) — [SORA-2.0] (not re-read this session: no page).
 OSO20: dict[str, tuple[str, str]] = {
     "OSO#01": ("Operator is competent and/or proven", "OLMHHH"),
     "OSO#02": ("UAS manufactured by competent and/or proven entity", "OOLMHH"),
@@ -158,34 +192,36 @@ OSO20: dict[str, tuple[str, str]] = {
     "OSO#23": ("Environmental conditions for safe operations defined, measurable and adhered to", "LLMMHH"),
     "OSO#24": ("UAS designed and qualified for adverse environmental conditions", "OOMHHH"),
 }
-#: SORA 2.5 Table 14 (17 OSOs: 2.5 merged OSO#10–12, #14–15 and #21–22 into others).
+#: SORA 2.5 Table 14 (17 OSOs; 2.5 folded 2.0's OSO #10–12, #14–15 and #21–22 into others),
+#: titles and levels as printed in [AMC-2.5] pp. 44–45.
 OSO25: dict[str, tuple[str, str]] = {
-    k: OSO20[k]
-    for k in (
-        "OSO#01",
-        "OSO#02",
-        "OSO#03",
-        "OSO#04",
-        "OSO#05",
-        "OSO#06",
-        "OSO#07",
-        "OSO#08",
-        "OSO#09",
-        "OSO#13",
-        "OSO#16",
-        "OSO#17",
-        "OSO#18",
-        "OSO#19",
-        "OSO#20",
-        "OSO#23",
-        "OSO#24",
-    )
+    "OSO#01": ("Ensure that the UAS operator is a competent and/or proven organisation", "OLMHHH"),
+    "OSO#02": ("UAS designed and produced by a competent and/or proven organisation", "OOLMHH"),
+    "OSO#03": ("UAS maintenance", "LLMMHH"),
+    "OSO#04": (
+        "UAS components essential to safe operations are designed to an airworthiness design standard",
+        "OOOMHH",
+    ),
+    "OSO#05": ("UAS is designed considering system safety and reliability", "OOLMHH"),
+    "OSO#06": ("C3 link characteristics (e.g. performance, spectrum use) are appropriate", "OLLMHH"),
+    "OSO#07": ("Conformity check of the UAS configuration", "LLMMHH"),
+    "OSO#08": ("Operational procedures are defined, validated and adhered to", "LMHHHH"),
+    "OSO#09": ("Remote crew trained and current", "LLMMHH"),
+    "OSO#13": ("External services supporting UAS operations are adequate for the UAS operation", "LLMHHH"),
+    "OSO#16": ("Multi-crew coordination", "LLMMHH"),
+    "OSO#17": ("Remote crew is fit to operate", "LLMMHH"),
+    "OSO#18": ("Automatic protection of the flight envelope from human errors", "OOLMHH"),
+    "OSO#19": ("Safe recovery from human error", "OOLMMH"),
+    "OSO#20": ("A human factors evaluation has been performed and the HMI found appropriate", "OLLMMH"),
+    "OSO#23": ("Environmental conditions for safe operations defined and measurable", "LLMMHH"),
+    "OSO#24": ("UAS designed and qualified to operate in adverse environmental conditions", "OOMHHH"),
 }
 _LEVEL = {"O": "optional", "L": "low", "M": "medium", "H": "high"}
 
 #: Airspace situations (encounter categories of 2.0 Figure 4 / 2.5 Figure 6) accepted as input.
 AIRSPACES = ("uncontrolled", "controlled", "tmz", "airport-bcd", "airport-efg", "atypical")
-#: 500 ft AGL, the height that splits the ARC decision tree (both editions).
+#: 500 ft AGL, the height that splits the ARC decision tree (both editions; see the module doc
+#: for why 500 ft and not 150 m).
 ARC_SPLIT_M = 152.4
 
 
@@ -222,6 +258,8 @@ class SoraResult:
     #: SORA 2.5's quantitative alternative (Annex F, computed with ``casex``): (iGRC, raw iGRC,
     #: critical area m²) for this UA and density; None when not computed.
     annex_f: tuple[int, float, float] | None = None
+    #: The rule behind the residual ARC (no claim, the VLOS reduction, or an Annex C claim).
+    residual_arc_rule: str = ""
 
     def to_dict(self) -> dict:
         """Plain JSON."""
@@ -238,6 +276,7 @@ class SoraResult:
             "certified": self.certified,
             "osos": [o.__dict__ for o in self.osos],
             "steps": list(self.steps),
+            "residual_arc_rule": self.residual_arc_rule,
             "annex_f": None
             if self.annex_f is None
             else {"igrc": self.annex_f[0], "raw_igrc": self.annex_f[1], "critical_area_m2": self.annex_f[2]},
@@ -339,6 +378,11 @@ def final_grc(igrc: int, mitigations: Mapping[str, str], edition: str, floor: in
     """Step #3: iGRC plus the corrections of the claimed mitigations, never below ``floor``
     (the column's controlled-ground-area value: 2.5 §4.3, 2.0 §2.3.2)."""
     table = MITIGATIONS25 if edition == "2.5" else MITIGATIONS20
+    if edition == "2.5" and mitigations.get("M1A") == "medium" and mitigations.get("M1B", "none") != "none":
+        raise InputError(
+            "SORA 2.5: M1A at medium robustness cannot be combined with M1B (time-based restrictions "
+            "would count twice: [AMC-2.5] Annex B §B.2, p. 85)"
+        )
     g = igrc
     for name, rob in mitigations.items():
         if name not in table:
@@ -378,6 +422,49 @@ def initial_arc(airspace: str, height_m: float, urban: bool) -> str:
     if airspace in ("tmz", "controlled"):
         return "c"  # AEC 7, 8
     return "c" if urban else "b"  # AEC 9 urban, AEC 10 rural
+
+
+def residual_arc_of(
+    initial: str, claimed: str | None, *, bvlos: bool, edition: str = "2.5"
+) -> tuple[str, str]:
+    """Step #5: the residual ARC and the rule that allows it.
+
+    ``claimed`` is the residual ARC the operator claims after strategic mitigations (None: no
+    claim, the residual is the initial ARC, [AMC-2.5] S.4.5.1(c), p. 33). A claim above the
+    initial ARC is refused. A VLOS operation (or BVLOS with airspace observers, ``bvlos``
+    False) may lower the initial ARC by one class but never to ARC-a ([AMC-2.5] S.4.5.4,
+    p. 34). Any other lower claim is an Annex C strategic-mitigation claim (operational
+    restrictions or airspace structure) the operator must substantiate: it is accepted and
+    labelled so; Annex C's own reduction limits were not reached in this session and are not
+    checked.
+    """
+    if initial not in ARCS:
+        raise InputError(f"unknown initial ARC {initial!r}")
+    if claimed is None or claimed == initial:
+        return (
+            initial,
+            "no strategic mitigation claimed: residual ARC = initial ARC ([AMC-2.5] S.4.5.1(c), p. 33)",
+        )
+    if claimed not in ARCS or ARCS.index(claimed) > ARCS.index(initial):
+        raise InputError(
+            f"residual ARC {claimed!r} must be one of a–{initial} (initial ARC-{initial}): strategic "
+            "mitigations only lower the ARC ([AMC-2.5] S.4.5, p. 33)"
+        )
+    one_down = ARCS.index(initial) - ARCS.index(claimed) == 1
+    if not bvlos and edition == "2.5" and one_down and claimed != "a":
+        return claimed, (
+            "VLOS (or BVLOS with airspace observers) lowers the initial ARC by one class ([AMC-2.5] "
+            "S.4.5.4, p. 34)"
+        )
+    if not bvlos and edition == "2.5" and claimed == "a":
+        raise InputError(
+            "residual ARC-a: the VLOS/observer mitigation cannot reduce the ARC to ARC-a ([AMC-2.5] "
+            "S.4.5.4, p. 34); ARC-a is the atypical air environment (p. 33): give --airspace atypical"
+        )
+    return claimed, (
+        f"claimed strategic mitigation ARC-{initial} → ARC-{claimed} (SORA {edition} Annex C §5–6: "
+        "operational restrictions or airspace structure), to be substantiated to the authority"
+    )
 
 
 def sail(grc: int, arc: str) -> str | None:
@@ -432,8 +519,8 @@ def assess(
     mitigations : mapping, optional
         Mitigation → robustness (2.5: M1A, M1B, M1C, M2; 2.0: M1, M2, M3).
     residual_arc : str, optional
-        Residual ARC after strategic mitigations, when the operator claims one (must not be
-        above the initial ARC); default: the initial ARC (no strategic mitigation assumed).
+        Residual ARC after strategic mitigations, when the operator claims one; checked by
+        :func:`residual_arc_of`. Default: the initial ARC (no strategic mitigation assumed).
     edition : {"2.5", "2.0"}
     density_ppl_km2 : float, optional
         Population density (ppl/km²) for the Annex F quantitative iGRC (2.5, with ``mass_g``),
@@ -455,7 +542,8 @@ def assess(
         col = _column25(dimension_m, speed_ms)
         floor = IGRC25_ROWS[0][2][col] or 1
         steps.append(
-            f"iGRC {ig} (SORA 2.5 Table 2: {dimension_m:g} m, {speed_ms:g} m/s, population {population})"
+            f"iGRC {ig} (SORA 2.5 Table 2, [AMC-2.5] p. 24: {dimension_m:g} m, {speed_ms:g} m/s, "
+            f"population {population})"
         )
     else:
         if mass_g is None:
@@ -475,28 +563,26 @@ def assess(
         floor = IGRC20_ROWS["controlled"][col] or 1
         steps.append(f"iGRC {ig} (SORA 2.0 Table 2: {dimension_m:g} m, {e:.0f} J, scenario {scen})")
     arc0 = initial_arc(airspace, height_m, urban)
-    arc = arc0 if residual_arc is None else residual_arc
-    if arc not in ARCS or ARCS.index(arc) > ARCS.index(arc0):
-        raise InputError(f"residual ARC {residual_arc!r} must be one of a–{arc0} (initial ARC-{arc0})")
+    arc, arc_rule = residual_arc_of(arc0, residual_arc, bvlos=bvlos, edition=edition)
     tm = TMPR[arc] if bvlos else "none"
     if ig is None:
         steps.append("grey cell of the iGRC table: outside the SORA, certified category")
-        return SoraResult(edition, population, None, None, mit, arc0, arc, tm, None, True, (), tuple(steps))
+        return SoraResult(
+            edition, population, None, None, mit, arc0, arc, tm, None, True, (), tuple(steps), None, arc_rule
+        )
     grc = final_grc(ig, mit, edition, floor)
-    table = "Table 5" if edition == "2.5" else "Table 3"
+    table = "Table 5, [AMC-2.5] p. 29" if edition == "2.5" else "Table 3"
     steps.append(f"final GRC {grc} (mitigations {mit or 'none'}, {table}; floor {floor})")
     steps.append(
         f"initial ARC-{arc0} (airspace {airspace}, {height_m:g} m AGL, {'urban' if urban else 'rural'})"
     )
-    steps.append(
-        f"residual ARC-{arc}" + (" (no strategic mitigation claimed)" if residual_arc is None else "")
-    )
+    steps.append(f"residual ARC-{arc}: {arc_rule}")
     steps.append(
         f"TMPR {tm}"
         + (
             " (VLOS: see-and-avoid by the remote crew)"
             if not bvlos
-            else f" ({'Table 6' if edition == '2.5' else 'Table 4'})"
+            else f" ({'Table 6, [AMC-2.5] p. 35' if edition == '2.5' else 'Table 4'})"
         )
     )
     af = None
@@ -512,8 +598,23 @@ def assess(
     s = sail(grc, arc)
     if s is None:
         steps.append(f"final GRC {grc} > 7: certified category")
-        return SoraResult(edition, population, ig, grc, mit, arc0, arc, tm, None, True, (), tuple(steps), af)
-    steps.append(f"SAIL {s} ({'Table 7' if edition == '2.5' else 'Table 5'})")
+        return SoraResult(
+            edition, population, ig, grc, mit, arc0, arc, tm, None, True, (), tuple(steps), af, arc_rule
+        )
+    steps.append(f"SAIL {s} ({'[AMC-2.5] p. 38 (JARUS Table 7)' if edition == '2.5' else 'Table 5'})")
     return SoraResult(
-        edition, population, ig, grc, mit, arc0, arc, tm, s, False, osos(s, edition), tuple(steps), af
+        edition,
+        population,
+        ig,
+        grc,
+        mit,
+        arc0,
+        arc,
+        tm,
+        s,
+        False,
+        osos(s, edition),
+        tuple(steps),
+        af,
+        arc_rule,
     )
