@@ -134,6 +134,16 @@ def command(as_json: bool, **options: Any) -> None:
         click.echo(f"  {x.id}: {'applies' if x.applies else 'no'} ({'; '.join(x.reasons)})")
     if sel.zones is not None:
         click.echo(f"Zones ({sel.zones.n_zones} read from {sel.zones.source}): {len(sel.zones.hits)} entered")
+        if sel.flight_window is not None:
+            fw = sel.flight_window
+            click.echo(
+                f"  schedules checked over {fw['start']} - {fw['end']} "
+                f"({fw['duration_s']:.0f} s: {fw['from']})"
+            )
+    auth = sel.authorisation
+    click.echo(f"Verdict: {auth['verdict']}")
+    for n in auth["requirements"]:
+        click.echo(f"  requires: {n}")
     for n in sel.notes:
         click.echo(f"  note: {n}")
     click.echo("\nEquipment (* necessary):")
@@ -162,7 +172,12 @@ def command(as_json: bool, **options: Any) -> None:
             f"  {rank_no:>2} {pair.uas:<30} {pair.camera:<26} {pair.score:6.2f} {pair.mass_g:7.0f}"
             f" {pair.cost_usd:7.0f}  {pair.open_subcategory or '-'}"
         )
-    if not sel.ranking:
+    if not sel.ranking and sel.withheld:
+        click.echo("  (none flyable: the area enters a PROHIBITED zone)")
+        click.echo("\nWithheld — would rank only if the zone authority exempted the flight:")
+        for rank_no, pair in enumerate(sel.withheld, 1):
+            click.echo(f"  {rank_no:>2} {pair.uas:<30} {pair.camera:<26} {pair.score:6.2f}")
+    elif not sel.ranking:
         click.echo("  (no feasible configuration)")
     if summary is not None:
         click.echo(f"\nAuthorisation summary written to {summary}")

@@ -106,6 +106,27 @@ class Applicability:
                 return True
         return False
 
+    def active_during(self, t0: dt.datetime, t1: dt.datetime) -> bool:
+        """Whether this applicability covers some instant of the closed window [t0, t1] (aware).
+
+        Exact: the active set is a union of closed intervals, so the window meets it iff it
+        contains ``t0`` or the left end of one of those intervals — ``start`` or a daily
+        period's start (or midnight, for periods over midnight and all-day ones) on one of the
+        UTC days the window spans.
+        """
+        if t1 < t0:
+            raise ValueError("window end before its start")
+        if self.permanent or self.active(t0):
+            return True
+        cands = [self.start] if self.start is not None else []
+        u0, u1 = t0.astimezone(dt.UTC), t1.astimezone(dt.UTC)
+        day = u0.date() - dt.timedelta(days=1)
+        while day <= u1.date():
+            starts = {dt.time(0, 0)} | {p.start for p in self.daily if p.start is not None}
+            cands += [dt.datetime.combine(day, t, tzinfo=dt.UTC) for t in starts]
+            day += dt.timedelta(days=1)
+        return any(t0 <= c <= t1 and self.active(c) for c in cands)
+
 
 @dataclass(frozen=True)
 class Zone:
@@ -128,6 +149,10 @@ class Zone:
     def active(self, t: dt.datetime) -> bool:
         """Whether the zone applies at ``t`` (no applicability given = always)."""
         return not self.applicability or any(a.active(t) for a in self.applicability)
+
+    def active_during(self, t0: dt.datetime, t1: dt.datetime) -> bool:
+        """Whether the zone applies at some instant of the window [t0, t1] (aware datetimes)."""
+        return not self.applicability or any(a.active_during(t0, t1) for a in self.applicability)
 
 
 def _opt_str(d: dict[str, Any], key: str, path: str) -> str:

@@ -70,6 +70,12 @@ class Requirements:
         Ground elevation above mean sea level (m), to compare AMSL zone limits.
     observers : int
         Airspace observers along the route (EVLOS).
+    residual_arc : {"a", "b", "c", "d"} or None
+        Residual ARC claimed after strategic air-risk mitigations (SORA step #5); None: the
+        initial ARC (:func:`uasnav.mission.sora.residual_arc_of` checks the claim).
+    flight_duration_s : float or None
+        Flight duration (s) for the zones' schedules (take-off + duration); None: the chosen
+        UAS's mission time estimate (:func:`mission_time_s`).
     """
 
     mission: str = "precision-agriculture"
@@ -97,6 +103,8 @@ class Requirements:
     sora_edition: str = "2.5"
     ground_elevation_m: float | None = None
     observers: int = 0
+    residual_arc: str | None = None
+    flight_duration_s: float | None = None
 
     def __post_init__(self) -> None:
         checks = {

@@ -28,7 +28,15 @@ from uasnav.mission.feasibility import Requirements
 from uasnav.mission.operation import OVER_PEOPLE
 from uasnav.mission.regulations import DEFAULT_CATEGORY
 from uasnav.mission.scoring import PARAMETERS, Targets, Weights
-from uasnav.mission.sora import AIRSPACES, DENSITY_CLASSES, EDITIONS, MITIGATIONS20, MITIGATIONS25, ROBUSTNESS
+from uasnav.mission.sora import (
+    AIRSPACES,
+    ARCS,
+    DENSITY_CLASSES,
+    EDITIONS,
+    MITIGATIONS20,
+    MITIGATIONS25,
+    ROBUSTNESS,
+)
 
 if TYPE_CHECKING:
     import datetime as dt
@@ -217,17 +225,29 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         label="SORA edition",
     ),
     SelectOption(
+        "residual_arc",
+        "choice",
+        None,
+        "Residual ARC claimed after strategic air-risk mitigations (SORA step #5): a | b | c | d; "
+        "default the initial ARC. VLOS may lower it one class (not to ARC-a); other claims are "
+        "Annex C claims to substantiate.",
+        choices=ARCS,
+        label="Residual ARC (strategic mitigation)",
+    ),
+    SelectOption(
         "area",
         "file",
         None,
-        "Mission area: GeoJSON polygon (or take-off point/line, buffered by --area-buffer or the range).",
-        label="Mission area (GeoJSON)",
+        "Mission area: GeoJSON polygon (or take-off point/line, buffered by --area-buffer or the range), "
+        "or a mission plan (.plan, .waypoints, .txt, .csv): its route buffered by --area-buffer.",
+        label="Mission area (GeoJSON or plan)",
     ),
     SelectOption(
         "area_buffer",
         "real",
         None,
-        "Buffer around the area (m); default 0 for polygons, the max distance for a point or line.",
+        "Buffer around the area (m); default 0 for polygons, the max distance for a point or line, "
+        "the flight height for a plan's route (1:1 ground-risk-buffer rule).",
         "m",
         0.0,
         label="Area buffer",
@@ -255,6 +275,18 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         None,
         "Take-off time, ISO 8601 with zone (2026-05-01T10:00Z), for zone schedules.",
         label="Flight time",
+    ),
+    SelectOption(
+        "flight_duration",
+        "real",
+        None,
+        "Flight duration (s) for zone schedules over [take-off, take-off + duration]; default: the "
+        "chosen UAS's mission time estimate.",
+        "s",
+        0.0,
+        True,
+        maximum=86400.0,
+        label="Flight duration",
     ),
     SelectOption("top", "int", 10, "Configurations listed.", minimum=1, maximum=1000, label="Top N"),
     SelectOption("summary", "output", None, "Write the authorisation summary: SUMMARY.html or SUMMARY.json."),
@@ -633,16 +665,22 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
         sora_edition=v["sora_edition"],
         ground_elevation_m=v["ground_elevation"],
         observers=v["observers"],
+        residual_arc=v["residual_arc"],
+        flight_duration_s=v["flight_duration"],
     )
     area = zones = None
     zones_where = "zones"
     if v["area"] is not None:
-        from uasnav.mission.zones import parse_area
+        from uasnav.mission.zones import is_plan_document, parse_area, parse_area_document
 
         content, where = _file_bytes("area", v["area"])
         buffer = v["area_buffer"]
         try:
-            if buffer is None:
+            if is_plan_document(where, content):
+                # A plan's footprint: the route widened by the buffer, by default the flight
+                # height (the 1:1 ground-risk-buffer rule, EASA AMC1 Art. 11 Annex A A.5.2.4).
+                area = parse_area_document(content, where, buffer_m=buffer if buffer else req.altitude_m)
+            elif buffer is None:
                 # A polygon is the area itself; a point (take-off) or a line is widened by the
                 # largest pilot distance, the farthest the UA goes from it.
                 area = parse_area(content, where, buffer_m=0.0)

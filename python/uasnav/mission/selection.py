@@ -15,6 +15,7 @@ from uasnav.mission.feasibility import (
     TestResult,
     camera_tests,
     describe,
+    mission_time_s,
     pair_tests,
     required_hfov_deg,
     uas_tests,
@@ -112,6 +113,69 @@ class Selection:
     zones: ZoneCheck | None = None
     #: EU STS/PDRA checks or FAA waivers/authorisations for the best configuration.
     scenarios: tuple[ScenarioCheck, ...] = ()
+    #: Configurations that would rank but are withheld: the area enters a PROHIBITED zone
+    #: (``ranking`` is then empty — nothing is presented as flyable).
+    withheld: list[RankedPair] = field(default_factory=list)
+    #: The flight window the zone schedules were checked over (start, end, duration_s, from).
+    flight_window: dict | None = None
+
+    @property
+    def authorisation(self) -> dict:
+        """The verdict an operator files against: ``authorisable`` (False when a PROHIBITED zone
+        is entered or nothing is feasible), the ``blocking`` reasons and the ``requirements``
+        (the category's authorisation, STS/PDRA or FAA waivers that apply, zone authorisations
+        and conditions)."""
+        op, req = self.operation, self.requirements
+        blocking = [r.message for r in self.rejections if r.test == "zone-prohibited"]
+        needs: list[str] = []
+        if op is not None and req.jurisdiction == "easa":
+            if op.category == "open":
+                sub = self.chosen.open_subcategory if self.chosen else None
+                where = f"open category {sub}" if sub else "open category"
+                needs.append(f"{where}: no operational authorisation ({op.legal_basis})")
+            elif op.category == "specific":
+                sail = (
+                    f", SORA {self.sora.edition} SAIL {self.sora.sail}"
+                    if self.sora and self.sora.sail
+                    else ""
+                )
+                needs.append(
+                    f"operational authorisation from the competent authority ((EU) 2019/947 Art. 12{sail})"
+                )
+                for x in self.scenarios:
+                    if x.applies:
+                        how = "declaration" if x.id.startswith("STS") else "authorisation"
+                        needs.append(f"or {how} under {x.id} ({x.source})")
+        else:
+            needs += [f"{x.id}: {'; '.join(x.reasons)} ({x.source})" for x in self.scenarios if x.applies]
+        if self.sora is not None and self.sora.certified:
+            blocking.append("outside the SORA: certified category")
+        for h in self.zones.hits if self.zones else ():
+            if h.restriction in ("REQ_AUTHORISATION", "CONDITIONAL"):
+                what = (
+                    "authorisation from the zone authority"
+                    if h.restriction == "REQ_AUTHORISATION"
+                    else "conditions"
+                )
+                needs.append(
+                    f"zone {h.identifier} {h.name} ({h.restriction}): {what}"
+                    + (f" — {h.message}" if h.message else "")
+                    + ("" if h.certain else f" [uncertain: {'; '.join(h.why)}]")
+                )
+        if blocking:
+            verdict = "not authorisable: " + "; ".join(blocking)
+        elif not self.ranking:
+            verdict = "no feasible configuration"
+        elif len(needs) > 1 or (needs and not needs[0].startswith("open category")):
+            verdict = "authorisable with the requirements listed"
+        else:
+            verdict = "no authorisation needed (open category)" if needs else "authorisable"
+        return {
+            "authorisable": not blocking and bool(self.ranking),
+            "verdict": verdict,
+            "blocking": blocking,
+            "requirements": needs,
+        }
 
     @property
     def chosen(self) -> RankedPair | None:
@@ -179,6 +243,9 @@ class Selection:
             "zones": self.zones.to_dict() if self.zones else None,
             "scenarios": [x.__dict__ | {"reasons": list(x.reasons)} for x in self.scenarios],
             "chosen_equipment": self.equipment_on(self.chosen.uas_id) if self.chosen else [],
+            "authorisation": self.authorisation,
+            "withheld_ranking": [c.__dict__ for c in self.withheld],
+            "flight_window": self.flight_window,
         }
 
 
@@ -187,6 +254,24 @@ def equipment_tests(u, req: Requirements, equipment: list[EquipmentNeed]) -> lis
     necessary item that is a design feature of the aircraft (not a module that can be fitted)."""
     need = [(e.onboard, e.name) for e in equipment if e.necessary and e.onboard and not e.retrofit]
     return _equipment_tests(u, req.gnss_autopilot, need)
+
+
+def _flight_duration(u, req: Requirements, ranking: list[RankedPair]) -> tuple[float, str]:
+    """(duration s, how it was obtained) of the flight: ``req.flight_duration_s`` when given,
+    else the mission time (out and back over the range against the wind at the cruise airspeed,
+    :func:`mission_time_s`) of the best-ranked UAS, else the longest finite one in the database."""
+    if req.flight_duration_s is not None:
+        return float(req.flight_duration_s), "--flight-duration"
+    t = mission_time_s(req.range_m, req.cruise_fraction * u.max_speed_ms, req.wind_ms)
+    if ranking:
+        i = u.ids.index(ranking[0].uas_id)
+        return float(
+            t[i]
+        ), f"mission time estimate of {u.label(i)} (range {req.range_m:g} m, wind {req.wind_ms:g} m/s)"
+    finite = t[np.isfinite(t)]
+    if finite.size == 0:
+        return 0.0, "no UAS can fly the range: take-off instant only"
+    return float(finite.max()), "longest mission time estimate in the database (no configuration ranked)"
 
 
 def _vlos_defaults(
@@ -417,6 +502,7 @@ def select(
             airspace=req.airspace,
             urban=op.urban,
             mitigations=dict(req.mitigations),
+            residual_arc=req.residual_arc,
             edition=req.sora_edition,
             density_ppl_km2=op.population_density,
             quantitative=quantitative,
@@ -464,19 +550,53 @@ def select(
     elif req.jurisdiction == "faa":
         scenarios = faa_checks(op, mtom_g=None)
     zone_check = None
+    window = None
+    withheld: list[RankedPair] = []
     if area is not None and zones is not None:
+        import datetime as _dt
+
         from uasnav.mission.zones import check_zones
 
+        until = None
+        if when is not None:
+            duration, how = _flight_duration(u, req, ranking)
+            until = when + _dt.timedelta(seconds=duration)
+            window = {
+                "start": when.isoformat(),
+                "end": until.isoformat(),
+                "duration_s": duration,
+                "from": how,
+            }
         zone_check = check_zones(
             zones,
             area,
             height_m=req.altitude_m,
             ground_elevation_m=req.ground_elevation_m,
             when=when,
+            until=until,
             source=zones_source,
         )
         for h in zone_check.hits:
             notes.append(f"zone {h.identifier} ({h.restriction}): {h.requires}")
+        banned = [h for h in zone_check.hits if h.restriction == "PROHIBITED"]
+        if banned:
+            # Nothing is presented as flyable: the configurations are withheld (kept for an
+            # exemption request to the zone authority) and the mission is rejected by zone.
+            withheld, ranking = ranking, []
+            for h in banned:
+                rejections.append(
+                    Rejection(
+                        "mission",
+                        req.mission,
+                        "zone-prohibited",
+                        float("nan"),
+                        float("nan"),
+                        "",
+                        f"the area enters PROHIBITED zone {h.identifier} {h.name}"
+                        + ("" if h.certain else f" (counted as entered: {'; '.join(h.why)})")
+                        + (f": {h.message}" if h.message else ""),
+                    )
+                )
     return Selection(
         req,
         mission.name,
@@ -497,4 +617,6 @@ def select(
         sora,
         zone_check,
         scenarios,
+        withheld,
+        window,
     )

@@ -20,7 +20,7 @@ from uasnav.errors import InputError
 from uasnav.jsonable import to_jsonable
 from uasnav.mission.selection import Selection
 
-SUMMARY_VERSION = "1"
+SUMMARY_VERSION = "2"  # 2: authorisation verdict, flight window, withheld configurations
 
 
 def summary_dict(sel: Selection) -> dict[str, Any]:
@@ -47,6 +47,9 @@ def summary_dict(sel: Selection) -> dict[str, Any]:
             "optional": [e.name for e in sel.equipment if not e.necessary],
             "on_chosen_uas": sel.equipment_on(chosen.uas_id) if chosen else [],
         },
+        "authorisation": sel.authorisation,
+        "flight_window": sel.flight_window,
+        "withheld": [c.__dict__ for c in sel.withheld],
         "chosen": chosen.__dict__ if chosen else None,
         "alternatives": [c.__dict__ for c in sel.ranking[1:5]],
         "notes": list(sel.notes),
@@ -83,8 +86,16 @@ def summary_html(sel: Selection) -> str:
         f"<title>Authorisation summary — {e(d['mission']['name'])}</title><style>{_CSS}</style></head><body>",
         f"<h1>Authorisation summary — {e(d['mission']['name'])}</h1>",
         "<p class='muted'>Produced by uasnav select; a decision aid, not an authorisation.</p>",
-        "<h2>Operation and category</h2>",
     ]
+    auth = d["authorisation"]
+    parts.append(f"<p class='{'ok' if auth['authorisable'] else 'warn'}'>Verdict: {e(auth['verdict'])}</p>")
+    if auth["requirements"]:
+        parts.append(
+            "<h2>What the operation requires</h2><ul>"
+            + "".join(f"<li>{e(n)}</li>" for n in auth["requirements"])
+            + "</ul>"
+        )
+    parts.append("<h2>Operation and category</h2>")
     if op:
         parts.append(
             f"<p><b>{e(op['visibility'])}</b>, {op['max_distance_m']:g} m from the pilot, "
@@ -146,6 +157,12 @@ def summary_html(sel: Selection) -> str:
         )
     parts.append("<h2>Geographical zones</h2>")
     z = d["zones"]
+    fw = d["flight_window"]
+    if fw is not None:
+        parts.append(
+            f"<p class='muted'>Schedules checked over the flight window {e(fw['start'])} – {e(fw['end'])} "
+            f"({fw['duration_s']:.0f} s: {e(fw['from'])}).</p>"
+        )
     if z is None:
         parts.append("<p class='warn'>No zone file or no area given: zones not checked.</p>")
     elif not z["hits"]:
@@ -191,6 +208,12 @@ def summary_html(sel: Selection) -> str:
                     ]
                 ],
             )
+        )
+    elif d["withheld"]:
+        w0 = d["withheld"][0]
+        parts.append(
+            "<p class='warn'>None: the area enters a PROHIBITED zone. Would rank first only with an "
+            f"exemption from the zone authority: {e(w0['uas'])} + {e(w0['camera'])}.</p>"
         )
     else:
         parts.append("<p class='warn'>No feasible configuration.</p>")

@@ -11,8 +11,13 @@ limit given AGL is compared directly; one given AMSL/WGS84 needs the ground elev
 (``ground_elevation_m``, m AMSL): without it the zone counts as hit and the hit says why.
 A zone whose lower limit equals the top of the flight band is not entered (touching).
 
-Time: a zone with a schedule is hit only when active at ``when`` (an aware datetime, the
-take-off time); without ``when`` a scheduled zone counts as hit and the hit says why.
+Time: a zone with a schedule is hit only when active at some instant of the flight window
+[``when``, ``until``] (aware datetimes: take-off and the end of the flight; ``until`` None: the
+take-off instant only); without ``when`` a scheduled zone counts as hit and the hit says why.
+
+Plans: the area may also be a mission plan (QGroundControl ``.plan``, Mission Planner
+``.waypoints``/``.txt``, uasnav plan ``.csv``, read by :mod:`uasnav.io.plans`); its footprint
+is the flown route buffered by ``buffer_m`` (:func:`area_from_plan`).
 """
 
 from __future__ import annotations
@@ -32,6 +37,11 @@ from shapely.validation import explain_validity
 from uasnav import jsoncheck as jc
 from uasnav.errors import DataFormatError, InputError
 from uasnav.io.ed269 import MAX_BYTES, Volume, Zone, parse_zones
+from uasnav.io.mission_plan import MissionPlan, plan_route
+from uasnav.io.plan_formats.csv_plan import parse_plan_csv
+from uasnav.io.plan_formats.qgc import parse_qgc_plan
+from uasnav.io.plan_formats.source import MAX_PLAN_BYTES
+from uasnav.io.plan_formats.wpl import parse_wpl
 from uasnav.limits import read_file_limited
 
 #: What each ED-269 restriction asks of the operator.
@@ -181,6 +191,73 @@ def parse_area(data: bytes | str | dict, where: str = "area", *, buffer_m: float
     return MissionArea(tuple(parts), float(buffer_m), where)
 
 
+def area_from_plan(plan: MissionPlan, where: str = "plan", *, buffer_m: float) -> MissionArea:
+    """The footprint of a mission plan: its route in flown order (:func:`uasnav.io.plans.plan_route`,
+    north/east m about the plan's origin) back to WGS84, buffered by ``buffer_m`` (m, > 0).
+
+    Raises
+    ------
+    InputError
+        A plan without a geographic origin (a north/east CSV): it cannot be placed on the map.
+    """
+    if not math.isfinite(buffer_m) or buffer_m <= 0:
+        raise InputError(f"plan footprint buffer {buffer_m} m: must be finite and > 0")
+    route, origin = plan_route(plan)
+    if origin is None:
+        raise InputError(f"{where}: a plan in local north/east has no geographic origin; give a GeoJSON area")
+    if len(route) == 0:
+        raise InputError(f"{where}: the plan has no positioned item")
+    lat0, lon0 = origin[0], origin[1]
+    lat, lon, _ = pymap3d.ned2geodetic(route[:, 0], route[:, 1], 0.0, lat0, lon0, 0.0)
+    pts = list(zip(np.atleast_1d(lon).tolist(), np.atleast_1d(lat).tolist(), strict=True))
+    part = ("point", pts[:1]) if len(pts) == 1 else ("line", pts)
+    return MissionArea((part,), float(buffer_m), where)
+
+
+def _plan_parser(where: str, data: bytes | str | dict):
+    """The plan parser for a document (by the name's extension, else by its content), or None
+    for GeoJSON."""
+    ext = os.path.splitext(where)[1].lower()
+    by_ext = {".plan": parse_qgc_plan, ".waypoints": parse_wpl, ".txt": parse_wpl, ".csv": parse_plan_csv}
+    if ext in by_ext:
+        return by_ext[ext]
+    if isinstance(data, dict):
+        return parse_qgc_plan if data.get("fileType") == "Plan" else None
+    head = data[:256] if isinstance(data, str) else data[:256].decode("utf-8", "replace")
+    if head.lstrip("\ufeff").startswith("QGC WPL"):
+        return parse_wpl
+    if '"fileType"' in head and '"Plan"' in head:
+        return parse_qgc_plan
+    return None
+
+
+def is_plan_document(where: str, data: bytes | str | dict) -> bool:
+    """Whether an ``--area`` document is a mission plan (extension or content) rather than GeoJSON."""
+    return _plan_parser(where, data) is not None
+
+
+def parse_area_document(data: bytes | str | dict, where: str = "area", *, buffer_m: float) -> MissionArea:
+    """An ``--area`` document: GeoJSON (:func:`parse_area`) or a mission plan (footprint of its
+    route, :func:`area_from_plan`), told apart by ``where``'s extension or the content."""
+    parser = _plan_parser(where, data)
+    if parser is None:
+        return parse_area(data, where, buffer_m=buffer_m)
+    if isinstance(data, dict):
+        import json
+
+        text = json.dumps(data)
+    elif isinstance(data, bytes):
+        if len(data) > MAX_PLAN_BYTES:
+            raise DataFormatError(f"plan larger than {MAX_PLAN_BYTES} bytes", path=where)
+        try:
+            text = data.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            raise DataFormatError("not a UTF-8 text file", path=where) from None
+    else:
+        text = data
+    return area_from_plan(parser(text, where), where, buffer_m=buffer_m)
+
+
 def read_area(path: str | os.PathLike[str], *, buffer_m: float = 0.0) -> MissionArea:
     """The mission area from a GeoJSON file (read bounded)."""
     p = os.fspath(path)
@@ -240,6 +317,7 @@ def check_zones(
     height_m: float,
     ground_elevation_m: float | None = None,
     when: dt.datetime | None = None,
+    until: dt.datetime | None = None,
     source: str = "zones",
 ) -> ZoneCheck:
     """Every zone the mission area enters (see the module doc for height and time)."""
@@ -247,6 +325,8 @@ def check_zones(
         raise InputError(f"flight height {height_m} m: must be finite and > 0")
     if when is not None and when.tzinfo is None:
         raise InputError("flight time must carry a time zone (UTC)")
+    if until is not None and (when is None or until.tzinfo is None or until < when):
+        raise InputError("flight window: the end needs a take-off time and must not be before it")
     lon0, lat0 = area.centre()
     a = area.local(lon0, lat0)
     hits = []
@@ -273,6 +353,13 @@ def check_zones(
             if when is None:
                 certain = False
                 why.append("the zone has a schedule and no flight time was given: counted as hit")
+            elif until is not None and until > when:
+                if not z.active_during(when, until):
+                    continue
+                why.append(
+                    f"the zone's schedule is active during the flight window {when.isoformat()} – "
+                    f"{until.isoformat()}"
+                )
             elif not z.active(when):
                 continue
             else:
@@ -308,9 +395,12 @@ __all__ = [
     "MissionArea",
     "ZoneCheck",
     "ZoneHit",
+    "area_from_plan",
     "check_zones",
+    "is_plan_document",
     "load_zones",
     "parse_area",
+    "parse_area_document",
     "parse_when",
     "read_area",
 ]
