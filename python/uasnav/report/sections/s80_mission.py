@@ -294,7 +294,11 @@ def _operation_section(w: SectionWriter, res) -> None:
                     if vlos.ranking
                     else "none"
                 )
-                + ". No ADS-B, TAWS or BLOS link is necessary for a rural VLOS flight below 120 m."
+                + ". No ADS-B, TAWS or BLOS link is necessary for a rural VLOS flight below 120 m. "
+                + "Each UA is held to the VLOS distance of its size (EASA AMC1 Art. 11 Annex A "
+                + "A.5.2.5: min(327 CD + 20 m rotorcraft, 490 CD + 30 m fixed wing; 1500 m)): "
+                + f"{sum(r.test == 'vlos-distance' for r in vlos.rejections)} UAS too small to be "
+                + "kept in sight at 300 m are rejected."
             ),
         )
     s = sel.sora
@@ -326,6 +330,12 @@ def _operation_section(w: SectionWriter, res) -> None:
             ["", "applies", "conditions / why not", "source"],
             [[x.id, "yes" if x.applies else "no", "; ".join(x.reasons), x.source] for x in sel.scenarios],
             caption="EU standard scenarios and PDRAs for the best configuration.",
+        )
+        auth = sel.authorisation
+        w.table(
+            ["verdict", "requirements"],
+            [[auth["verdict"], "; ".join(auth["requirements"])]],
+            caption="Authorisation verdict of the BVLOS case (no area or zone file in the report).",
         )
         chosen = sel.equipment_on(best.uas_id)
         w.table(
