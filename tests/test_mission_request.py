@@ -90,10 +90,13 @@ def test_refusals_name_the_option(values, option) -> None:
 
 
 def test_sources_are_not_request_options() -> None:
+    # data sources (opened by the server) and outputs (written by the command line) are never
+    # taken from a request
     assert {o.name for o in SELECT_OPTIONS} - {o.name for o in request_options()} == {
         "db",
         "regulations",
         "matrices",
+        "summary",
     }
 
 
