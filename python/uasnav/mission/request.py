@@ -85,6 +85,8 @@ class SelectOption:
     choices: tuple[str, ...] | None = None
     #: Thesis table the input comes from, for the form's labels.
     label: str = ""
+    #: Where the input sits in the user-input interface (a key of :data:`OPTION_GROUPS`).
+    group: str = ""
 
     @property
     def flag(self) -> str:
@@ -92,19 +94,68 @@ class SelectOption:
         return "--" + self.name.replace("_", "-")
 
 
+#: The groups of the user-input interface (thesis Figure 75: mission, requirements, payload,
+#: weather, then the operation and its regulations, and the scoring), key → heading; the last
+#: two are command-line only (never form fields).
+OPTION_GROUPS: dict[str, str] = {
+    "mission": "Mission",
+    "requirements": "Requirements",
+    "payload": "Payload",
+    "weather": "Weather",
+    "operation": "Operation and regulations",
+    "scoring": "Scoring",
+    "output": "Output",
+    "sources": "Data sources",
+}
+
+
 #: Every input of ``uasnav select``, in the order of the thesis' user-input interface
 #: (Figure 75: mission, requirements, weather, scoring) then the data sources.
 SELECT_OPTIONS: tuple[SelectOption, ...] = (
-    SelectOption("mission", "text", "precision-agriculture", "Mission id (Table 18).", label="Mission"),
-    SelectOption("range", "real", 1500.0, "Mission range (m).", "m", 0.0, True, label="Range"),
     SelectOption(
-        "resolution", "real", 0.05, "Ground resolution (m/px).", "m/px", 0.0, True, label="Resolution"
+        "mission", "text", "precision-agriculture", "Mission id (Table 18).", label="Mission", group="mission"
     ),
-    SelectOption("image_size", "size", "70x70", "Target size LENGTHxWIDTH (m).", "m", label="Image size"),
-    SelectOption("altitude", "real", 50.0, "Flight altitude AGL (m).", "m", 0.0, True, label="Altitude"),
-    SelectOption("imagery", "text", "multispectral", "Camera type, or 'any'.", label="Imagery type"),
-    SelectOption("wind", "real", 5.0, "Wind speed (m/s).", "m/s", 0.0, label="Wind"),
-    SelectOption("rain", "flag", False, "The flight must be possible in rain.", label="Rain"),
+    SelectOption(
+        "range", "real", 1500.0, "Mission range (m).", "m", 0.0, True, label="Range", group="requirements"
+    ),
+    SelectOption(
+        "resolution",
+        "real",
+        0.05,
+        "Ground resolution (m/px).",
+        "m/px",
+        0.0,
+        True,
+        label="Resolution",
+        group="payload",
+    ),
+    SelectOption(
+        "image_size",
+        "size",
+        "70x70",
+        "Target size LENGTHxWIDTH (m).",
+        "m",
+        label="Image size",
+        group="payload",
+    ),
+    SelectOption(
+        "altitude",
+        "real",
+        50.0,
+        "Flight altitude AGL (m).",
+        "m",
+        0.0,
+        True,
+        label="Altitude",
+        group="requirements",
+    ),
+    SelectOption(
+        "imagery", "text", "multispectral", "Camera type, or 'any'.", label="Imagery type", group="payload"
+    ),
+    SelectOption("wind", "real", 5.0, "Wind speed (m/s).", "m/s", 0.0, label="Wind", group="weather"),
+    SelectOption(
+        "rain", "flag", False, "The flight must be possible in rain.", label="Rain", group="weather"
+    ),
     SelectOption(
         "speed",
         "real",
@@ -113,6 +164,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "m/s",
         0.0,
         label="Ground speed",
+        group="requirements",
     ),
     SelectOption(
         "order_by",
@@ -121,6 +173,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "Most important parameter: its weight is 1.25 (eq. 61 with cost first).",
         choices=PARAMETERS,
         label="Order by",
+        group="scoring",
     ),
     SelectOption(
         "weights",
@@ -128,6 +181,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         None,
         "Explicit weights, e.g. range=1,weight=0.75,cost=1.25,resolution=1.",
         label="Weights",
+        group="scoring",
     ),
     SelectOption(
         "targets",
@@ -136,14 +190,18 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "TARGET:LIMIT per parameter, e.g. range=5000:1500,weight=800:1600,cost=4000:7000,"
         "resolution=0.01:0.06.",
         label="Targets and limits",
+        group="scoring",
     ),
-    SelectOption("jurisdiction", "text", "easa", "Regulations: easa | faa.", label="Regulations"),
+    SelectOption(
+        "jurisdiction", "text", "easa", "Regulations: easa | faa.", label="Regulations", group="operation"
+    ),
     SelectOption(
         "category",
         "text",
         None,
         "Category (default: derived from the operation — open or specific for easa, part107 for faa).",
         label="Category",
+        group="operation",
     ),
     SelectOption(
         "gnss_autopilot",
@@ -151,6 +209,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         True,
         "A GNSS-based autopilot is required (thesis Table 22); UAS without one are rejected.",
         label="GNSS autopilot",
+        group="requirements",
     ),
     SelectOption(
         "max_distance",
@@ -161,6 +220,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         0.0,
         True,
         label="Max pilot distance",
+        group="requirements",
     ),
     SelectOption(
         "vlos_distance",
@@ -172,6 +232,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         0.0,
         True,
         label="VLOS distance",
+        group="operation",
     ),
     SelectOption(
         "observers",
@@ -181,6 +242,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         minimum=0,
         maximum=100,
         label="Observers",
+        group="operation",
     ),
     SelectOption(
         "over_people",
@@ -189,6 +251,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "Flight over people: none | uninvolved | assemblies.",
         choices=OVER_PEOPLE,
         label="Over people",
+        group="operation",
     ),
     SelectOption(
         "population_density",
@@ -199,8 +262,9 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         + " (default lightly).",
         "1/km²",
         label="Population density",
+        group="operation",
     ),
-    SelectOption("night", "flag", False, "The flight is at night.", label="Night"),
+    SelectOption("night", "flag", False, "The flight is at night.", label="Night", group="weather"),
     SelectOption(
         "airspace",
         "choice",
@@ -208,6 +272,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "Airspace (SORA ARC): " + " | ".join(AIRSPACES) + ".",
         choices=AIRSPACES,
         label="Airspace",
+        group="operation",
     ),
     SelectOption(
         "mitigations",
@@ -215,6 +280,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         None,
         "SORA ground-risk mitigations claimed, e.g. M1A=low,M2=medium (2.5) or M1=medium,M3=low (2.0).",
         label="SORA mitigations",
+        group="operation",
     ),
     SelectOption(
         "sora_edition",
@@ -223,6 +289,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "JARUS SORA edition: 2.5 | 2.0.",
         choices=EDITIONS,
         label="SORA edition",
+        group="operation",
     ),
     SelectOption(
         "residual_arc",
@@ -233,6 +300,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "Annex C claims to substantiate.",
         choices=ARCS,
         label="Residual ARC (strategic mitigation)",
+        group="operation",
     ),
     SelectOption(
         "area",
@@ -241,6 +309,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "Mission area: GeoJSON polygon (or take-off point/line, buffered by --area-buffer or the range), "
         "or a mission plan (.plan, .waypoints, .txt, .csv): its route buffered by --area-buffer.",
         label="Mission area (GeoJSON or plan)",
+        group="operation",
     ),
     SelectOption(
         "area_buffer",
@@ -251,6 +320,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "m",
         0.0,
         label="Area buffer",
+        group="operation",
     ),
     SelectOption(
         "zones",
@@ -258,6 +328,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         None,
         "ED-269 geographical zones (JSON): path or http(s) URL.",
         label="Zones (ED-269)",
+        group="operation",
     ),
     SelectOption(
         "ground_elevation",
@@ -268,6 +339,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         -500.0,
         maximum=9000.0,
         label="Ground elevation",
+        group="operation",
     ),
     SelectOption(
         "flight_time",
@@ -275,6 +347,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         None,
         "Take-off time, ISO 8601 with zone (2026-05-01T10:00Z), for zone schedules.",
         label="Flight time",
+        group="operation",
     ),
     SelectOption(
         "flight_duration",
@@ -287,12 +360,21 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         True,
         maximum=86400.0,
         label="Flight duration",
+        group="requirements",
     ),
-    SelectOption("top", "int", 10, "Configurations listed.", minimum=1, maximum=1000, label="Top N"),
-    SelectOption("summary", "output", None, "Write the authorisation summary: SUMMARY.html or SUMMARY.json."),
-    SelectOption("db", "source", None, "UAS/camera database: path or http(s) URL."),
-    SelectOption("regulations", "source", None, "Regulations database: path or URL."),
-    SelectOption("matrices", "source", None, "Compliance matrices: path or URL."),
+    SelectOption(
+        "top", "int", 10, "Configurations listed.", minimum=1, maximum=1000, label="Top N", group="scoring"
+    ),
+    SelectOption(
+        "summary",
+        "output",
+        None,
+        "Write the authorisation summary: SUMMARY.html or SUMMARY.json.",
+        group="output",
+    ),
+    SelectOption("db", "source", None, "UAS/camera database: path or http(s) URL.", group="sources"),
+    SelectOption("regulations", "source", None, "Regulations database: path or URL.", group="sources"),
+    SelectOption("matrices", "source", None, "Compliance matrices: path or URL.", group="sources"),
 )
 
 _BY_NAME = {o.name: o for o in SELECT_OPTIONS}

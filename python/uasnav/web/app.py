@@ -36,7 +36,7 @@ from uasnav.mission import request as select_request
 from uasnav.mission.database import Database, load_database
 from uasnav.mission.matrices import NECESSARY, Matrices, load_matrices
 from uasnav.mission.regulations import Regulations, load_regulations
-from uasnav.mission.request import OptionError, parse_select_options, run_select
+from uasnav.mission.request import OPTION_GROUPS, OptionError, parse_select_options, run_select
 from uasnav.mission.scoring import PARAMETERS
 from uasnav.web import forms, prediction, selection_view, tables
 from uasnav.web.security import BodyTooLarge, GuardMiddleware
@@ -50,27 +50,6 @@ MAX_BODY_BYTES = 16 * 2**20
 MAX_JSON_BYTES = 256 * 2**10
 #: Multipart limits: files, fields, bytes per non-file part.
 MAX_FILES, MAX_FIELDS, MAX_PART_BYTES = 4, 64, 64 * 2**10
-#: Groups of the form, in the thesis' order (Figure 75); an option not named here is a
-#: requirement.
-GROUPS = (
-    ("Mission", ("mission",)),
-    ("Requirements", ()),
-    ("Weather", ("wind", "rain", "night", "temperature", "visibility")),
-    ("Area and zones", ("area", "area_buffer", "zones", "when")),
-    (
-        "Regulations",
-        (
-            "jurisdiction",
-            "category",
-            "airspace",
-            "over_people",
-            "population_density",
-            "mitigations",
-            "sora_edition",
-        ),
-    ),
-    ("Scoring", ("order_by", "weights", "targets", "top")),
-)
 GENERIC_500 = "internal server error: the details are in the server log"
 _SECURITY_HEADERS = {
     "content-security-policy": (
@@ -646,11 +625,12 @@ def _choices(docs: Documents) -> dict[str, tuple[tuple[str, str], ...]]:
 
 
 def _grouped(fields: list[forms.FormField]) -> list[tuple[str, list[forms.FormField]]]:
-    named = {n: g for g, names in GROUPS for n in names}
-    out: dict[str, list[forms.FormField]] = {g: [] for g, _ in GROUPS}
+    """The fields under their option's group, in the groups' order (an option with no group
+    would fall under "Requirements": nothing is ever dropped)."""
+    out: dict[str, list[forms.FormField]] = {g: [] for g in OPTION_GROUPS}
     for f in fields:
-        out[named.get(f.name, "Requirements")].append(f)
-    return [(g, fs) for g, fs in out.items() if fs]
+        out[f.option.group if f.option.group in out else "requirements"].append(f)
+    return [(OPTION_GROUPS[g], fs) for g, fs in out.items() if fs]
 
 
 def _auto(x: Any) -> str:

@@ -82,6 +82,8 @@ def form_fields(choices: Mapping[str, tuple[tuple[str, str], ...]]) -> list[Form
             ch, w = choices[opt.name], "select"
         elif opt.choices is not None:
             ch = tuple((c, c) for c in opt.choices)
+            if opt.default is None:  # an empty choice, or the form would submit the first one
+                ch = (("", "— (not set)"), *ch)
         out.append(FormField(opt, w, ch, default_text(opt)))
     return out
 
