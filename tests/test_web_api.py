@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from markupsafe import escape as jinja_escape
 
 from uasnav.cli import main
 from uasnav.cli.select import command as select_command
@@ -423,7 +424,13 @@ def test_page_downloads_are_what_is_shown(client) -> None:
     r = client.post("/select", data={k: str(v) for k, v in THESIS.items()})
     found = re.findall(r'href="data:([^;]+);charset=utf-8;base64,([^"]+)" download="([^"]+)"', r.text)
     uris = {name: base64.b64decode(data).decode() for _, data, name in found}
-    assert set(uris) == {"selection.json", "ranking.csv", "rejections.csv"}
+    assert set(uris) == {
+        "selection.json",
+        "ranking.csv",
+        "rejections.csv",
+        "authorisation-summary.html",
+        "authorisation-summary.json",
+    }
     api = client.post("/api/select", json=THESIS).json()
     assert json.loads(uris["selection.json"]) == api
     assert [row["uas"] for row in csv.DictReader(io.StringIO(uris["ranking.csv"]))] == [
@@ -480,29 +487,158 @@ def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
     assert big.status_code == 422 and "fake_area: file over" in big.text
 
 
-def test_authorisation_summary_is_the_compliance_document(client, monkeypatch) -> None:
-    """Where ``uasnav.mission.summary`` exists (the compliance issue), the page offers that
-    document for download, made from the same selection; without it, no second one."""
+def test_authorisation_summary_is_the_compliance_document(client, tmp_path) -> None:
+    """The results page embeds the authorisation summary rendered by ``uasnav.mission.summary``
+    (its print view, linked to the same stylesheet), and its downloads are that document: the
+    same bytes as ``uasnav select --summary`` writes. One renderer, one document."""
     import base64
-    import sys
-    import types
 
-    import uasnav.web.app as web_app
+    from uasnav.mission.request import run_select
+    from uasnav.mission.summary import SUMMARY_CSS, summary_dict, summary_fragment
 
-    r = client.post("/select", data={"range": "300"})
-    assert "authorisation-summary" in r.text or web_app._summary_module() is None
-    fake = types.ModuleType("uasnav.mission.summary")
-    fake.summary_html = lambda sel: f"<html>{sel.mission_name}: {len(sel.ranking)} configurations</html>"  # type: ignore[attr-defined]
-    fake.summary_dict = lambda sel: {"mission": sel.mission_name}  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "uasnav.mission.summary", fake)
-    monkeypatch.setattr(web_app, "_summary_module", lambda: fake)
     r = client.post("/select", data={"range": "300", "top": "4"})
-    m = re.search(
-        r'href="data:text/html;charset=utf-8;base64,([^"]+)" download="authorisation-summary.html"', r.text
-    )
+    sel = run_select({"range": 300.0, "top": 4})
+    fragment = summary_fragment(sel)
+    assert fragment in r.text  # rendered once, by the summary module
+    assert r.text.count("class='auth-summary'") == 1
+    assert '<link rel="stylesheet" href="/summary.css">' in r.text
+    css = client.get("/summary.css")
     assert (
-        m and base64.b64decode(m.group(1)).decode() == "<html>Precision Agriculture: 4 configurations</html>"
+        css.status_code == 200
+        and css.text == SUMMARY_CSS
+        and css.headers["content-type"].startswith("text/css")
     )
+    found = dict(
+        (name, base64.b64decode(data).decode())
+        for data, name in re.findall(
+            r'href="data:[^;]+;charset=utf-8;base64,([^"]+)" download="(authorisation-summary\.[a-z]+)"',
+            r.text,
+        )
+    )
+    out = tmp_path / "s.html"
+    res = CliRunner().invoke(main, ["select", "--range", "300", "--top", "4", "--summary", str(out)])
+    assert res.exit_code == 0, res.output
+    assert found["authorisation-summary.html"] == out.read_text()
+    assert fragment in out.read_text()
+    assert json.loads(found["authorisation-summary.json"]) == summary_dict(sel)
+
+
+# A field inside the InterUSS sample zone (Geneva), as in test_mission_authorisation.
+INSIDE = {
+    "type": "Polygon",
+    "coordinates": [
+        [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+    ],
+}
+
+
+def _prohibited(shared_data, tmp_path) -> tuple[Path, Path]:
+    doc = json.loads((shared_data / "utm" / "interuss_ed269_geozone_sample.json").read_text())
+    doc["UASZoneList"][0].update(restriction="PROHIBITED", message="military area")
+    z, a = tmp_path / "prohibited.json", tmp_path / "field.geojson"
+    z.write_text(json.dumps(doc))
+    a.write_text(json.dumps(INSIDE))
+    return z, a
+
+
+def test_not_authorisable_is_shown_and_nothing_is_flyable(client, shared_data, tmp_path) -> None:
+    """A PROHIBITED zone: the page leads with the verdict and lists the configurations as
+    withheld (not as a ranking); the API with the same documents equals ``select --json``."""
+    z, a = _prohibited(shared_data, tmp_path)
+    cli = CliRunner().invoke(
+        main, ["select", "--range", "1500", "--zones", str(z), "--area", str(a), "--json"]
+    )
+    want = json.loads(cli.output)
+    assert want["authorisation"]["authorisable"] is False and want["withheld_ranking"]
+    body = {"range": 1500, "zones": json.loads(z.read_text()), "area": json.loads(a.read_text())}
+    got = client.post("/api/select", json=body).json()
+    assert (
+        got["authorisation"] == want["authorisation"] and got["withheld_ranking"] == want["withheld_ranking"]
+    )
+    assert got["ranking"] == [] and got["sora"] == want["sora"]
+    page = client.post(
+        "/select",
+        data={"range": "1500"},
+        files={"zones": ("prohibited.json", z.read_bytes()), "area": ("field.geojson", a.read_bytes())},
+    ).text
+    box = re.search(r'<div class="verdict-box" role="alert" id="not-authorisable">(.*?)</div>', page, re.S)
+    assert box and "Not flyable as planned" in box.group(1)
+    assert str(jinja_escape(want["authorisation"]["verdict"])) in box.group(1)
+    assert 'id="ranking"' not in page
+    table = re.search(r'<table class="data sortable withheld" id="withheld">(.*?)</table>', page, re.S)
+    assert table
+    rows = re.findall(r"<tr><td class=\"num\">\d+</td><td>([^<]*)</td><td>([^<]*)</td>", table.group(1))
+    assert rows == [
+        (str(jinja_escape(w["uas"])), str(jinja_escape(w["camera"]))) for w in want["withheld_ranking"]
+    ]
+    assert table.group(1).count("withheld</span>") == len(rows)
+
+
+def test_issue18_inputs_by_kind(client, tmp_path) -> None:
+    """Density, mitigations, datetime as text; a choice whose default is None has an empty
+    option (selected, so nothing is submitted); a flag defaulting on is sent as ``false`` when
+    unchecked; an uploaded plan keeps its extension so the area reader picks its format."""
+    html = client.get("/").text
+    sel = re.search(r'<select id="f-residual_arc".*?</select>', html, re.S)
+    assert sel and re.search(r'<option value="" selected>', sel.group(0))
+    for name in ("population_density", "mitigations", "flight_time"):
+        assert re.search(rf'<input id="f-{name}" name="{name}" ', html), name
+    assert re.search(
+        r'type="hidden" name="gnss_autopilot" value="false".*?id="f-gnss_autopilot"[^>]*checked', html, re.S
+    )
+    # an unchecked default-on flag: the hidden false is what the browser posts
+    off = client.post("/select", data={"range": "300", "gnss_autopilot": "false"}).text
+    api_off = client.post("/api/select", json={"range": 300, "gnss_autopilot": False}).json()
+    api_on = client.post("/api/select", json={"range": 300}).json()
+    n_off, n_on = len(api_off["rejections"]), len(api_on["rejections"])
+    assert n_off != n_on and f"({n_off}: failed test and margin)" in off
+
+    def ranked(page: str) -> list[tuple[str, str]]:
+        table = re.search(r'id="ranking">(.*?)</table>', page, re.S)
+        assert table
+        return re.findall(r'<tr>\s*<td class="num">\d+</td><td>([^<]*)</td><td>([^<]*)</td>', table.group(1))
+
+    assert ranked(off) == [
+        (str(jinja_escape(x["uas"])), str(jinja_escape(x["camera"]))) for x in api_off["ranking"]
+    ]
+    # typed issue-18 values reach the selector as the API takes them
+    typed = {
+        "range": "1500",
+        "population_density": "sparsely",
+        "mitigations": "M1=low",
+        "flight_time": "2026-06-01T10:00:00+02:00",
+        "residual_arc": "",
+        "sora_edition": "2.0",
+    }
+    page = client.post("/select", data=typed).text
+    api = client.post("/api/select", json={k: v for k, v in typed.items() if v}).json()
+    assert api["sora"]["edition"] == "2.0" and f"SORA {api['sora']['edition']}" in page
+    # equipment: each item with its reason, necessary ones with their state on the chosen UAS
+    for e in api["equipment"]:
+        assert str(jinja_escape(e["reason"])) in page, e["id"]
+    for x in api["chosen_equipment"]:
+        assert re.search(
+            rf'data-id="{x["id"]}">.*?<span class="state [^"]*">{re.escape(x["state"])}</span>', page, re.S
+        ), x
+    # a Mission Planner plan as the area, recognised by its uploaded file name's extension
+    wpl = "QGC WPL 110\n" + "".join(
+        f"{i}\t{int(i == 0)}\t{0 if i == 0 else 3}\t16\t0\t0\t0\t0\t{lat}\t{lon}\t{0 if i == 0 else 50}\t1\n"
+        for i, (lat, lon) in enumerate([(46.2161, 6.1681), (46.2161, 6.1682), (46.2164, 6.1688)])
+    )
+    p = tmp_path / "route.waypoints"
+    p.write_text(wpl)
+    cli = CliRunner().invoke(main, ["select", "--range", "300", "--area", str(p), "--json"])
+    up = client.post(
+        "/select", data={"range": "300"}, files={"area": ("C:\\plans\\route.waypoints", wpl.encode())}
+    )
+    assert up.status_code == 200, up.text
+    want = json.loads(cli.output)
+    assert cli.exit_code == 0, cli.output
+    api = client.post("/api/select", json={"range": 300, "area": wpl}).json()
+    assert api["operation"] == want["operation"] and api["ranking"] == want["ranking"]
+    assert ranked(up.text) == [
+        (str(jinja_escape(x["uas"])), str(jinja_escape(x["camera"]))) for x in want["ranking"]
+    ]
 
 
 def test_4d_plan_check_is_the_predictors_rule(client, tmp_path) -> None:

@@ -57,45 +57,75 @@ def summary_dict(sel: Selection) -> dict[str, Any]:
     return to_jsonable(d)
 
 
-_CSS = """
-body{font:10.5pt/1.35 system-ui,sans-serif;margin:1.5em auto;max-width:60em;color:#111}
-h1{font-size:15pt;margin:0 0 .2em}h2{font-size:11.5pt;margin:1em 0 .3em;border-bottom:1px solid #999}
-table{border-collapse:collapse;width:100%;margin:.2em 0}td,th{border:1px solid #bbb;padding:.15em .4em;
-vertical-align:top;text-align:left}th{background:#eee}.muted{color:#555;font-size:9pt}
-.warn{color:#a00;font-weight:600}.ok{color:#060}
-@media print{@page{size:A4;margin:12mm}body{margin:0;max-width:none;font-size:8.5pt}
-h2{break-after:avoid}table{break-inside:avoid}a{color:inherit;text-decoration:none}}
+#: The summary's stylesheet, scoped to ``.auth-summary`` so the web application links the same
+#: file into its results page (whose print view is this summary) without restyling the page.
+SUMMARY_CSS = """
+.auth-summary{font:10.5pt/1.35 system-ui,sans-serif;color:#111}
+.auth-summary h2{font-size:15pt;margin:0 0 .2em;border:0}
+.auth-summary h3{font-size:11.5pt;margin:1em 0 .3em;border-bottom:1px solid #999}
+.auth-summary table{border-collapse:collapse;width:100%;margin:.2em 0}
+.auth-summary td,.auth-summary th{border:1px solid #bbb;padding:.15em .4em;vertical-align:top;text-align:left}
+.auth-summary th{background:#eee;font-weight:600}
+.auth-summary td.num,.auth-summary th.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+.auth-summary .muted{color:#555;font-size:9pt}
+.auth-summary .warn{color:#a00;font-weight:600}.auth-summary .ok{color:#060}
+.auth-summary .verdict{font-size:12pt;font-weight:700;padding:.35em .6em;margin:.4em 0;border:2px solid;
+border-radius:4px}
+.auth-summary .verdict.warn{background:#fdecec;border-color:#a00}
+.auth-summary .verdict.ok{background:#e8f3ec;border-color:#060}
+.auth-summary ul.osos{display:flex;flex-wrap:wrap;gap:.15em .6em;list-style:none;padding:0;margin:.2em 0;
+font-size:9pt}
+.auth-summary ul.osos b{font-variant-numeric:tabular-nums}
+@media print{@page{size:A4;margin:12mm}.auth-summary{font-size:8.5pt}
+.auth-summary .verdict{font-size:10pt}.auth-summary h3{break-after:avoid}
+.auth-summary table{break-inside:avoid}.auth-summary a{color:inherit;text-decoration:none}
+.auth-summary *{-webkit-print-color-adjust:exact;print-color-adjust:exact}}
 """
+#: The stand-alone document's page layout (the web page has its own).
+_PAGE_CSS = "body{margin:1.5em auto;max-width:60em}@media print{body{margin:0;max-width:none}}"
 
 
-def _table(head: list[str], rows: list[list[Any]]) -> str:
+def _table(head: list[str], rows: list[list[Any]], num: tuple[int, ...] = ()) -> str:
+    """A table; the columns ``num`` are numbers (right-aligned, tabular figures)."""
     e = html.escape
-    out = ["<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr>"]
+
+    def cls(i: int) -> str:
+        return " class='num'" if i in num else ""
+
+    out = ["<table><tr>" + "".join(f"<th{cls(i)}>{e(h)}</th>" for i, h in enumerate(head)) + "</tr>"]
     for r in rows:
-        out.append("<tr>" + "".join(f"<td>{e('' if c is None else str(c))}</td>" for c in r) + "</tr>")
+        out.append(
+            "<tr>"
+            + "".join(f"<td{cls(i)}>{e('' if c is None else str(c))}</td>" for i, c in enumerate(r))
+            + "</tr>"
+        )
     return "".join(out) + "</table>"
 
 
-def summary_html(sel: Selection) -> str:
-    """The summary as one self-contained HTML page (print stylesheet included)."""
+def summary_fragment(sel: Selection) -> str:
+    """The summary's content as one ``<article class="auth-summary">`` element: the one
+    renderer of the summary, used by :func:`summary_html` (``uasnav select --summary``) and by
+    the web application's results page, whose print view is this element."""
     d = summary_dict(sel)
     e = html.escape
     op, cat, sora, chosen = d["operation"], d["category"], d["sora"], d["chosen"]
     parts = [
-        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
-        f"<title>Authorisation summary — {e(d['mission']['name'])}</title><style>{_CSS}</style></head><body>",
-        f"<h1>Authorisation summary — {e(d['mission']['name'])}</h1>",
+        "<article class='auth-summary' id='auth-summary' aria-labelledby='auth-summary-h'>",
+        f"<h2 id='auth-summary-h'>Authorisation summary — {e(d['mission']['name'])}</h2>",
         "<p class='muted'>Produced by uasnav select; a decision aid, not an authorisation.</p>",
     ]
     auth = d["authorisation"]
-    parts.append(f"<p class='{'ok' if auth['authorisable'] else 'warn'}'>Verdict: {e(auth['verdict'])}</p>")
+    parts.append(
+        f"<p class='verdict {'ok' if auth['authorisable'] else 'warn'}' role='status'>"
+        f"Verdict: {e(auth['verdict'])}</p>"
+    )
     if auth["requirements"]:
         parts.append(
-            "<h2>What the operation requires</h2><ul>"
+            "<h3>What the operation requires</h3><ul>"
             + "".join(f"<li>{e(n)}</li>" for n in auth["requirements"])
             + "</ul>"
         )
-    parts.append("<h2>Operation and category</h2>")
+    parts.append("<h3>Operation and category</h3>")
     if op:
         parts.append(
             f"<p><b>{e(op['visibility'])}</b>, {op['max_distance_m']:g} m from the pilot, "
@@ -117,7 +147,7 @@ def summary_html(sel: Selection) -> str:
             )
         )
     if sora:
-        parts.append(f"<h2>SORA {e(sora['edition'])}</h2>")
+        parts.append(f"<h3>SORA {e(sora['edition'])}</h3>")
         parts.append(
             _table(
                 ["iGRC", "final GRC", "initial ARC", "residual ARC", "TMPR", "SAIL"],
@@ -131,21 +161,22 @@ def summary_html(sel: Selection) -> str:
                         sora["sail"] or "certified category",
                     ]
                 ],
+                num=(0, 1),
             )
         )
         parts.append("<p class='muted'>" + e("; ".join(sora["steps"])) + "</p>")
-        if sora["osos"]:
+        required = [o for o in sora["osos"] if o["robustness"] != "optional"]
+        if required:
             parts.append(
-                "<p class='muted'>OSOs: "
-                + e(
-                    ", ".join(
-                        f"{o['id']} {o['robustness']}" for o in sora["osos"] if o["robustness"] != "optional"
-                    )
+                "<p class='muted'>OSOs and their robustness (optional ones left out):</p><ul class='osos'>"
+                + "".join(
+                    f"<li title='{e(o.get('title', ''))}'>{e(o['id'])} <b>{e(o['robustness'])}</b></li>"
+                    for o in required
                 )
-                + "</p>"
+                + "</ul>"
             )
     if d["scenarios"]:
-        parts.append("<h2>Standard scenarios, PDRAs, waivers</h2>")
+        parts.append("<h3>Standard scenarios, PDRAs, waivers</h3>")
         parts.append(
             _table(
                 ["", "applies / needed", "conditions", "source"],
@@ -155,7 +186,7 @@ def summary_html(sel: Selection) -> str:
                 ],
             )
         )
-    parts.append("<h2>Geographical zones</h2>")
+    parts.append("<h3>Geographical zones</h3>")
     z = d["zones"]
     fw = d["flight_window"]
     if fw is not None:
@@ -183,7 +214,7 @@ def summary_html(sel: Selection) -> str:
                 ],
             )
         )
-    parts.append("<h2>Equipment</h2>")
+    parts.append("<h3>Equipment</h3>")
     on = {x["id"]: x["state"] for x in d["equipment"]["on_chosen_uas"]}
     parts.append(
         _table(
@@ -192,11 +223,11 @@ def summary_html(sel: Selection) -> str:
         )
     )
     parts.append("<p class='muted'>Optional: " + e(", ".join(d["equipment"]["optional"])) + "</p>")
-    parts.append("<h2>Chosen configuration</h2>")
+    parts.append("<h3>Chosen configuration</h3>")
     if chosen:
         parts.append(
             _table(
-                ["UAS", "camera", "score (eq. 61, lower is better)", "mass g", "cost $", "SAIL"],
+                ["UAS", "camera", "score (eq. 61, lower is better)", "mass (g)", "cost (USD)", "SAIL"],
                 [
                     [
                         chosen["uas"],
@@ -207,6 +238,7 @@ def summary_html(sel: Selection) -> str:
                         chosen["sail"],
                     ]
                 ],
+                num=(2, 3, 4),
             )
         )
     elif d["withheld"]:
@@ -218,9 +250,21 @@ def summary_html(sel: Selection) -> str:
     else:
         parts.append("<p class='warn'>No feasible configuration.</p>")
     if d["notes"]:
-        parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{e(n)}</li>" for n in d["notes"]) + "</ul>")
-    parts.append("</body></html>")
+        parts.append("<h3>Notes</h3><ul>" + "".join(f"<li>{e(n)}</li>" for n in d["notes"]) + "</ul>")
+    parts.append("</article>")
     return "\n".join(parts)
+
+
+def summary_html(sel: Selection) -> str:
+    """The summary as one self-contained HTML page: :func:`summary_fragment` with its
+    stylesheet (print included) inline."""
+    title = html.escape(f"Authorisation summary — {sel.mission_name}")
+    return (
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+        f"<title>{title}</title><style>{SUMMARY_CSS}{_PAGE_CSS}</style></head><body>\n"
+        + summary_fragment(sel)
+        + "\n</body></html>"
+    )
 
 
 def write_summary(sel: Selection, path: str | os.PathLike[str]) -> str:

@@ -26,6 +26,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import HTMLResponse, JSONResponse, PlainTextResponse, RedirectResponse, Response
 from fastapi.staticfiles import StaticFiles
 from fastapi.templating import Jinja2Templates
+from markupsafe import Markup
 from starlette.concurrency import run_in_threadpool
 from starlette.datastructures import UploadFile
 
@@ -33,6 +34,7 @@ from uasnav import __version__
 from uasnav.errors import DataFormatError, UasnavError
 from uasnav.jsonable import to_jsonable
 from uasnav.mission import request as select_request
+from uasnav.mission import summary
 from uasnav.mission.database import Database, load_database
 from uasnav.mission.matrices import NECESSARY, Matrices, load_matrices
 from uasnav.mission.regulations import Regulations, load_regulations
@@ -120,6 +122,11 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
     templates.env.filters["num"] = _num
     templates.env.filters["auto"] = _auto
     app.mount("/static", StaticFiles(directory=str(HERE / "static")), name="static")
+
+    @app.get("/summary.css", include_in_schema=False)
+    def summary_css() -> Response:
+        # the authorisation summary's own stylesheet, so the printed page is that document
+        return Response(summary.SUMMARY_CSS, media_type="text/css", headers={"cache-control": "no-cache"})
     app.state.docs = docs
 
     choices = _choices(docs)
@@ -188,14 +195,16 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             "ranking": _data_uri("text/csv", selection_view.ranking_csv(sel)),
             "rejections": _data_uri("text/csv", selection_view.rejections_csv(sel)),
         }
-        summary = _summary_module()
-        if summary is not None:
-            downloads["summary_html"] = _data_uri("text/html", summary.summary_html(selection))
-            downloads["summary_json"] = _data_uri(
-                "application/json", json.dumps(to_jsonable(summary.summary_dict(selection)), indent=2)
-            )
+        # the authorisation summary (issue 18) is the page's print view: one document, one renderer
+        downloads["summary_html"] = _data_uri("text/html", summary.summary_html(selection))
+        downloads["summary_json"] = _data_uri(
+            "application/json", json.dumps(summary.summary_dict(selection), ensure_ascii=False, indent=2)
+        )
+        onboard = {x["id"]: x["state"] for x in sel["chosen_equipment"] or []}
         return {
             "sel": sel,
+            "summary": Markup(summary.summary_fragment(selection)),
+            "onboard": onboard,
             "equipment": equipment,
             "plots": selection_view.transfer_plots(sel, req.targets, docs.database),
             "breakdown": selection_view.breakdown(sel),
@@ -589,17 +598,6 @@ def _selection(values: dict[str, Any], docs: Documents, files: dict[str, Any] | 
     except UasnavError as e:
         raise ApiError(422, None, str(e)) from None
     return sel
-
-
-def _summary_module() -> Any:
-    """The compliance issue's authorisation summary (``uasnav.mission.summary``) if this
-    version has it: the page then offers that document rather than a second one."""
-    import importlib
-    import importlib.util
-
-    if importlib.util.find_spec("uasnav.mission.summary") is None:
-        return None
-    return importlib.import_module("uasnav.mission.summary")
 
 
 def _download(resp: Response, filename: str) -> Response:

@@ -135,14 +135,31 @@ def pair_values(text: str | None) -> dict[str, str]:
 
 
 def field_errors(values: Mapping[str, Any]) -> dict[str, str]:
-    """Every field's own error (each option parsed alone), so the form shows them all at once."""
+    """Every field's own error, so the form shows them all at once.
+
+    Some options depend on others (``mitigations`` on ``sora_edition``): a field is checked
+    together with every other field that is valid on its own, and nothing is reported when the
+    whole request parses."""
+    try:
+        parse_select_options(values)
+        return {}
+    except OptionError as e:
+        whole = e
+
+    def error_of(v: Mapping[str, Any]) -> OptionError | None:
+        try:
+            parse_select_options(v)
+        except OptionError as e:
+            return e
+        return None
+
+    valid_alone = {k: v for k, v in values.items() if error_of({k: v}) is None}
     errors = {}
     for name, value in values.items():
-        try:
-            parse_select_options({name: value})
-        except OptionError as e:
+        e = error_of({**{k: v for k, v in valid_alone.items() if k != name}, name: value})
+        if e is not None:
             errors[e.option] = str(e)
-    return errors
+    return errors or {whole.option: str(whole)}
 
 
 def file_value(option: str, filename: str, data: bytes) -> Any:
