@@ -8,13 +8,17 @@ widths are written to ``build/screenshots/``.
 
 from __future__ import annotations
 
+import io
 import json
 import re
 import shutil
 import subprocess
+import unicodedata
+from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
 
+import pypdf
 import pytest
 
 from uasnav.io.plans import plan_route, read_plan, write_plan
@@ -149,7 +153,7 @@ def test_thesis_scenario_matches_the_cli(pages, server) -> None:
         assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
 
 
-def test_ranking_sorts_and_downloads(pages, server) -> None:
+def test_ranking_sorts_and_downloads(pages, server, tmp_path) -> None:
     page = pages.new()
     page.goto(server.url + "/")
     page.click("#select-form button[type=submit]")
@@ -163,12 +167,30 @@ def test_ranking_sorts_and_downloads(pages, server) -> None:
         page.click("a:has-text('JSON')")
     data = json.loads(Path(d.value.path()).read_text())
     assert data["ranking"] and data["mission"] == "precision-agriculture"
-    # print: a one-page summary without the form or the navigation
+    # print: the authorisation summary (the document `select --summary` writes), one page
+    summary = page.locator(".auth-summary").inner_text()
     page.emulate_media(media="print")
     assert not page.locator("#select-form").is_visible() and not page.locator("header.top").is_visible()
-    assert page.locator("#ranking").is_visible()
-    pdf = page.pdf(format="A4", print_background=True)
-    assert len(re.findall(rb"/Type\s*/Page[^s]", pdf)) == 1
+    assert not page.locator("#ranking").is_visible() and page.locator(".auth-summary").is_visible()
+    assert page.locator("main").inner_text().strip() == summary.strip()  # nothing else printed
+    pdf = pypdf.PdfReader(io.BytesIO(page.pdf(format="A4", print_background=True)))
+    assert len(pdf.pages) == 1
+    printed = " ".join(pdf.pages[0].extract_text().split())
+    # the same document as the CLI's, opened on its own
+    out = tmp_path / "summary.html"
+    argv = ["select", "--summary", str(out)]
+    subprocess.run([*uasnav_command(), *argv], capture_output=True, check=True, timeout=120)
+    alone = pages.new()
+    alone.set_content(out.read_text())
+    assert " ".join(alone.locator(".auth-summary").inner_text().split()) == " ".join(summary.split())
+
+    # every character of the summary is on the printed page: nothing clipped or pushed off it
+    # (the PDF's text comes out in two columns and with ligatures, so compare as multisets)
+    def chars(text: str) -> Counter[str]:
+        return Counter(c for c in unicodedata.normalize("NFKC", text) if not c.isspace())
+
+    assert not chars(summary) - chars(printed), chars(summary) - chars(printed)
+    assert "Verdict:" in printed and "SORA 2.5" in printed
 
 
 def test_bad_value_is_shown_beside_its_field(pages, server) -> None:

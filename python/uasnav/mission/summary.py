@@ -76,9 +76,17 @@ border-radius:4px}
 .auth-summary ul.osos{display:flex;flex-wrap:wrap;gap:.15em .6em;list-style:none;padding:0;margin:.2em 0;
 font-size:9pt}
 .auth-summary ul.osos b{font-variant-numeric:tabular-nums}
-@media print{@page{size:A4;margin:12mm}.auth-summary{font-size:8.5pt}
-.auth-summary .verdict{font-size:10pt}.auth-summary h3{break-after:avoid}
-.auth-summary table{break-inside:avoid}.auth-summary a{color:inherit;text-decoration:none}
+@media print{@page{size:A4;margin:10mm}
+.auth-summary{font-size:6.4pt;line-height:1.22;columns:2;column-gap:5mm}
+.auth-summary h2{font-size:11pt;column-span:all}.auth-summary h2+.muted{column-span:all;margin:0}
+.auth-summary .verdict{font-size:8.5pt;column-span:all;padding:.2em .5em}
+.auth-summary h3{font-size:7.5pt;margin:.5em 0 .15em;break-after:avoid}
+.auth-summary p,.auth-summary ul{margin:.15em 0}.auth-summary ul{padding-left:1.2em}
+.auth-summary .muted,.auth-summary ul.osos{font-size:6pt}
+.auth-summary td,.auth-summary th{padding:0 .25em}
+.auth-summary .chosen{column-span:all}
+
+.auth-summary tr{break-inside:avoid}.auth-summary a{color:inherit;text-decoration:none}
 .auth-summary *{-webkit-print-color-adjust:exact;print-color-adjust:exact}}
 """
 #: The stand-alone document's page layout (the web page has its own).
@@ -223,11 +231,11 @@ def summary_fragment(sel: Selection) -> str:
         )
     )
     parts.append("<p class='muted'>Optional: " + e(", ".join(d["equipment"]["optional"])) + "</p>")
-    parts.append("<h3>Chosen configuration</h3>")
+    parts.append("<section class='chosen'><h3>Chosen configuration</h3>")
     if chosen:
         parts.append(
             _table(
-                ["UAS", "camera", "score (eq. 61, lower is better)", "mass (g)", "cost (USD)", "SAIL"],
+                ["UAS", "camera", "score (eq. 61, lower better)", "mass (g)", "cost (USD)", "SAIL"],
                 [
                     [
                         chosen["uas"],
@@ -249,6 +257,7 @@ def summary_fragment(sel: Selection) -> str:
         )
     else:
         parts.append("<p class='warn'>No feasible configuration.</p>")
+    parts.append("</section>")
     if d["notes"]:
         parts.append("<h3>Notes</h3><ul>" + "".join(f"<li>{e(n)}</li>" for n in d["notes"]) + "</ul>")
     parts.append("</article>")
