@@ -306,3 +306,53 @@ def test_database_pages_filter_and_sort(pages, server) -> None:
     page.goto(server.url + "/db/regulations")
     assert page.locator("#table tbody tr").count() > 0
     shot(page, "database-regulations-phone")
+
+
+def test_not_authorisable_in_the_browser(pages, server, shared_data, tmp_path) -> None:
+    """Zones and area uploaded through the form (file names kept): a PROHIBITED zone puts the
+    verdict first and lists the configurations as withheld, as ``select --json`` does; the
+    default-on GNSS-autopilot box, unchecked, is sent as false."""
+    doc = json.loads((shared_data / "utm" / "interuss_ed269_geozone_sample.json").read_text())
+    doc["UASZoneList"][0].update(restriction="PROHIBITED", message="military area")
+    zones, area = tmp_path / "prohibited.json", tmp_path / "field.geojson"
+    zones.write_text(json.dumps(doc))
+    ring = [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [ring]}))
+    argv = [
+        "select",
+        "--json",
+        "--range",
+        "1500",
+        "--zones",
+        str(zones),
+        "--area",
+        str(area),
+        "--no-gnss-autopilot",
+    ]
+    want = json.loads(
+        subprocess.run([*uasnav_command(), *argv], capture_output=True, check=True, timeout=120).stdout
+    )
+    assert want["authorisation"]["authorisable"] is False
+    for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
+        page = pages.new(viewport)
+        page.goto(server.url + "/")
+        page.fill("#f-range", "1500")
+        page.set_input_files("#f-zones", str(zones))
+        page.set_input_files("#f-area", str(area))
+        page.uncheck("#f-gnss_autopilot")
+        page.click("#select-form button[type=submit]")
+        page.wait_for_selector("#results")
+        box = page.locator("#not-authorisable")
+        assert box.is_visible() and want["authorisation"]["verdict"] in box.inner_text()
+        assert page.locator("#ranking").count() == 0
+        rows = page.locator("#withheld tbody tr")
+        got = [
+            (rows.nth(i).locator("td").nth(1).inner_text(), rows.nth(i).locator("td").nth(2).inner_text())
+            for i in range(rows.count())
+        ]
+        assert got == [(w["uas"], w["camera"]) for w in want["withheld_ranking"]]
+        assert page.locator(".auth-summary .verdict.warn").is_visible()
+        n = len(want["rejections"])
+        assert page.locator("#rejections tbody tr").count() == n
+        shot(page, f"select-withheld-{tag}")
+        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
