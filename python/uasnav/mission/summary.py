@@ -104,7 +104,10 @@ def _table(head: list[str], rows: list[list[Any]], num: tuple[int, ...] = ()) ->
     for r in rows:
         out.append(
             "<tr>"
-            + "".join(f"<td{cls(i)}>{e('' if c is None else str(c))}</td>" for i, c in enumerate(r))
+            + "".join(
+                f"<td{cls(i)} data-label='{e(head[i])}'>{e('' if c is None else str(c))}</td>"
+                for i, c in enumerate(r)
+            )
             + "</tr>"
         )
     return "".join(out) + "</table>"
