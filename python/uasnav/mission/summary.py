@@ -66,7 +66,8 @@ SUMMARY_CSS = """
 .auth-summary table{border-collapse:collapse;width:100%;margin:.2em 0}
 .auth-summary td,.auth-summary th{border:1px solid #bbb;padding:.15em .4em;vertical-align:top;text-align:left}
 .auth-summary th{background:#eee;font-weight:600}
-.auth-summary td.num,.auth-summary th.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+.auth-summary td.num,.auth-summary th.num{text-align:right;font-variant-numeric:tabular-nums;
+white-space:nowrap}
 .auth-summary .muted{color:#555;font-size:9pt}
 .auth-summary .warn{color:#a00;font-weight:600}.auth-summary .ok{color:#060}
 .auth-summary .verdict{font-size:12pt;font-weight:700;padding:.35em .6em;margin:.4em 0;border:2px solid;

@@ -127,6 +127,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
     def summary_css() -> Response:
         # the authorisation summary's own stylesheet, so the printed page is that document
         return Response(summary.SUMMARY_CSS, media_type="text/css", headers={"cache-control": "no-cache"})
+
     app.state.docs = docs
 
     choices = _choices(docs)

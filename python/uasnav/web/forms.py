@@ -140,11 +140,6 @@ def field_errors(values: Mapping[str, Any]) -> dict[str, str]:
     Some options depend on others (``mitigations`` on ``sora_edition``): a field is checked
     together with every other field that is valid on its own, and nothing is reported when the
     whole request parses."""
-    try:
-        parse_select_options(values)
-        return {}
-    except OptionError as e:
-        whole = e
 
     def error_of(v: Mapping[str, Any]) -> OptionError | None:
         try:
@@ -153,12 +148,15 @@ def field_errors(values: Mapping[str, Any]) -> dict[str, str]:
             return e
         return None
 
+    whole = error_of(values)
+    if whole is None:
+        return {}
     valid_alone = {k: v for k, v in values.items() if error_of({k: v}) is None}
-    errors = {}
+    errors: dict[str, str] = {}
     for name, value in values.items():
-        e = error_of({**{k: v for k, v in valid_alone.items() if k != name}, name: value})
-        if e is not None:
-            errors[e.option] = str(e)
+        err = error_of({**{k: v for k, v in valid_alone.items() if k != name}, name: value})
+        if err is not None:
+            errors[err.option] = str(err)
     return errors or {whole.option: str(whole)}
 
 
