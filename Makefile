@@ -8,14 +8,19 @@ EXTRAS ?= test
 RUST_SRC := $(shell find crates -name '*.rs' -o -name Cargo.toml) Cargo.toml Cargo.lock
 PY_SRC := pyproject.toml
 
-.PHONY: demo test setup rust-checks py-checks bench bench-python clean
+.PHONY: demo test setup browser rust-checks py-checks bench bench-python clean
 
 demo: setup
 	$(BIN)/uasnav report --out build/report
 
 test: setup rust-checks py-checks
 
-setup: $(VENV)/.built
+setup: $(VENV)/.built browser
+
+# The browser tests of `uasnav serve` drive Debian's chromium through Playwright's executable_path
+# (Playwright's own browser download does not work on these machines); installed when missing.
+browser:
+	@command -v chromium >/dev/null || (apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium)
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)

@@ -12,7 +12,8 @@ Hypothesis. The contract, whatever the input:
 
 With the ``ci`` Hypothesis profile (tests/conftest.py: derandomized, 25 examples) the file runs
 in well under a minute. ``report`` is left out (it runs the thesis experiments: minutes per
-valid example); its options are covered by tests/test_cli_options.py.
+valid example), and so is ``serve`` (a server runs until stopped); their options are covered by
+tests/test_cli_options.py.
 """
 
 from __future__ import annotations
@@ -32,8 +33,10 @@ from hypothesis import strategies as st
 from uasnav.cli import main
 from uasnav.cli._common import OutputPath, Real
 
-# Commands whose valid runs take minutes: not fuzzed here (see the module docstring).
-_SLOW = {("report",)}
+# Commands whose valid runs take minutes: not fuzzed here (see the module docstring). ``serve``
+# runs until it is stopped (a valid example would never return): its options are covered by
+# tests/test_cli_options.py and its behaviour over HTTP by tests/test_web_serve.py.
+_SLOW = {("report",), ("serve",)}
 # Options whose valid values start long computations; they are fuzzed with a fast value.
 _FAST_FLAGS_OFF = {"simulated"}
 

@@ -13,6 +13,7 @@ from uasnav.cli.select import command as select_command
 from uasnav.jsonable import to_jsonable
 from uasnav.mission import Requirements, Weights, select
 from uasnav.mission.request import (
+    OPTION_GROUPS,
     SELECT_OPTIONS,
     OptionError,
     parse_select_options,
@@ -24,6 +25,25 @@ from uasnav.mission.request import (
 def test_cli_options_are_the_table() -> None:
     cli = {o for p in select_command.params for o in p.opts} - {"--json", "--help"}
     assert cli == {o.flag for o in SELECT_OPTIONS}
+
+
+def test_every_option_has_a_group() -> None:
+    """Each option sits in one group of the input interface; request options never in the
+    command-line-only groups, sources and outputs only there; every group is used."""
+    assert all(o.group in OPTION_GROUPS for o in SELECT_OPTIONS), [
+        o.name for o in SELECT_OPTIONS if o.group not in OPTION_GROUPS
+    ]
+    cli_only = {"output", "sources"}
+    assert all(o.group not in cli_only for o in request_options())
+    assert all(o.group in cli_only for o in SELECT_OPTIONS if o.kind in ("output", "source"))
+    assert {o.group for o in SELECT_OPTIONS} == set(OPTION_GROUPS)
+    by = {o.name: o.group for o in SELECT_OPTIONS}
+    assert (by["mission"], by["resolution"], by["wind"], by["weights"]) == (
+        "mission",
+        "payload",
+        "weather",
+        "scoring",
+    )
 
 
 def test_defaults_are_the_thesis_case() -> None:
@@ -90,10 +110,13 @@ def test_refusals_name_the_option(values, option) -> None:
 
 
 def test_sources_are_not_request_options() -> None:
+    # data sources (opened by the server) and outputs (written by the command line) are never
+    # taken from a request
     assert {o.name for o in SELECT_OPTIONS} - {o.name for o in request_options()} == {
         "db",
         "regulations",
         "matrices",
+        "summary",
     }
 
 

@@ -63,7 +63,9 @@ def test_precision_agriculture_case() -> None:
     sel = select(Requirements())  # Table 22
     names = [e.name for e in sel.equipment if e.necessary]
     assert "Standard GNSS receiver" in names and "C2 data link" in names
-    assert sel.regulatory_height_m == 120.0 and sel.vlos_required
+    # 1500 m from the pilot is beyond sight (issue 18): the specific category, not the open one
+    assert sel.regulatory_height_m == 120.0 and not sel.vlos_required
+    assert sel.operation.visibility == "BVLOS" and sel.operation.category == "specific"
     assert "DJI Phantom 4" in sel.feasible_uas and "DJI Phantom 3 Professional" in sel.feasible_uas
     assert "Tetracam ADC Micro" in sel.feasible_cameras
     # ADC Snap: HFOV from its 4.8 mm sensor behind the 8.43 mm lens is 31.8°, short of 32.5°.
@@ -102,7 +104,9 @@ def test_rejections_say_test_and_margin() -> None:
 
 
 def test_payload_and_mass_pair_tests() -> None:
-    sel = select(Requirements(imagery="rgb", resolution_m=0.1), top=400)
+    # kept in sight at 1500 m (the user says so): VLOS, the open category and its 25 kg limit
+    sel = select(Requirements(imagery="rgb", resolution_m=0.1, vlos_distance_m=2000.0), top=400)
+    assert sel.operation.category == "open"
     pairs = {(c.uas_id, c.camera_id) for c in sel.ranking}
     # Sony A7R (665 g) exceeds the Phantom 4's estimated 200 g payload.
     assert ("dji-phantom-4", "sony-a7r-28-mm") not in pairs

@@ -7,9 +7,19 @@ from typing import Any
 
 import click
 
-from uasnav.cli._common import Real, echo_json
-from uasnav.mission.request import SELECT_OPTIONS, OptionError, SelectOption, parse_select_options
+from uasnav.cli._common import OutputPath, Real, check_outputs, echo_json
+from uasnav.mission.request import (
+    SELECT_OPTIONS,
+    OptionError,
+    SelectOption,
+    parse_select_options,
+    read_file_option,
+)
 from uasnav.mission.selection import select
+
+#: Kinds whose bad values are usage errors (exit 2), like the typed options; the other refusals
+#: (a combination the regulations cannot resolve) stay domain errors (exit 1).
+_USAGE_KINDS = ("size", "pairs", "density", "mitigations", "datetime", "file")
 
 
 def _click_type(opt: SelectOption) -> Any:
@@ -23,6 +33,8 @@ def _click_type(opt: SelectOption) -> Any:
         )
     if opt.kind == "choice":
         return click.Choice(opt.choices or ())
+    if opt.kind == "output":
+        return OutputPath()
     return None
 
 
@@ -30,7 +42,9 @@ def _options(f: Callable[..., None]) -> Callable[..., None]:
     """One click option per entry of :data:`SELECT_OPTIONS` (the web form reads the same table)."""
     for opt in reversed(SELECT_OPTIONS):
         if opt.kind == "flag":
-            f = click.option(opt.flag, opt.name, is_flag=True, default=bool(opt.default), help=opt.help)(f)
+            # A flag on by default needs its negative spelling to be switched off.
+            spelling = f"{opt.flag}/--no-{opt.flag[2:]}" if opt.default else opt.flag
+            f = click.option(spelling, opt.name, is_flag=True, default=bool(opt.default), help=opt.help)(f)
             continue
         f = click.option(
             opt.flag,
@@ -58,13 +72,22 @@ def command(as_json: bool, **options: Any) -> None:
     from uasnav.mission import load_database, load_matrices, load_regulations
 
     sources = {o.name: options.pop(o.name) for o in SELECT_OPTIONS if o.kind == "source"}
+    outputs = {o.name: options.pop(o.name) for o in SELECT_OPTIONS if o.kind == "output"}
+    files = [o for o in SELECT_OPTIONS if o.kind == "file" and options.get(o.name) is not None]
+    summary = outputs["summary"]
+    if summary is not None:
+        check_outputs([options[o.name] for o in files] + list(sources.values()), {"--summary": summary})
+        if not str(summary).lower().endswith((".html", ".htm", ".json")):
+            raise click.BadParameter("expected a file ending in .html or .json", param_hint="'--summary'")
     try:
+        for o in files:
+            options[o.name] = read_file_option(o.name, options[o.name])
         request = parse_select_options(options)
     except OptionError as e:
         # A malformed value is a usage error, like the typed options; a combination the
         # regulations cannot resolve (no default category) stays a domain error (exit 1).
         opt = next((o for o in SELECT_OPTIONS if o.name == e.option), None)
-        if opt is None or opt.kind not in ("size", "pairs"):
+        if opt is None or opt.kind not in _USAGE_KINDS:
             raise
         raise click.BadParameter(str(e), param_hint=f"'{opt.flag}'") from None
     sel = select(
@@ -75,15 +98,52 @@ def command(as_json: bool, **options: Any) -> None:
         targets=request.targets,
         weights=request.weights,
         top=request.top,
+        area=request.area,
+        zones=request.zones,
+        zones_source=request.zones_source,
+        when=request.when,
     )
+    if summary is not None:
+        from uasnav.mission.summary import write_summary
+
+        write_summary(sel, summary)
     req, w = request.requirements, request.weights
-    jurisdiction, category = req.jurisdiction, req.category
+    op = sel.operation
+    jurisdiction, category = req.jurisdiction, op.category if op else req.category
     if as_json:
         echo_json(sel.to_dict())
         return
     click.echo(
         f"Mission: {sel.mission_name}  ({jurisdiction}/{category}, max height {sel.regulatory_height_m:g} m)"
     )
+    if op is not None:
+        click.echo(
+            f"Operation: {op.visibility}, {op.max_distance_m:g} m from the pilot (in sight up to "
+            f"{op.vlos_distance_m:g} m), {op.height_m:g} m AGL, {'urban' if op.urban else 'rural'} "
+            f"({op.population}), over people: {op.over_people}, {'night' if op.night else 'day'}, "
+            f"airspace {op.airspace}"
+        )
+        click.echo(f"  category: {op.legal_basis}")
+    if sel.sora is not None:
+        s = sel.sora
+        click.echo(
+            f"SORA {s.edition} (best configuration): iGRC {s.igrc}, final GRC {s.final_grc}, "
+            f"ARC-{s.initial_arc} -> ARC-{s.residual_arc}, TMPR {s.tmpr}, SAIL {s.sail or 'none (certified)'}"
+        )
+    for x in sel.scenarios:
+        click.echo(f"  {x.id}: {'applies' if x.applies else 'no'} ({'; '.join(x.reasons)})")
+    if sel.zones is not None:
+        click.echo(f"Zones ({sel.zones.n_zones} read from {sel.zones.source}): {len(sel.zones.hits)} entered")
+        if sel.flight_window is not None:
+            fw = sel.flight_window
+            click.echo(
+                f"  schedules checked over {fw['start']} - {fw['end']} "
+                f"({fw['duration_s']:.0f} s: {fw['from']})"
+            )
+    auth = sel.authorisation
+    click.echo(f"Verdict: {auth['verdict']}")
+    for n in auth["requirements"]:
+        click.echo(f"  requires: {n}")
     for n in sel.notes:
         click.echo(f"  note: {n}")
     click.echo("\nEquipment (* necessary):")
@@ -91,6 +151,9 @@ def command(as_json: bool, **options: Any) -> None:
         items = [e for e in sel.equipment if e.group == group]
         if items:
             click.echo(f"  {group}: " + "; ".join(("* " if e.necessary else "") + e.name for e in items))
+    for e in sel.equipment:
+        if e.necessary:
+            click.echo(f"    * {e.name}: {e.reason}")
     click.echo(f"\nFeasible UAS ({len(sel.feasible_uas)}): " + ", ".join(sel.feasible_uas))
     click.echo(
         f"Feasible cameras ({len(sel.feasible_cameras)}, HFOV >= {sel.required_hfov_deg:.1f} deg): "
@@ -109,5 +172,12 @@ def command(as_json: bool, **options: Any) -> None:
             f"  {rank_no:>2} {pair.uas:<30} {pair.camera:<26} {pair.score:6.2f} {pair.mass_g:7.0f}"
             f" {pair.cost_usd:7.0f}  {pair.open_subcategory or '-'}"
         )
-    if not sel.ranking:
+    if not sel.ranking and sel.withheld:
+        click.echo("  (none flyable: the area enters a PROHIBITED zone)")
+        click.echo("\nWithheld — would rank only if the zone authority exempted the flight:")
+        for rank_no, pair in enumerate(sel.withheld, 1):
+            click.echo(f"  {rank_no:>2} {pair.uas:<30} {pair.camera:<26} {pair.score:6.2f}")
+    elif not sel.ranking:
         click.echo("  (no feasible configuration)")
+    if summary is not None:
+        click.echo(f"\nAuthorisation summary written to {summary}")

@@ -34,7 +34,7 @@ from uasnav.mission import (
     load_matrices,
     select,
 )
-from uasnav.mission.matrices import Mission
+from uasnav.mission.matrices import NECESSARY, Mission, explain_table20
 from uasnav.mission.scoring import transfer
 
 #: Thesis (Table 24) names → our database ids; None where the thesis' product cannot be
@@ -148,6 +148,12 @@ class MissionResult:
     table24: tuple[Table24Row, ...]
     top5: tuple[RankedPair, ...]
     figure74: Figure74
+    #: Every Table 20 disagreement with its kind and reason (:func:`explain_table20`).
+    table20_explained: tuple[dict, ...] = ()
+    #: The thesis case before issue 18: necessary items from the mission type alone.
+    before_necessary: tuple[str, ...] = ()
+    #: The thesis' requirements flown at 300 m: VLOS, open category.
+    vlos: Selection | None = None
 
 
 def compare_table20(mx: Matrices) -> Table20Comparison:
@@ -218,6 +224,10 @@ def run(
     db = load_database()
     req, t, wts = Requirements(), Targets(), Weights()
     sel = select(req, database=db, matrices=mx, top=500)
+    say("mission selector: VLOS variant (300 m)")
+    vlos = select(Requirements(range_m=300.0), database=db, matrices=mx, top=5)
+    status = mx.derive(req.mission)
+    before = tuple(e.name for e in mx.equipment.values() if status[e.id] == NECESSARY)
     x = np.linspace(0, 2400, 400)
     r = np.linspace(0, 7000, 400)
     fig74 = Figure74(x, transfer(x, *t.weight_g), r, transfer(r, *t.range_m))
@@ -233,6 +243,9 @@ def run(
         score_thesis_pairs(sel),
         tuple(sel.ranking[:5]),
         fig74,
+        tuple(explain_table20(mx)),
+        before,
+        vlos,
     )
 
 

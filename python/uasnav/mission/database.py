@@ -7,7 +7,7 @@ database (10⁴ UAS × 10³ cameras). Units are in the field names (g, min, m, m
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -42,6 +42,11 @@ class UasTable:
     rain: np.ndarray  # bool
     sources: list[str]
     estimated: list[frozenset[str]]
+    #: Equipment tokens per UAS as delivered (database.xml ``<equipment has>``); None where the
+    #: entry has no reviewed equipment record.
+    equipment: list[frozenset[str] | None] = field(default_factory=list)
+    #: The document each equipment record comes from (None where there is no record).
+    equipment_sources: list[str | None] = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -49,6 +54,12 @@ class UasTable:
     def label(self, i: int) -> str:
         """ "Producer Name" of entry ``i``."""
         return f"{self.producers[i]} {self.names[i]}"
+
+    def has(self, token: str) -> np.ndarray:
+        """Boolean mask, shape (n,): UAS whose equipment record lists ``token`` (False where
+        there is no record)."""
+        eq = self.equipment or [None] * len(self)
+        return np.array([e is not None and token in e for e in eq], dtype=bool)
 
 
 @dataclass(frozen=True)
@@ -138,6 +149,10 @@ def load_database(source: str | os.PathLike | None = None, **fetch_kw) -> Databa
         max_range_m=col(us, "max_range_m"),
         eu_class=[e.findtext("eu_class") for e in us],
         rain=np.array([_rain_capable(e.findtext("ip_rating"), e.findtext("rain")) for e in us], dtype=bool),
+        equipment=[
+            frozenset(q.get("has").split()) if (q := e.find("equipment")) is not None else None for e in us
+        ],
+        equipment_sources=[q.get("source") if (q := e.find("equipment")) is not None else None for e in us],
     )
     cams = CameraTable(
         **common(cs),

@@ -39,12 +39,43 @@ class Requirements:
         Whether the flight must be possible in rain (UAS needs IPX3 or a rain rating).
     speed_ms : float or None
         Required ground speed against the wind (m/s); None: no requirement.
-    jurisdiction, category : str
-        Regulations applied (``easa``/``open``, ``easa``/``specific``, ``faa``/``part107``).
+    jurisdiction : str
+        Regulations applied (``easa``, ``faa``).
+    category : str or None
+        Category (``open``/``specific``, ``part107``); None: derived from the operation
+        (:func:`uasnav.mission.operation.derive_operation`).
     cruise_fraction : float
         Cruise airspeed as a fraction of the maximum speed, for the endurance test.
     reserve : float
         Fraction of the endurance kept in reserve.
+    max_distance_m : float or None
+        Largest distance between remote pilot and UA (m); None: ``range_m``.
+    vlos_distance_m : float or None
+        Distance up to which the UA is kept in sight (m); None: the default of
+        :mod:`uasnav.mission.operation`.
+    over_people : {"none", "uninvolved", "assemblies"}
+    population_density : float or None
+        Population density of the operational area (ppl/km²).
+    population_class : str or None
+        A SORA 2.5 population class name instead of a number (``remote``, ``lightly`` …).
+    night : bool
+    airspace : str
+        ``uncontrolled``, ``controlled``, ``tmz``, ``airport-bcd``, ``airport-efg``, ``atypical``.
+    gnss_autopilot : bool
+        A GNSS-based autopilot is required (thesis Table 22 "GNSS autopilot: Yes").
+    mitigations : tuple of (str, str)
+        SORA mitigations claimed, (name, robustness) (2.5: M1A M1B M1C M2; 2.0: M1 M2 M3).
+    sora_edition : {"2.5", "2.0"}
+    ground_elevation_m : float or None
+        Ground elevation above mean sea level (m), to compare AMSL zone limits.
+    observers : int
+        Airspace observers along the route (EVLOS).
+    residual_arc : {"a", "b", "c", "d"} or None
+        Residual ARC claimed after strategic air-risk mitigations (SORA step #5); None: the
+        initial ARC (:func:`uasnav.mission.sora.residual_arc_of` checks the claim).
+    flight_duration_s : float or None
+        Flight duration (s) for the zones' schedules (take-off + duration); None: the chosen
+        UAS's mission time estimate (:func:`mission_time_s`).
     """
 
     mission: str = "precision-agriculture"
@@ -57,9 +88,23 @@ class Requirements:
     rain: bool = False
     speed_ms: float | None = None
     jurisdiction: str = "easa"
-    category: str = "open"
+    category: str | None = None
     cruise_fraction: float = 0.7
     reserve: float = 0.2
+    max_distance_m: float | None = None
+    vlos_distance_m: float | None = None
+    over_people: str = "none"
+    population_density: float | None = None
+    population_class: str | None = None
+    night: bool = False
+    airspace: str = "uncontrolled"
+    gnss_autopilot: bool = True
+    mitigations: tuple[tuple[str, str], ...] = ()
+    sora_edition: str = "2.5"
+    ground_elevation_m: float | None = None
+    observers: int = 0
+    residual_arc: str | None = None
+    flight_duration_s: float | None = None
 
     def __post_init__(self) -> None:
         checks = {
@@ -78,6 +123,20 @@ class Requirements:
             raise InputError(f"requirement speed_ms={self.speed_ms}: must be finite and >= 0")
         if not 0.0 < self.cruise_fraction <= 1.0:
             raise InputError(f"cruise_fraction={self.cruise_fraction}: must be in (0, 1]")
+        for name in ("max_distance_m", "vlos_distance_m"):
+            v = getattr(self, name)
+            if v is not None and (not math.isfinite(v) or v <= 0):
+                raise InputError(f"requirement {name}={v}: must be finite and > 0")
+        if self.population_density is not None and (
+            not math.isfinite(self.population_density) or self.population_density < 0
+        ):
+            raise InputError(
+                f"requirement population_density={self.population_density}: must be finite and >= 0"
+            )
+        if self.ground_elevation_m is not None and not math.isfinite(self.ground_elevation_m):
+            raise InputError(f"requirement ground_elevation_m={self.ground_elevation_m}: must be finite")
+        if not 0 <= self.observers <= 100:
+            raise InputError(f"requirement observers={self.observers}: must be in 0..100")
         if not 0.0 <= self.reserve < 1.0:
             raise InputError(f"reserve={self.reserve}: must be in [0, 1)")
 
@@ -158,6 +217,26 @@ def uas_tests(u: UasTable, req: Requirements, max_mtom_g: float) -> list[TestRes
     return out
 
 
+def equipment_tests(u: UasTable, gnss_autopilot: bool, need: list[tuple[str, str]]) -> list[TestResult]:
+    """Equipment the UAS must carry: ``gnss-autopilot`` when ``gnss_autopilot``, and each
+    (database token, item name) of ``need``. A UAS without an equipment record fails (what the
+    database does not record cannot be claimed). The test's ``unit`` holds the item name."""
+    n = len(u)
+    full = np.full(n, 1.0)
+    items = ([("gnss-autopilot", "GNSS-based autopilot (thesis Table 22)")] if gnss_autopilot else []) + [
+        t for t in need if t[0] != "gnss-autopilot"
+    ]
+    out = []
+    seen = set()
+    for token, name in items:
+        if token in seen:
+            continue
+        seen.add(token)
+        ok = u.has(token)
+        out.append(TestResult("equipment:" + token, ok, ok.astype(float), full, name, "=="))
+    return out
+
+
 def camera_tests(c: CameraTable, req: Requirements, height_m: float) -> list[TestResult]:
     """Camera tests: imagery type, HFOV (eq. 60) and ground resolution at ``height_m``.
 
@@ -194,6 +273,16 @@ def describe(test: TestResult, i, label: str) -> str:
     v, lim = float(test.value[i]), float(test.limit[i])
     if test.name == "imagery":
         return f"{label}: imagery is not {test.unit}"
+    if test.name.startswith("equipment:"):
+        token = test.name.removeprefix("equipment:")
+        return (
+            f"{label}: lacks {test.unit}, necessary for this operation (no '{token}' in its equipment record)"
+        )
+    if test.name == "vlos-distance":
+        return (
+            f"{label}: kept in sight only up to {v:.0f} m (its size, EASA AMC1 Art. 11 Annex A "
+            f"§A.5.2.5), the pilot-UA distance is {lim:g} m"
+        )
     if test.name == "rain":
         return f"{label}: not rated for rain (needs IPX3 or better)"
     if test.name == "endurance":

@@ -319,6 +319,8 @@ def fetch(
     cache_dir: str | os.PathLike | None = None,
     kind: str | None = None,
     offline_fallback: bool = True,
+    check=None,
+    accept: str = "application/xml",
 ) -> Fetched:
     """Download ``url`` with a total deadline, a size limit and a revalidated cache.
 
@@ -328,6 +330,10 @@ def fetch(
     ``offline_fallback`` a network failure falls back to a previously validated cached copy
     (with a warning). A cache directory that cannot be written only warns: the document was
     fetched and validated, so the load succeeds.
+
+    ``check`` (a callable taking the body and the URL, raising on a bad document) replaces the
+    XML parse-and-validate step for documents that are not XML (e.g. ED-269 zone files, JSON);
+    ``accept`` is the ``Accept`` header sent.
     """
     if not is_url(url):
         raise InputError(f"{url!r}: only http:// and https:// URLs are fetched")
@@ -345,7 +351,7 @@ def fetch(
                 cached = blob
     except (OSError, ValueError, AttributeError):  # unreadable, oversize or not a JSON object
         cached, meta = None, {}
-    req = urllib.request.Request(url, headers={"User-Agent": "uasnav-mission", "Accept": "application/xml"})
+    req = urllib.request.Request(url, headers={"User-Agent": "uasnav-mission", "Accept": accept})
     if cached is not None:
         if meta.get("etag"):
             req.add_header("If-None-Match", meta["etag"])
@@ -379,7 +385,10 @@ def fetch(
             warnings.warn(f"{url}: {failure}; using the cached copy", stacklevel=2)
             return Fetched(cached, "cache-offline")
         raise InputError(f"{url}: cannot fetch ({failure})")
-    validate(parse_bytes(data, url, max_bytes=max_bytes), url, kind)
+    if check is not None:
+        check(data, url)
+    else:
+        validate(parse_bytes(data, url, max_bytes=max_bytes), url, kind)
     try:
         cdir.mkdir(parents=True, exist_ok=True)
         atomic_write_bytes(body_path, data)

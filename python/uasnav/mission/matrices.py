@@ -33,6 +33,21 @@ class Equipment:
     always_necessary: bool
     note: str
     table20_name: str | None = None
+    #: Operation rules: (facts, reason) — necessary when the operation has any of the facts.
+    operation_rules: tuple[tuple[frozenset[str], str], ...] = ()
+    #: Database token of the per-UAS equipment that provides this item (None: not recorded).
+    onboard: str | None = None
+    #: Whether the item can be fitted to a UAS that lacks it (a module, not a design feature).
+    retrofit: bool = False
+
+
+@dataclass(frozen=True)
+class EquipmentStatus:
+    """The status of one item for one mission flown as one operation, and why."""
+
+    id: str
+    status: str
+    reason: str
 
 
 @dataclass(frozen=True)
@@ -86,6 +101,41 @@ class Matrices:
                 incompatible = True
         return INCOMPATIBLE if incompatible else OPTIONAL
 
+    def status_for(
+        self,
+        equipment_id: str,
+        features: dict[str, tuple[str, ...]],
+        facts: frozenset[str] = frozenset(),
+    ) -> EquipmentStatus:
+        """Status of one item for a mission's ``features`` (Table 18 levels, possibly narrowed
+        to the operation) and the operation's ``facts``, with the rule that decided it.
+
+        The Table 19 rule of the module docstring, then the operation rules: an operation rule
+        makes an item necessary even where a feature level alone would exclude it (the
+        operation is what is flown; e.g. a BLOS link for a BVLOS flight).
+        """
+        item = self.equipment[equipment_id]
+        if item.always_necessary:
+            return EquipmentStatus(item.id, NECESSARY, "always necessary (" + item.note + ")")
+        for tokens, reason in item.operation_rules:
+            if tokens & facts:
+                return EquipmentStatus(item.id, NECESSARY, "operation " + reason)
+        incompatible = None
+        for feat, levels in features.items():
+            cells = [(feat, lv) for lv in levels]
+            hit = next((c for c in cells if c in item.necessary_when), None)
+            if hit is not None:
+                return EquipmentStatus(
+                    item.id, NECESSARY, f"Table 19: {self.feature_names.get(feat, feat)} {hit[1]} needs it"
+                )
+            if cells and all(c in item.incompatible_when for c in cells) and incompatible is None:
+                incompatible = (
+                    f"Table 19: not used at {self.feature_names.get(feat, feat)} {' '.join(levels)}"
+                )
+        if incompatible is not None:
+            return EquipmentStatus(item.id, INCOMPATIBLE, incompatible)
+        return EquipmentStatus(item.id, OPTIONAL, "no rule of Table 19 or of the operation needs it")
+
     def derive(self, mission_id: str) -> dict[str, str]:
         """Missions × equipment for one mission: equipment id → status (thesis step 4)."""
         return {eid: self.equipment_status(mission_id, eid) for eid in self.equipment}
@@ -112,6 +162,52 @@ class Matrices:
                         }
                     )
         return out
+
+
+def explain_table20(mx: Matrices) -> list[dict]:
+    """Every cell where the derivation and the printed Table 20 disagree, each with the reason.
+
+    Kinds: ``blank-is-not-relevant`` (we derive optional, Table 20 leaves it blank: Table 20 uses
+    blank for "not relevant", Table 19 allows the item); ``mission-objective`` (Table 20 asks
+    for an item that no feature rule of Table 19 / §5.2.2.3 asks for — §5.2.2.4 motivates such
+    items by the mission's objective, which the features cannot express); ``rule-applied`` (a
+    rule of §5.2.2.3, named by its Table 19 cell, makes the item necessary where Table 20 does
+    not; we follow the stated rule); ``incompatible-cell`` (a Table 19 incompatibility with a
+    physical reason excludes an item Table 20 lists).
+    """
+    out = []
+    for d in mx.compare_table20():
+        mission = mx.mission(d["mission"])
+        st = mx.status_for(d["equipment"], dict(mission.features))
+        derived, printed = d["derived"], d["table20"]
+        if derived == OPTIONAL and printed == INCOMPATIBLE:
+            kind = "blank-is-not-relevant"
+            why = "Table 20 leaves blank (not relevant) what Table 19 allows; no feature excludes it"
+        elif printed == NECESSARY:
+            kind = "mission-objective"
+            why = (
+                "Table 20 requires it but no rule of §5.2.2.3 names a feature level of this mission "
+                "(objective-driven, §5.2.2.4)"
+            )
+        elif derived == NECESSARY:
+            kind = "rule-applied"
+            why = f"{st.reason}; Table 20 does not apply this rule"
+            span = [
+                f
+                for f, lv in mission.features.items()
+                if len(lv) > 1 and mx.feature_names.get(f, f) in st.reason
+            ]
+            if span:
+                f = span[0]
+                why += (
+                    f" (the mission spans {f} {' '.join(mission.features[f])}: with the operation known, "
+                    "only the flown level counts — uasnav.mission.operation)"
+                )
+        else:
+            kind = "incompatible-cell"
+            why = f"{st.reason} (Table 19 blank kept for its physical reason: see the item's note)"
+        out.append({**d, "kind": kind, "reason": why})
+    return out
 
 
 def _cells(text: str, features: dict[str, tuple[str, ...]], where: str, line: int | None) -> frozenset:
@@ -166,6 +262,11 @@ def load_matrices(source: str | os.PathLike | None = None, **fetch_kw) -> Matric
             always_necessary=it.get("always") == "necessary",
             note=(it.findtext("note") or "").strip(),
             table20_name=it.get("table20"),
+            operation_rules=tuple(
+                (frozenset(op.get("necessary").split()), op.get("reason")) for op in it.iterfind("operation")
+            ),
+            onboard=it.get("onboard"),
+            retrofit=it.get("retrofit") in ("true", "1"),
         )
     order = list(missions)
     rows = []

@@ -46,13 +46,33 @@ class Limit:
 
 
 @dataclass(frozen=True)
+class Subcategory:
+    """An EASA open subcategory: the classes it admits and the distances to people it keeps.
+
+    ``overfly_uninvolved``: classes (``"legacy"`` for unmarked UA below ``legacy_mtom_lt_g``)
+    allowed over uninvolved persons; ``people_distance_m``: horizontal distance kept from
+    uninvolved persons (m); ``residential_distance_m``: distance kept from residential,
+    commercial, industrial or recreational areas (m) — such a subcategory is closed to urban
+    operations.
+    """
+
+    id: str
+    classes: tuple[str, ...]
+    legacy_mtom_lt_g: float | None
+    source: str
+    overfly_uninvolved: tuple[str, ...] = ()
+    people_distance_m: float | None = None
+    residential_distance_m: float | None = None
+
+
+@dataclass(frozen=True)
 class Category:
     """An operational category (EASA open/specific, FAA Part 107)."""
 
     id: str
     vlos_required: bool
     limits: tuple[Limit, ...]
-    subcategories: dict[str, tuple[tuple[str, ...], float | None, str]]
+    subcategories: dict[str, Subcategory]
     source: str
 
     def limit(self, quantity: str) -> Limit | None:
@@ -144,20 +164,40 @@ class Regulations:
                 ok.append(cid)
         return ok
 
-    def open_subcategory(self, mtom_g: float, eu_class: str | None = None) -> str | None:
+    def open_subcategory(
+        self,
+        mtom_g: float,
+        eu_class: str | None = None,
+        *,
+        over_people: str = "none",
+        urban: bool = False,
+    ) -> str | None:
         """EASA open subcategory (A1/A2/A3) for a UAS; None if the open category is closed to it.
 
         A class-marked UAS flies in the subcategories that list its class; an unmarked one
-        (legacy, Art. 20 of (EU) 2019/947) in A1 below 250 g, else A3 below 25 kg.
+        (legacy, Art. 20 of (EU) 2019/947) in A1 below 250 g, else A3 below 25 kg. The
+        operation narrows the choice: over ``"uninvolved"`` persons only a subcategory that lets
+        this class overfly them (A1 with C0 or an unmarked UA below 250 g); over
+        ``"assemblies"`` none (Art. 4(1)(c)); in an ``urban`` area not A3 (150 m from
+        residential areas, UAS.OPEN.040(2)).
         """
         cat = self.category("easa", "open")
+        if over_people == "assemblies":
+            return None
         if not all(c.ok for c in self.check("easa", "open", mtom_g=mtom_g)):
             return None
-        for sid, (classes, legacy_lt_g, _src) in cat.subcategories.items():
-            if eu_class is not None and eu_class in classes:
-                return sid
-            if eu_class is None and legacy_lt_g is not None and mtom_g < legacy_lt_g:
-                return sid
+        for sid, sub in cat.subcategories.items():
+            legacy = eu_class is None and sub.legacy_mtom_lt_g is not None and mtom_g < sub.legacy_mtom_lt_g
+            if not (legacy or (eu_class is not None and eu_class in sub.classes)):
+                continue
+            if (
+                over_people == "uninvolved"
+                and ("legacy" if legacy else eu_class) not in sub.overfly_uninvolved
+            ):
+                continue
+            if urban and sub.residential_distance_m is not None:
+                continue
+            return sid
         return None
 
 
@@ -177,10 +217,14 @@ def load_regulations(source: str | os.PathLike | None = None, **fetch_kw) -> Reg
         cats = {}
         for c in j.iterfind("category"):
             subs = {
-                s.get("id"): (
+                s.get("id"): Subcategory(
+                    s.get("id"),
                     tuple(s.get("classes").split()),
                     float(s.get("legacy-mtom-lt-g")) if s.get("legacy-mtom-lt-g") else None,
                     s.get("source"),
+                    tuple((s.get("overfly-uninvolved") or "").split()),
+                    float(s.get("people-distance-m")) if s.get("people-distance-m") else None,
+                    float(s.get("residential-distance-m")) if s.get("residential-distance-m") else None,
                 )
                 for s in c.iterfind("subcategory")
             }

@@ -23,16 +23,30 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from uasnav.errors import InputError
+from uasnav.errors import InputError, UasnavError
 from uasnav.mission.feasibility import Requirements
+from uasnav.mission.operation import OVER_PEOPLE
 from uasnav.mission.regulations import DEFAULT_CATEGORY
 from uasnav.mission.scoring import PARAMETERS, Targets, Weights
+from uasnav.mission.sora import (
+    AIRSPACES,
+    ARCS,
+    DENSITY_CLASSES,
+    EDITIONS,
+    MITIGATIONS20,
+    MITIGATIONS25,
+    ROBUSTNESS,
+)
 
 if TYPE_CHECKING:
+    import datetime as dt
+
+    from uasnav.io.ed269 import Zone
     from uasnav.mission.database import Database
     from uasnav.mission.matrices import Matrices
     from uasnav.mission.regulations import Regulations
     from uasnav.mission.selection import Selection
+    from uasnav.mission.zones import MissionArea
 
 
 class OptionError(InputError):
@@ -48,9 +62,16 @@ class SelectOption:
     """One input of the selector.
 
     ``kind``: ``real`` (a finite number within ``minimum``/``maximum``), ``int``, ``text``,
-    ``choice`` (one of ``choices``), ``flag`` (boolean), ``size`` (``LENGTHxWIDTH``), ``pairs``
-    (``NAME=VALUE,…`` or a mapping) or ``source`` (a path or URL the *server* opens: command
-    line only, never taken from a web request). ``unit`` is shown beside the field and in help.
+    ``choice`` (one of ``choices``), ``flag`` (boolean; a ``True`` default is spelt
+    ``--name/--no-name`` on the command line), ``size`` (``LENGTHxWIDTH``), ``pairs``
+    (``NAME=VALUE,…`` or a mapping), ``density`` (a number of people per km² or a population
+    class name), ``mitigations`` (``M1A=low,M2=medium`` or a mapping), ``datetime`` (ISO 8601
+    with a time zone), ``file`` (a document the request carries: the command line reads it from
+    a path — or an http(s) URL for zones — the web form uploads it; the parser takes its bytes,
+    text, an already parsed JSON object or an :class:`Upload`), ``output`` (a file the command
+    line writes: never part of a request, never shown by a web form) or ``source`` (a path or
+    URL the *server* opens: command line only, never taken from a web request). ``unit`` is
+    shown beside the field and in help.
     """
 
     name: str
@@ -64,6 +85,8 @@ class SelectOption:
     choices: tuple[str, ...] | None = None
     #: Thesis table the input comes from, for the form's labels.
     label: str = ""
+    #: Where the input sits in the user-input interface (a key of :data:`OPTION_GROUPS`).
+    group: str = ""
 
     @property
     def flag(self) -> str:
@@ -71,19 +94,68 @@ class SelectOption:
         return "--" + self.name.replace("_", "-")
 
 
+#: The groups of the user-input interface (thesis Figure 75: mission, requirements, payload,
+#: weather, then the operation and its regulations, and the scoring), key → heading; the last
+#: two are command-line only (never form fields).
+OPTION_GROUPS: dict[str, str] = {
+    "mission": "Mission",
+    "requirements": "Requirements",
+    "payload": "Payload",
+    "weather": "Weather",
+    "operation": "Operation and regulations",
+    "scoring": "Scoring",
+    "output": "Output",
+    "sources": "Data sources",
+}
+
+
 #: Every input of ``uasnav select``, in the order of the thesis' user-input interface
 #: (Figure 75: mission, requirements, weather, scoring) then the data sources.
 SELECT_OPTIONS: tuple[SelectOption, ...] = (
-    SelectOption("mission", "text", "precision-agriculture", "Mission id (Table 18).", label="Mission"),
-    SelectOption("range", "real", 1500.0, "Mission range (m).", "m", 0.0, True, label="Range"),
     SelectOption(
-        "resolution", "real", 0.05, "Ground resolution (m/px).", "m/px", 0.0, True, label="Resolution"
+        "mission", "text", "precision-agriculture", "Mission id (Table 18).", label="Mission", group="mission"
     ),
-    SelectOption("image_size", "size", "70x70", "Target size LENGTHxWIDTH (m).", "m", label="Image size"),
-    SelectOption("altitude", "real", 50.0, "Flight altitude AGL (m).", "m", 0.0, True, label="Altitude"),
-    SelectOption("imagery", "text", "multispectral", "Camera type, or 'any'.", label="Imagery type"),
-    SelectOption("wind", "real", 5.0, "Wind speed (m/s).", "m/s", 0.0, label="Wind"),
-    SelectOption("rain", "flag", False, "The flight must be possible in rain.", label="Rain"),
+    SelectOption(
+        "range", "real", 1500.0, "Mission range (m).", "m", 0.0, True, label="Range", group="requirements"
+    ),
+    SelectOption(
+        "resolution",
+        "real",
+        0.05,
+        "Ground resolution (m/px).",
+        "m/px",
+        0.0,
+        True,
+        label="Resolution",
+        group="payload",
+    ),
+    SelectOption(
+        "image_size",
+        "size",
+        "70x70",
+        "Target size LENGTHxWIDTH (m).",
+        "m",
+        label="Image size",
+        group="payload",
+    ),
+    SelectOption(
+        "altitude",
+        "real",
+        50.0,
+        "Flight altitude AGL (m).",
+        "m",
+        0.0,
+        True,
+        label="Altitude",
+        group="requirements",
+    ),
+    SelectOption(
+        "imagery", "text", "multispectral", "Camera type, or 'any'.", label="Imagery type", group="payload"
+    ),
+    SelectOption("wind", "real", 5.0, "Wind speed (m/s).", "m/s", 0.0, label="Wind", group="weather"),
+    SelectOption(
+        "rain", "flag", False, "The flight must be possible in rain.", label="Rain", group="weather"
+    ),
     SelectOption(
         "speed",
         "real",
@@ -92,6 +164,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "m/s",
         0.0,
         label="Ground speed",
+        group="requirements",
     ),
     SelectOption(
         "order_by",
@@ -100,6 +173,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "Most important parameter: its weight is 1.25 (eq. 61 with cost first).",
         choices=PARAMETERS,
         label="Order by",
+        group="scoring",
     ),
     SelectOption(
         "weights",
@@ -107,6 +181,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         None,
         "Explicit weights, e.g. range=1,weight=0.75,cost=1.25,resolution=1.",
         label="Weights",
+        group="scoring",
     ),
     SelectOption(
         "targets",
@@ -115,15 +190,191 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "TARGET:LIMIT per parameter, e.g. range=5000:1500,weight=800:1600,cost=4000:7000,"
         "resolution=0.01:0.06.",
         label="Targets and limits",
+        group="scoring",
     ),
-    SelectOption("jurisdiction", "text", "easa", "Regulations: easa | faa.", label="Regulations"),
     SelectOption(
-        "category", "text", None, "Category (default: open for easa, part107 for faa).", label="Category"
+        "jurisdiction", "text", "easa", "Regulations: easa | faa.", label="Regulations", group="operation"
     ),
-    SelectOption("top", "int", 10, "Configurations listed.", minimum=1, maximum=1000, label="Top N"),
-    SelectOption("db", "source", None, "UAS/camera database: path or http(s) URL."),
-    SelectOption("regulations", "source", None, "Regulations database: path or URL."),
-    SelectOption("matrices", "source", None, "Compliance matrices: path or URL."),
+    SelectOption(
+        "category",
+        "text",
+        None,
+        "Category (default: derived from the operation — open or specific for easa, part107 for faa).",
+        label="Category",
+        group="operation",
+    ),
+    SelectOption(
+        "gnss_autopilot",
+        "flag",
+        True,
+        "A GNSS-based autopilot is required (thesis Table 22); UAS without one are rejected.",
+        label="GNSS autopilot",
+        group="requirements",
+    ),
+    SelectOption(
+        "max_distance",
+        "real",
+        None,
+        "Largest remote pilot–UA distance (m); default: the range.",
+        "m",
+        0.0,
+        True,
+        label="Max pilot distance",
+        group="requirements",
+    ),
+    SelectOption(
+        "vlos_distance",
+        "real",
+        None,
+        "Distance up to which the UA is kept in sight (m); default: from each UA's size (EASA AMC1 "
+        "Art. 11 Annex A A.5.2.5: min(327 CD + 20 m rotorcraft, 490 CD + 30 m fixed wing; 1500 m)).",
+        "m",
+        0.0,
+        True,
+        label="VLOS distance",
+        group="operation",
+    ),
+    SelectOption(
+        "observers",
+        "int",
+        0,
+        "Airspace observers posted along the route (EVLOS, specific category).",
+        minimum=0,
+        maximum=100,
+        label="Observers",
+        group="operation",
+    ),
+    SelectOption(
+        "over_people",
+        "choice",
+        "none",
+        "Flight over people: none | uninvolved | assemblies.",
+        choices=OVER_PEOPLE,
+        label="Over people",
+        group="operation",
+    ),
+    SelectOption(
+        "population_density",
+        "density",
+        None,
+        "Population density of the area (people/km²) or a SORA 2.5 class: "
+        + ", ".join(DENSITY_CLASSES)
+        + " (default lightly).",
+        "1/km²",
+        label="Population density",
+        group="operation",
+    ),
+    SelectOption("night", "flag", False, "The flight is at night.", label="Night", group="weather"),
+    SelectOption(
+        "airspace",
+        "choice",
+        "uncontrolled",
+        "Airspace (SORA ARC): " + " | ".join(AIRSPACES) + ".",
+        choices=AIRSPACES,
+        label="Airspace",
+        group="operation",
+    ),
+    SelectOption(
+        "mitigations",
+        "mitigations",
+        None,
+        "SORA ground-risk mitigations claimed, e.g. M1A=low,M2=medium (2.5) or M1=medium,M3=low (2.0).",
+        label="SORA mitigations",
+        group="operation",
+    ),
+    SelectOption(
+        "sora_edition",
+        "choice",
+        "2.5",
+        "JARUS SORA edition: 2.5 | 2.0.",
+        choices=EDITIONS,
+        label="SORA edition",
+        group="operation",
+    ),
+    SelectOption(
+        "residual_arc",
+        "choice",
+        None,
+        "Residual ARC claimed after strategic air-risk mitigations (SORA step #5): a | b | c | d; "
+        "default the initial ARC. VLOS may lower it one class (not to ARC-a); other claims are "
+        "Annex C claims to substantiate.",
+        choices=ARCS,
+        label="Residual ARC (strategic mitigation)",
+        group="operation",
+    ),
+    SelectOption(
+        "area",
+        "file",
+        None,
+        "Mission area: GeoJSON polygon (or take-off point/line, buffered by --area-buffer or the range), "
+        "or a mission plan (.plan, .waypoints, .txt, .csv): its route buffered by --area-buffer.",
+        label="Mission area (GeoJSON or plan)",
+        group="operation",
+    ),
+    SelectOption(
+        "area_buffer",
+        "real",
+        None,
+        "Buffer around the area (m); default 0 for polygons, the max distance for a point or line, "
+        "the flight height for a plan's route (1:1 ground-risk-buffer rule).",
+        "m",
+        0.0,
+        label="Area buffer",
+        group="operation",
+    ),
+    SelectOption(
+        "zones",
+        "file",
+        None,
+        "ED-269 geographical zones (JSON): path or http(s) URL.",
+        label="Zones (ED-269)",
+        group="operation",
+    ),
+    SelectOption(
+        "ground_elevation",
+        "real",
+        None,
+        "Ground elevation (m AMSL), to compare AMSL zone limits with the flight.",
+        "m",
+        -500.0,
+        maximum=9000.0,
+        label="Ground elevation",
+        group="operation",
+    ),
+    SelectOption(
+        "flight_time",
+        "datetime",
+        None,
+        "Take-off time, ISO 8601 with zone (2026-05-01T10:00Z), for zone schedules.",
+        label="Flight time",
+        group="operation",
+    ),
+    SelectOption(
+        "flight_duration",
+        "real",
+        None,
+        "Flight duration (s) for zone schedules over [take-off, take-off + duration]; default: the "
+        "chosen UAS's mission time estimate.",
+        "s",
+        0.0,
+        True,
+        maximum=86400.0,
+        label="Flight duration",
+        group="requirements",
+    ),
+    SelectOption(
+        "top", "int", 10, "Configurations listed.", minimum=1, maximum=1000, label="Top N", group="scoring"
+    ),
+    SelectOption(
+        "summary",
+        "output",
+        None,
+        "Write the authorisation summary: SUMMARY.html or SUMMARY.json.",
+        group="output",
+    ),
+    SelectOption("db", "source", None, "UAS/camera database: path or http(s) URL.", group="sources"),
+    SelectOption("regulations", "source", None, "Regulations database: path or URL.", group="sources"),
+    SelectOption("matrices", "source", None, "Compliance matrices: path or URL.", group="sources"),
 )
 
 _BY_NAME = {o.name: o for o in SELECT_OPTIONS}
@@ -136,6 +387,14 @@ _TARGET_FIELDS = {
 
 
 @dataclass(frozen=True)
+class Upload:
+    """A ``file`` option's document: its name (for messages) and its bytes."""
+
+    name: str
+    data: bytes
+
+
+@dataclass(frozen=True)
 class SelectRequest:
     """A parsed selector request: what :func:`uasnav.mission.select` takes."""
 
@@ -143,11 +402,116 @@ class SelectRequest:
     weights: Weights
     targets: Targets
     top: int
+    area: MissionArea | None = None
+    zones: tuple[Zone, ...] | None = None
+    zones_source: str = "zones"
+    when: dt.datetime | None = None
 
 
 def request_options() -> tuple[SelectOption, ...]:
-    """The options a request may carry (every option but the data sources)."""
-    return tuple(o for o in SELECT_OPTIONS if o.kind != "source")
+    """The options a request may carry (every option but the data sources and outputs)."""
+    return tuple(o for o in SELECT_OPTIONS if o.kind not in ("source", "output"))
+
+
+def _density(opt: SelectOption, value: Any) -> tuple[float | None, str | None]:
+    """(density, None) for a number, (None, class) for a class name."""
+    if isinstance(value, str) and value.strip() in DENSITY_CLASSES:
+        return None, value.strip()
+    x = (
+        _real(
+            SelectOption(opt.name, "real", None, "", minimum=0.0),
+            value,
+        )
+        if not (isinstance(value, str) and not _is_number(value))
+        else None
+    )
+    if x is None:
+        raise OptionError(
+            opt.name,
+            f"{opt.name}: {value!r} is neither a number >= 0 nor one of {', '.join(DENSITY_CLASSES)}",
+        )
+    return x, None
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def parse_mitigations(value: Any, edition: str) -> tuple[tuple[str, str], ...]:
+    """``"M1A=low,M2=medium"`` or a mapping → ((name, robustness), …), checked against the
+    edition's mitigation table (SORA 2.5 Table 5: M1A M1B M1C M2; 2.0 Table 3: M1 M2 M3)."""
+    if value is None or value == "":
+        return ()
+    table = MITIGATIONS25 if edition == "2.5" else MITIGATIONS20
+    if isinstance(value, Mapping):
+        items = [(str(k), v) for k, v in value.items()]
+    elif isinstance(value, str):
+        items = []
+        for item in value.split(","):
+            if not item.strip():
+                continue
+            k, sep, v = item.partition("=")
+            if not sep:
+                raise OptionError("mitigations", f"mitigations: expected NAME=ROBUSTNESS, got {item!r}")
+            items.append((k.strip(), v.strip()))
+    else:
+        raise OptionError("mitigations", f"mitigations: expected NAME=ROBUSTNESS,… got {value!r}")
+    out = []
+    for k, v in items:
+        if k.upper() not in table:
+            raise OptionError(
+                "mitigations", f"mitigations: {k!r} is not a SORA {edition} mitigation ({', '.join(table)})"
+            )
+        if not isinstance(v, str) or v.strip().lower() not in ROBUSTNESS:
+            raise OptionError(
+                "mitigations", f"mitigations: {k}={v!r}: robustness is one of {', '.join(ROBUSTNESS)}"
+            )
+        rob = v.strip().lower()
+        if table[k.upper()][rob] is None:
+            raise OptionError(
+                "mitigations", f"mitigations: {k} cannot be claimed at {rob} robustness in SORA {edition}"
+            )
+        out.append((k.upper(), rob))
+    got = dict(out)
+    if edition == "2.5" and got.get("M1A") == "medium" and got.get("M1B", "none") != "none":
+        raise OptionError(
+            "mitigations",
+            "mitigations: M1A=medium cannot be combined with M1B (EASA AMC1 Art. 11 Annex B B.2, p. 85)",
+        )
+    return tuple(out)
+
+
+def _file_bytes(name: str, value: Any) -> tuple[Any, str]:
+    """(content, where) of a ``file`` option's value."""
+    if isinstance(value, Upload):
+        return value.data, value.name
+    if isinstance(value, bytes | str | Mapping):
+        return value, name
+    raise OptionError(name, f"{name}: expected the document's content, got {type(value).__name__}")
+
+
+def read_file_option(name: str, source: str) -> Upload:
+    """Read a ``file`` option given on the command line: a path (bounded read), or for
+    ``zones`` also an http(s) URL (the hardened fetcher)."""
+    from uasnav.io.ed269 import MAX_BYTES
+    from uasnav.limits import read_file_limited
+    from uasnav.mission.loading import fetch, is_url
+
+    if is_url(source):
+        if name != "zones":
+            raise OptionError(name, f"{name}: give a file path")
+        from uasnav.io.ed269 import parse_zones
+
+        return Upload(source, fetch(source, check=parse_zones, accept="application/json").data)
+    import os
+
+    if os.path.isdir(source):
+        raise InputError(f"{source}: is a directory, not a file")
+    return Upload(source, read_file_limited(source, MAX_BYTES, source))
 
 
 def _real(opt: SelectOption, value: Any) -> float:
@@ -333,22 +697,32 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
             continue
         if opt.kind == "real":
             v[opt.name] = _real(opt, raw)
+        elif opt.kind == "density":
+            v[opt.name] = _density(opt, raw)
         elif opt.kind == "int":
             v[opt.name] = _int(opt, raw)
         elif opt.kind == "flag":
             v[opt.name] = _flag(opt, raw)
         elif opt.kind in ("text", "choice"):
             v[opt.name] = _text(opt, raw)
-        else:  # size, pairs: parsed below with their own messages
+        else:  # size, pairs, mitigations, datetime, file: parsed below with their own messages
             v[opt.name] = raw
     size = parse_image_size(v["image_size"])
     weights = parse_weights(v["weights"], v["order_by"])
     targets = parse_targets(v["targets"])
     category = v["category"]
-    if category is None:
-        category = DEFAULT_CATEGORY.get(v["jurisdiction"])
-        if category is None:
-            raise OptionError("category", f"jurisdiction {v['jurisdiction']!r}: give the category too")
+    if category is None and v["jurisdiction"] not in DEFAULT_CATEGORY:
+        raise OptionError("category", f"jurisdiction {v['jurisdiction']!r}: give the category too")
+    density, pop_class = v["population_density"] if v["population_density"] is not None else (None, None)
+    mitigations = parse_mitigations(v["mitigations"], v["sora_edition"])
+    when = None
+    if v["flight_time"] is not None:
+        from uasnav.mission.zones import parse_when
+
+        try:
+            when = parse_when(str(v["flight_time"]))
+        except InputError as e:
+            raise OptionError("flight_time", str(e)) from None
     req = Requirements(
         mission=v["mission"],
         range_m=v["range"],
@@ -361,8 +735,55 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
         speed_ms=v["speed"],
         jurisdiction=v["jurisdiction"],
         category=category,
+        max_distance_m=v["max_distance"],
+        vlos_distance_m=v["vlos_distance"],
+        over_people=v["over_people"],
+        population_density=density,
+        population_class=pop_class,
+        night=v["night"],
+        airspace=v["airspace"],
+        gnss_autopilot=v["gnss_autopilot"],
+        mitigations=mitigations,
+        sora_edition=v["sora_edition"],
+        ground_elevation_m=v["ground_elevation"],
+        observers=v["observers"],
+        residual_arc=v["residual_arc"],
+        flight_duration_s=v["flight_duration"],
     )
-    return SelectRequest(req, weights, targets, v["top"])
+    area = zones = None
+    zones_where = "zones"
+    if v["area"] is not None:
+        from uasnav.mission.zones import is_plan_document, parse_area, parse_area_document
+
+        content, where = _file_bytes("area", v["area"])
+        buffer = v["area_buffer"]
+        try:
+            if is_plan_document(where, content):
+                # A plan's footprint: the route widened by the buffer, by default the flight
+                # height (the 1:1 ground-risk-buffer rule, EASA AMC1 Art. 11 Annex A A.5.2.4).
+                area = parse_area_document(content, where, buffer_m=buffer if buffer else req.altitude_m)
+            elif buffer is None:
+                # A polygon is the area itself; a point (take-off) or a line is widened by the
+                # largest pilot distance, the farthest the UA goes from it.
+                area = parse_area(content, where, buffer_m=0.0)
+                if any(kind != "poly" for kind, _ in area.parts):
+                    area = parse_area(content, where, buffer_m=req.max_distance_m or req.range_m)
+            else:
+                area = parse_area(content, where, buffer_m=buffer)
+        except UasnavError as e:
+            raise OptionError("area", f"area: {e}") from None
+    if v["zones"] is not None:
+        from uasnav.io.ed269 import parse_zones, zones_from_json
+
+        content, zones_where = _file_bytes("zones", v["zones"])
+        try:
+            if isinstance(content, Mapping):
+                zones = zones_from_json(dict(content))
+            else:
+                zones = parse_zones(content.encode() if isinstance(content, str) else content, zones_where)
+        except UasnavError as e:
+            raise OptionError("zones", f"zones: {e}") from None
+    return SelectRequest(req, weights, targets, v["top"], area, zones, zones_where, when)
 
 
 def run_select(
@@ -386,4 +807,8 @@ def run_select(
         targets=r.targets,
         weights=r.weights,
         top=r.top,
+        area=r.area,
+        zones=r.zones,
+        zones_source=r.zones_source,
+        when=r.when,
     )

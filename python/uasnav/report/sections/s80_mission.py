@@ -82,6 +82,24 @@ def build(w: SectionWriter) -> None:
         ),
     )
     w.data["table20"] = {"cells": t20.cells, "agree": t20.agree, "agree_necessary": t20.agree_necessary}
+    kinds20: dict[str, int] = {}
+    for d in res.table20_explained:
+        kinds20[d["kind"]] = kinds20.get(d["kind"], 0) + 1
+    w.table(
+        ["equipment", "mission", "ours", "Table 20", "kind", "reason"],
+        [
+            [d["label"], mx.missions[d["mission"]].name, d["derived"], d["table20"], d["kind"], d["reason"]]
+            for d in res.table20_explained
+        ],
+        caption=(
+            f"Every one of the {len(res.table20_explained)} differing cells with its reason ("
+            + ", ".join(f"{k}: {n}" for k, n in sorted(kinds20.items()))
+            + "). 'rule-applied' cells mostly come from a mission whose Table 18 range spans "
+            "<1 km to >5 km: the mission-only derivation takes the hardest level; with the "
+            "operation known (below), only the flown level counts."
+        ),
+    )
+    w.data["table20"]["explained"] = kinds20
 
     w.heading("Table 21 — database")
     u, c = db.uas, db.cameras
@@ -212,6 +230,8 @@ def build(w: SectionWriter) -> None:
         "n_feasible_cameras": len(sel.feasible_cameras),
     }
 
+    _operation_section(w, res)
+
     f74 = res.figure74
     fig, ax = new_figure()
     ax.plot(f74.weight_g, f74.weight_score, label="weight: target 800 g, limit 1600 g")
@@ -229,3 +249,103 @@ def build(w: SectionWriter) -> None:
 
 
 SECTION = Section("mission", "Mission selector: matrices, database, feasibility, scoring (§5.2)", 80, build)
+
+
+def _operation_section(w: SectionWriter, res) -> None:
+    """Issue 18: the operation, its category and equipment; the VLOS variant; the BVLOS SORA."""
+    sel, vlos = res.selection, res.vlos
+    op = sel.operation
+    w.heading("Operation, category and equipment — the thesis case before and after")
+    after = [e.name for e in sel.equipment if e.necessary]
+    w.table(
+        ["", "before (mission type only)", "after (operation derived from the requirements)"],
+        [
+            [
+                "operation",
+                "not derived (VLOS note at 1500 m)",
+                f"{op.visibility}: {op.max_distance_m:g} m > {op.vlos_distance_m:g} m in sight",
+            ],
+            ["category", "easa/open", f"easa/{op.category} — {op.legal_basis}"],
+            ["necessary equipment", ", ".join(res.before_necessary), ", ".join(after)],
+        ],
+        caption=(
+            "The thesis' precision-agriculture case (Table 22, range 1500 m). Before, the equipment "
+            "followed the mission type, whose Table 18 range spans <1 km to >5 km, so ADS-B, TAWS, "
+            "the airspeed sensor and contingency management were necessary and the BLOS link "
+            "optional. After, the flown range level and the operation decide."
+        ),
+    )
+    w.table(
+        ["fact", "value", "from", "rule"],
+        [[f.name, f.value, f.requirement, f.rule] for f in op.derivation],
+        caption="How each fact of the 1500 m operation was derived.",
+    )
+    if vlos is not None and vlos.operation is not None:
+        vo = vlos.operation
+        w.heading("VLOS variant: the same requirements at 300 m")
+        w.table(
+            ["necessary item", "why"],
+            [[e.name, e.reason] for e in vlos.equipment if e.necessary],
+            caption=(
+                f"{vo.visibility}, {vo.category} category ({vo.legal_basis}); best configuration "
+                + (
+                    f"{vlos.ranking[0].uas} + {vlos.ranking[0].camera}, open subcategory "
+                    f"{vlos.ranking[0].open_subcategory}"
+                    if vlos.ranking
+                    else "none"
+                )
+                + ". No ADS-B, TAWS or BLOS link is necessary for a rural VLOS flight below 120 m. "
+                + "Each UA is held to the VLOS distance of its size (EASA AMC1 Art. 11 Annex A "
+                + "A.5.2.5: min(327 CD + 20 m rotorcraft, 490 CD + 30 m fixed wing; 1500 m)): "
+                + f"{sum(r.test == 'vlos-distance' for r in vlos.rejections)} UAS too small to be "
+                + "kept in sight at 300 m are rejected."
+            ),
+        )
+    s = sel.sora
+    if s is not None:
+        w.heading(f"BVLOS at 1500 m: SORA {s.edition}")
+        best = sel.ranking[0]
+        w.table(
+            ["configuration", "iGRC", "final GRC", "initial ARC", "residual ARC", "TMPR", "SAIL"],
+            [
+                [
+                    f"{best.uas} + {best.camera}",
+                    s.igrc,
+                    s.final_grc,
+                    s.initial_arc,
+                    s.residual_arc,
+                    s.tmpr,
+                    s.sail,
+                ]
+            ],
+            caption="; ".join(s.steps)
+            + ". Population: lightly populated (default for an agricultural area); no mitigation claimed.",
+        )
+        w.table(
+            ["OSO", "objective", f"robustness at SAIL {s.sail}"],
+            [[o.id, o.title, o.robustness] for o in s.osos],
+            caption=f"Operational safety objectives (SORA {s.edition}).",
+        )
+        w.table(
+            ["", "applies", "conditions / why not", "source"],
+            [[x.id, "yes" if x.applies else "no", "; ".join(x.reasons), x.source] for x in sel.scenarios],
+            caption="EU standard scenarios and PDRAs for the best configuration.",
+        )
+        auth = sel.authorisation
+        w.table(
+            ["verdict", "requirements"],
+            [[auth["verdict"], "; ".join(auth["requirements"])]],
+            caption="Authorisation verdict of the BVLOS case (no area or zone file in the report).",
+        )
+        chosen = sel.equipment_on(best.uas_id)
+        w.table(
+            ["necessary item", f"on the {best.uas}", "why necessary"],
+            [[x["name"], x["state"], x["reason"]] for x in chosen],
+            caption="Necessary equipment against the chosen UAS's equipment record (database.xml).",
+        )
+        w.data["operation"] = {
+            "thesis": {"visibility": op.visibility, "category": op.category, "sora": s.to_dict()},
+            "vlos": {"visibility": vlos.operation.visibility, "category": vlos.operation.category}
+            if vlos is not None and vlos.operation is not None
+            else None,
+        }

@@ -1,0 +1,188 @@
+"""The mission-selection form, generated from the selector's one option table.
+
+Every entry of :data:`uasnav.mission.request.SELECT_OPTIONS` that a request may carry becomes
+one form field, named as the API key, with its label, unit, default and help; the command line
+builds its options from the same table, so the form, ``POST /api/select`` and ``uasnav select``
+cannot drift apart. Kinds are handled generically: a kind this module does not know is a text
+field (its value goes to :func:`~uasnav.mission.request.parse_select_options` as typed), a file
+kind is an upload field (the document goes to the parser as bytes, never as a path), and data
+sources and output paths are never fields.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from uasnav.mission import request as select_request
+from uasnav.mission.request import OptionError, SelectOption, parse_select_options, request_options
+from uasnav.mission.scoring import PARAMETERS
+
+#: Kinds naming a file the request uploads (the server stores it in a temporary directory).
+FILE_KINDS = frozenset({"file", "input_file", "infile", "upload", "path", "input"})
+#: Kinds that are never form fields: server-side sources and output files.
+NOT_FIELDS = frozenset({"source", "output", "output_file", "outfile", "output_path", "out"})
+#: Largest uploaded option file (bytes).
+MAX_OPTION_FILE_BYTES = 4 * 2**20
+
+
+def is_field(opt: SelectOption) -> bool:
+    """Whether ``opt`` is a form field (and an API key)."""
+    return opt.kind not in NOT_FIELDS and not opt.kind.startswith("output")
+
+
+def widget(opt: SelectOption) -> str:
+    """The field's widget: number, text, select, checkbox, file or pairs."""
+    if opt.kind in FILE_KINDS or opt.kind.endswith("file"):
+        return "file"
+    return {
+        "real": "number",
+        "int": "number",
+        "flag": "checkbox",
+        "choice": "select",
+        "pairs": "pairs",
+    }.get(opt.kind, "text")
+
+
+@dataclass(frozen=True)
+class FormField:
+    """One rendered field: the option plus the choices the loaded documents offer."""
+
+    option: SelectOption
+    widget: str
+    choices: tuple[tuple[str, str], ...] | None
+    default_text: str
+
+    @property
+    def name(self) -> str:
+        return self.option.name
+
+
+def default_text(opt: SelectOption) -> str:
+    """The option's default as typed in a form ("" for none)."""
+    d = opt.default
+    if d is None or isinstance(d, bool):
+        return ""
+    if isinstance(d, float):
+        return f"{d:g}"
+    return str(d)
+
+
+def form_fields(choices: Mapping[str, tuple[tuple[str, str], ...]]) -> list[FormField]:
+    """The form's fields in the table's order; ``choices`` maps an option name to the
+    (value, label) pairs the loaded documents offer (missions, imagery types, jurisdictions)."""
+    out = []
+    for opt in request_options():
+        if not is_field(opt):
+            continue
+        w = widget(opt)
+        ch = None
+        if opt.name in choices:
+            ch, w = choices[opt.name], "select"
+        elif opt.choices is not None:
+            ch = tuple((c, c) for c in opt.choices)
+            if opt.default is None:  # an empty choice, or the form would submit the first one
+                ch = (("", "— (not set)"), *ch)
+        out.append(FormField(opt, w, ch, default_text(opt)))
+    return out
+
+
+def field_names() -> set[str]:
+    """The option names the form (and the API) take."""
+    return {o.name for o in request_options() if is_field(o)}
+
+
+def values_from_form(form: Mapping[str, Any], getlist: Any) -> dict[str, Any]:
+    """Form data → option values as text (blank fields are left out: they take defaults).
+
+    ``pairs`` options come as one sub-field per scored parameter (``weights.cost``), joined
+    into ``cost=1.25,…``; a checkbox is preceded by a hidden ``false`` so the last value wins.
+    """
+    values: dict[str, Any] = {}
+    for opt in request_options():
+        if not is_field(opt) or widget(opt) == "file":
+            continue
+        w = widget(opt)
+        if w == "pairs":
+            parts = []
+            for p in PARAMETERS:
+                v = form.get(f"{opt.name}.{p}")
+                if isinstance(v, str) and v.strip():
+                    parts.append(f"{p}={v.strip()}")
+            if parts:
+                values[opt.name] = ",".join(parts)
+            elif isinstance(form.get(opt.name), str) and form[opt.name].strip():
+                values[opt.name] = form[opt.name]
+            continue
+        got = [v for v in getlist(opt.name) if isinstance(v, str)]
+        if not got:
+            continue
+        v = got[-1]
+        if w == "checkbox" or v.strip():
+            values[opt.name] = v
+    return values
+
+
+def pair_values(text: str | None) -> dict[str, str]:
+    """``"range=1,cost=2"`` → {"range": "1", "cost": "2"} for re-filling the sub-fields."""
+    out: dict[str, str] = {}
+    for item in (text or "").split(","):
+        k, sep, v = item.partition("=")
+        if sep and k.strip() in PARAMETERS:
+            out[k.strip()] = v.strip()
+    return out
+
+
+def field_errors(values: Mapping[str, Any]) -> dict[str, str]:
+    """Every field's own error, so the form shows them all at once.
+
+    Some options depend on others (``mitigations`` on ``sora_edition``): a field is checked
+    together with every other field that is valid on its own, and nothing is reported when the
+    whole request parses."""
+
+    def error_of(v: Mapping[str, Any]) -> OptionError | None:
+        try:
+            parse_select_options(v)
+        except OptionError as e:
+            return e
+        return None
+
+    whole = error_of(values)
+    if whole is None:
+        return {}
+    valid_alone = {k: v for k, v in values.items() if error_of({k: v}) is None}
+    errors: dict[str, str] = {}
+    for name, value in values.items():
+        err = error_of({**{k: v for k, v in valid_alone.items() if k != name}, name: value})
+        if err is not None:
+            errors[err.option] = str(err)
+    return errors or {whole.option: str(whole)}
+
+
+def file_value(option: str, filename: str, data: bytes) -> Any:
+    """A file option's uploaded document as the parser takes it: an ``Upload(name, data)``
+    where :mod:`uasnav.mission.request` defines one, else the bytes. Never written to disk,
+    never a path."""
+    if len(data) > MAX_OPTION_FILE_BYTES:
+        raise OptionError(option, f"{option}: file over {MAX_OPTION_FILE_BYTES} bytes")
+    upload = getattr(select_request, "Upload", None)
+    # the client's file name is only a label for messages: its last part, printable
+    base = filename.replace("\\", "/").rsplit("/", 1)[-1]
+    label = "".join(ch for ch in base if ch.isprintable())[:100]
+    return upload(label or option, data) if upload is not None else data
+
+
+__all__ = [
+    "FILE_KINDS",
+    "NOT_FIELDS",
+    "FormField",
+    "field_errors",
+    "field_names",
+    "file_value",
+    "form_fields",
+    "is_field",
+    "pair_values",
+    "values_from_form",
+    "widget",
+]

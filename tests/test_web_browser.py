@@ -1,0 +1,358 @@
+"""``uasnav serve`` in a real headless Chromium (Debian's ``chromium`` driven by Playwright through
+``executable_path``; ``make setup`` installs it). One server and one browser for the module.
+
+Every request a page makes that is not to the app is blocked and recorded, and each test ends
+by asserting there was none: the application works offline. Screenshots at desktop and phone
+widths are written to ``build/screenshots/``.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import re
+import shutil
+import subprocess
+import unicodedata
+from collections import Counter
+from collections.abc import Iterator
+from pathlib import Path
+
+import pypdf
+import pytest
+
+from uasnav.io.plans import plan_route, read_plan, write_plan
+from uasnav.trajectory.features import wind_vector
+from uasnav.web.default_model import default_model
+from uasnav.web.process import Server, running_server, uasnav_command
+
+ROOT = Path(__file__).resolve().parents[1]
+SHOTS = ROOT / "build" / "screenshots"
+DESKTOP = {"width": 1366, "height": 900}
+PHONE = {"width": 390, "height": 844}
+#: The thesis' precision-agriculture scenario (Table 22, §5.2.3.6) as typed in the form.
+THESIS = {
+    "range": "1500",
+    "resolution": "0.05",
+    "image_size": "70x70",
+    "altitude": "50",
+    "wind": "5",
+}
+THESIS_SELECTS = {"mission": "precision-agriculture", "imagery": "multispectral", "order_by": "cost"}
+
+
+def chromium_path() -> str:
+    found = shutil.which("chromium") or shutil.which("chromium-browser")
+    assert found, "chromium is not installed: run `make setup` (apt-get install chromium)"
+    return found
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[Server]:
+    with running_server() as s:
+        yield s
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[object]:
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=chromium_path())
+        yield b
+        b.close()
+
+
+class Pages:
+    """Opens pages that may only talk to the app; records any other request."""
+
+    def __init__(self, browser, server: Server) -> None:  # type: ignore[no-untyped-def]
+        self.browser, self.server = browser, server
+        self.outside: list[str] = []
+        self.contexts: list[object] = []
+
+    def new(self, viewport: dict[str, int] = DESKTOP):  # type: ignore[no-untyped-def]
+        ctx = self.browser.new_context(viewport=viewport, accept_downloads=True)
+        self.contexts.append(ctx)
+        base = self.server.url + "/"
+
+        def guard(route):  # type: ignore[no-untyped-def]
+            url = route.request.url
+            if url.startswith(base) or url == self.server.url:
+                route.continue_()
+            else:
+                self.outside.append(url)
+                route.abort()
+
+        ctx.route("**/*", guard)
+        page = ctx.new_page()
+        page.set_default_timeout(60_000)
+        return page
+
+
+@pytest.fixture
+def pages(browser, server) -> Iterator[Pages]:  # type: ignore[no-untyped-def]
+    p = Pages(browser, server)
+    yield p
+    for c in p.contexts:
+        c.close()
+    assert p.outside == [], f"requests left the app: {p.outside}"
+
+
+def shot(page, name: str) -> None:  # type: ignore[no-untyped-def]
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(SHOTS / f"{name}.png"), full_page=True)
+
+
+def fill_thesis(page) -> None:  # type: ignore[no-untyped-def]
+    for name, value in THESIS_SELECTS.items():
+        page.select_option(f"#f-{name}", value)
+    for name, value in THESIS.items():
+        page.fill(f"#f-{name}", value)
+
+
+def cli_select() -> dict:
+    argv = ["select", "--json"]
+    for k, v in {**THESIS, **THESIS_SELECTS}.items():
+        argv += ["--" + k.replace("_", "-"), v]
+    out = subprocess.run([*uasnav_command(), *argv], capture_output=True, check=True, timeout=120)
+    return json.loads(out.stdout)
+
+
+def test_thesis_scenario_matches_the_cli(pages, server) -> None:
+    expected = cli_select()
+    for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
+        page = pages.new(viewport)
+        page.goto(server.url + "/")
+        shot(page, f"select-form-{tag}")
+        fill_thesis(page)
+        page.click("#select-form button[type=submit]")
+        page.wait_for_selector("#results")
+        # ranked table: every row, in order, as `uasnav select --json` ranks them
+        rows = page.locator("#ranking tbody tr")
+        got = [
+            (rows.nth(i).locator("td").nth(1).inner_text(), rows.nth(i).locator("td").nth(2).inner_text())
+            for i in range(rows.count())
+        ]
+        assert got == [(r["uas"], r["camera"]) for r in expected["ranking"]]
+        first_score = rows.nth(0).locator("td").nth(3).inner_text()
+        assert float(first_score) == pytest.approx(expected["ranking"][0]["score"], abs=5e-4)
+        # feasible lists and the equipment with its necessary marks
+        assert page.locator("#feasible-uas li").all_inner_texts() == expected["feasible_uas"]
+        assert page.locator("#feasible-cameras li").all_inner_texts() == expected["feasible_cameras"]
+        items = page.locator("dl.equipment li").all_inner_texts()
+        assert len(items) == len(expected["equipment"])
+        for text, e in zip(items, expected["equipment"], strict=True):
+            assert (
+                text.upper().startswith("NECESSARY" if e["necessary"] else "OPTIONAL") and e["name"] in text
+            )
+        assert page.locator("#rejections tbody tr").count() == len(expected["rejections"])
+        assert page.locator("figure.plot").count() == 4  # Figure 74, one per scored parameter
+        shot(page, f"select-results-{tag}")
+        # no sideways scrolling of the page at any width (wide tables scroll in their box)
+        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+
+
+def test_ranking_sorts_and_downloads(pages, server, tmp_path) -> None:
+    page = pages.new()
+    page.goto(server.url + "/")
+    page.click("#select-form button[type=submit]")
+    page.wait_for_selector("#results")
+    page.click("#ranking th:has-text('Cost (USD)')")
+    costs = [
+        float(x.replace(",", "")) for x in page.locator("#ranking tbody tr td:nth-child(7)").all_inner_texts()
+    ]
+    assert costs == sorted(costs)
+    with page.expect_download() as d:
+        page.click("a:has-text('JSON')")
+    data = json.loads(Path(d.value.path()).read_text())
+    assert data["ranking"] and data["mission"] == "precision-agriculture"
+    # print: the authorisation summary (the document `select --summary` writes), one page
+    summary = page.locator(".auth-summary").inner_text()
+    page.emulate_media(media="print")
+    assert not page.locator("#select-form").is_visible() and not page.locator("header.top").is_visible()
+    assert not page.locator("#ranking").is_visible() and page.locator(".auth-summary").is_visible()
+    assert page.locator("main").inner_text().strip() == summary.strip()  # nothing else printed
+    pdf = pypdf.PdfReader(io.BytesIO(page.pdf(format="A4", print_background=True)))
+    assert len(pdf.pages) == 1
+    printed = " ".join(pdf.pages[0].extract_text().split())
+    # the same document as the CLI's, opened on its own
+    out = tmp_path / "summary.html"
+    argv = ["select", "--summary", str(out)]
+    subprocess.run([*uasnav_command(), *argv], capture_output=True, check=True, timeout=120)
+    alone = pages.new()
+    alone.set_content(out.read_text())
+    assert " ".join(alone.locator(".auth-summary").inner_text().split()) == " ".join(summary.split())
+
+    # every character of the summary is on the printed page: nothing clipped or pushed off it
+    # (the PDF's text comes out in two columns and with ligatures, so compare as multisets)
+    def chars(text: str) -> Counter[str]:
+        return Counter(c for c in unicodedata.normalize("NFKC", text) if not c.isspace())
+
+    assert not chars(summary) - chars(printed), chars(summary) - chars(printed)
+    assert "Verdict:" in printed and "SORA 2.5" in printed
+
+
+def test_bad_value_is_shown_beside_its_field(pages, server) -> None:
+    page = pages.new()
+    page.goto(server.url + "/")
+    page.fill("#f-range", "-5")
+    page.fill("#f-altitude", "abc")
+    page.press("#f-altitude", "Tab")  # the script checks on leaving the field
+    assert page.locator("#e-altitude").inner_text().startswith("altitude:")
+    page.click("#select-form button[type=submit]")
+    page.wait_for_selector(".field.invalid")
+    assert page.locator("#e-range").inner_text() == "range: -5 is not > 0"
+    assert page.locator("#e-altitude").inner_text().startswith("altitude: ")
+    assert page.locator("#f-range").input_value() == "-5"
+    assert page.locator("#results").count() == 0
+    assert page.locator("#e-wind").inner_text() == ""
+    shot(page, "select-errors-desktop")
+
+
+def test_keyboard_only(pages, server) -> None:
+    """Tab reaches every field in order, typing fills them, Enter submits."""
+    page = pages.new()
+    page.goto(server.url + "/")
+    order = page.eval_on_selector_all(
+        "#select-form input:not([type=hidden]), #select-form select, #select-form button",
+        "els => els.map(e => e.id || e.type)",
+    )
+    seen: list[str] = []
+    page.keyboard.press("Tab")
+    assert page.evaluate("document.activeElement.className") == "skip"
+    for _ in range(80):
+        page.keyboard.press("Tab")
+        active = page.evaluate("document.activeElement.id || document.activeElement.type")
+        if active == "f-range":
+            page.keyboard.press("Control+A")
+            page.keyboard.type("800")
+        if active == "f-top":
+            page.keyboard.press("Control+A")
+            page.keyboard.type("3")
+        if active == "f-rain":
+            page.keyboard.press("Space")
+        if active in order:
+            seen.append(active)
+        if active == "submit":
+            break
+    assert seen == order, "Tab order differs from the form's order"
+    with page.expect_navigation():
+        page.keyboard.press("Enter")
+    page.wait_for_selector("#results")
+    assert 0 < page.locator("#ranking tbody tr").count() <= 3
+    facts = page.locator(".facts").first.inner_text()
+    assert "range 800 m" in facts and "rain" in facts
+    # the ranking's headers sort from the keyboard too
+    page.focus("#ranking th:has-text('Score')")
+    page.keyboard.press("Enter")
+    assert page.get_attribute("#ranking th:has-text('Score')", "aria-sort") == "ascending"
+
+
+def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
+    import pymap3d
+
+    from uasnav.trajectory.simulator import phantom4_plans
+
+    ne = phantom4_plans()["B"]
+    lat, lon, _ = pymap3d.ned2geodetic(ne[:, 0], ne[:, 1], 0.0, 47.3977, 8.5456, 50.0)
+    csv = tmp_path / "b.csv"
+    csv.write_text("lat,lon,alt\n" + "".join(f"{a:.9f},{b:.9f},50\n" for a, b in zip(lat, lon, strict=True)))
+    plan = tmp_path / "b.plan"
+    write_plan(read_plan(csv), plan)  # a QGroundControl .plan
+    route, _ = plan_route(read_plan(plan))
+    ref = default_model().predict(route, wind_vector(2.78, 22.5), 3.33)
+    for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
+        page = pages.new(viewport)
+        page.goto(server.url + "/trajectory")
+        page.set_input_files("#t-plan", str(plan))
+        page.fill("#t-wind_speed", "2.78")
+        page.fill("#t-wind_from", "22.5")
+        page.fill("#t-speed", "3.33")
+        page.click("#trajectory-form button[type=submit]")
+        page.wait_for_selector("#prediction")
+        times = [
+            float(x)
+            for x in page.eval_on_selector_all(
+                "#waypoints td[data-time]", "els => els.map(e => e.dataset.time)"
+            )
+        ]
+        assert times == pytest.approx(list(ref.waypoint_times_s), abs=1e-6)
+        assert float(page.get_attribute("#eta", "data-eta")) == pytest.approx(ref.eta_s)
+        low = page.locator("#elements tbody tr.low").count()
+        assert low == sum(1 for f in ref.flags if f)
+        assert page.locator("svg polyline.seg").count() == len(ref.time_s)
+        shot(page, f"trajectory-{tag}")
+        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+    with page.expect_download() as d:
+        page.click("a:has-text('Waypoint times CSV')")
+    lines = Path(d.value.path()).read_text().splitlines()
+    assert lines[0].endswith("time_s") and len(lines) == len(ref.waypoint_times_s) + 1
+
+
+def test_database_pages_filter_and_sort(pages, server) -> None:
+    page = pages.new()
+    page.goto(server.url + "/db/uas")
+    total = page.locator("#table tbody tr").count()
+    page.fill("#q", "dji")
+    visible = page.locator("#table tbody tr:not([hidden])")
+    assert 0 < visible.count() < total
+    assert all("dji" in t.lower() for t in visible.all_inner_texts())
+    page.click("button:has-text('Filter')")  # the same filter on the server (works without JS)
+    page.wait_for_url(re.compile(r"q=dji"))
+    assert page.locator("#table tbody tr").count() == visible.count()
+    shot(page, "database-desktop")
+    page = pages.new(PHONE)
+    page.goto(server.url + "/db/regulations")
+    assert page.locator("#table tbody tr").count() > 0
+    shot(page, "database-regulations-phone")
+
+
+def test_not_authorisable_in_the_browser(pages, server, shared_data, tmp_path) -> None:
+    """Zones and area uploaded through the form (file names kept): a PROHIBITED zone puts the
+    verdict first and lists the configurations as withheld, as ``select --json`` does; the
+    default-on GNSS-autopilot box, unchecked, is sent as false."""
+    doc = json.loads((shared_data / "utm" / "interuss_ed269_geozone_sample.json").read_text())
+    doc["UASZoneList"][0].update(restriction="PROHIBITED", message="military area")
+    zones, area = tmp_path / "prohibited.json", tmp_path / "field.geojson"
+    zones.write_text(json.dumps(doc))
+    ring = [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [ring]}))
+    argv = [
+        "select",
+        "--json",
+        "--range",
+        "1500",
+        "--zones",
+        str(zones),
+        "--area",
+        str(area),
+        "--no-gnss-autopilot",
+    ]
+    want = json.loads(
+        subprocess.run([*uasnav_command(), *argv], capture_output=True, check=True, timeout=120).stdout
+    )
+    assert want["authorisation"]["authorisable"] is False
+    for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
+        page = pages.new(viewport)
+        page.goto(server.url + "/")
+        page.fill("#f-range", "1500")
+        page.set_input_files("#f-zones", str(zones))
+        page.set_input_files("#f-area", str(area))
+        page.uncheck("#f-gnss_autopilot")
+        page.click("#select-form button[type=submit]")
+        page.wait_for_selector("#results")
+        box = page.locator("#not-authorisable")
+        assert box.is_visible() and want["authorisation"]["verdict"] in box.inner_text()
+        assert page.locator("#ranking").count() == 0
+        rows = page.locator("#withheld tbody tr")
+        got = [
+            (rows.nth(i).locator("td").nth(1).inner_text(), rows.nth(i).locator("td").nth(2).inner_text())
+            for i in range(rows.count())
+        ]
+        assert got == [(w["uas"], w["camera"]) for w in want["withheld_ranking"]]
+        assert page.locator(".auth-summary .verdict.warn").is_visible()
+        n = len(want["rejections"])
+        assert page.locator("#rejections tbody tr").count() == n
+        shot(page, f"select-withheld-{tag}")
+        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
