@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import click
 import numpy as np
@@ -10,8 +11,10 @@ import numpy as np
 from uasnav.cli._common import (
     NON_NEGATIVE,
     POSITIVE,
+    PROBABILITY,
     SEED,
     OutputPath,
+    Real,
     check_outputs,
     echo_json,
     parse_float_list,
@@ -216,7 +219,14 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         if not flights:
             raise click.UsageError("give FLIGHT files or --simulated")
         wind = parse_wind(wind_text) if wind_text else None
-        fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
+        # warnings (telemetry gaps) are shown once the evaluation succeeded: a failed run
+        # prints its one error line only
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
+            errors = leave_one_run_out(fs, segment, random_state=seed)
+        for w in caught:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
         table = {
             e.name: {
                 "applicable": True,
@@ -227,7 +237,7 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             }
             if e.applicable
             else {"applicable": False, "reason": e.reason}
-            for e in leave_one_run_out(fs, segment, random_state=seed)
+            for e in errors
         }
         out = {"methods": table, "n_runs": len(fs), "n_elements": fs.n_elements}
     if as_json:
@@ -244,3 +254,186 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
             + ", ".join(f"{x:.2f}" for x in row["t_real_s"])
         )
+
+
+@command.command("calibrate")
+@click.option(
+    "--model", "model_path", required=True, type=click.Path(dir_okay=False), help="Model JSON (from train)."
+)
+@click.option(
+    "--out", "out", required=True, type=OutputPath(), help="Model JSON to write, with its time bounds."
+)
+@click.option(
+    "--runs",
+    type=click.IntRange(20, 100_000),
+    default=200,
+    show_default=True,
+    help="Simulated calibration runs.",
+)
+@click.option(
+    "--test-runs",
+    type=click.IntRange(0, 100_000),
+    default=0,
+    show_default=True,
+    help="Held-out simulated runs to report the coverage on.",
+)
+@click.option(
+    "--coverage",
+    type=PROBABILITY,
+    default=0.95,
+    show_default=True,
+    help="Coverage reported for the held-out runs.",
+)
+@click.option("--seed", type=SEED, default=0, show_default=True)
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # type: ignore[no-untyped-def]
+    """Calibrate the time bounds of a model (split-conformal on simulated runs with truth)."""
+    from uasnav.trajectory.calibration import calibrate as fit_bounds
+    from uasnav.trajectory.calibration import covered, simulated_runs
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+    from uasnav.trajectory.timebounds import clopper_pearson
+
+    check_outputs([model_path], {"--out": out})
+    model = TrajectoryPredictor.load(model_path)
+    with click.progressbar(
+        length=runs + test_runs, label="simulated runs", file=click.get_text_stream("stderr")
+    ) as bar:
+        cal = simulated_runs(model, runs, seed=2 * seed, progress=lambda i, n: bar.update(1))
+        test = simulated_runs(model, test_runs, seed=2 * seed + 1, progress=lambda i, n: bar.update(1))
+    model.time_bounds_ = fit_bounds(cal, source=f"{runs} simulated runs, seed {seed}")
+    q = model.time_bounds_.quantile(coverage)
+    res = {"runs": runs, "coverage": coverage, "quantile": q, "tau_s": model.time_bounds_.tau_s}
+    if test_runs:
+        k = sum(covered(model.time_bounds_, r, coverage) for r in test)
+        lo, hi = clopper_pearson(k, test_runs)
+        res |= {"test_runs": test_runs, "covered": k, "covered_ci95": [lo, hi]}
+    model.save(out)
+    if as_json:
+        echo_json(res)
+        return
+    click.echo(
+        f"time bounds: ±{q:.3f}·(t + {model.time_bounds_.tau_s:g} s) at {coverage:.0%} coverage, {runs} runs"
+    )
+    if test_runs:
+        click.echo(
+            f"held-out coverage {res['covered']}/{test_runs} (Clopper–Pearson 95 %: {lo:.3f}–{hi:.3f})"
+        )
+
+
+@command.command("intent")
+@click.option(
+    "--model",
+    "model_path",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="Model JSON (from train/calibrate).",
+)
+@click.option(
+    "--plan",
+    "plan_path",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="Plan: .plan, .waypoints, .csv.",
+)
+@click.option("--wind", "wind_text", required=True, help="SPEED@DIR: m/s @ degrees the wind comes from.")
+@click.option(
+    "--start",
+    "start_text",
+    required=True,
+    help="Departure time, ISO 8601 with a zone (2026-05-01T09:30:00Z).",
+)
+@click.option(
+    "--coverage", type=PROBABILITY, default=0.95, show_default=True, help="Coverage of the time bounds."
+)
+@click.option(
+    "--lateral-buffer",
+    type=POSITIVE,
+    default=15.0,
+    show_default=True,
+    help="Horizontal buffer around the path (m).",
+)
+@click.option(
+    "--vertical-buffer", type=NON_NEGATIVE, default=10.0, show_default=True, help="Vertical buffer (m)."
+)
+@click.option(
+    "--geoid-height",
+    type=Real(-120.0, 120.0),
+    help="Geoid height N at the site (m; W84 = AMSL + N). Required.",
+)
+@click.option("--home-alt", type=Real(-1000.0, 9000.0), help="Home altitude AMSL (m) if the plan has none.")
+@click.option("--speed", type=POSITIVE, help="Horizontal speed (m/s); default the plan's, else the model's.")
+@click.option("--climb-rate", type=POSITIVE, default=2.5, show_default=True, help="Climb speed (m/s).")
+@click.option("--descent-rate", type=POSITIVE, default=1.5, show_default=True, help="Descent speed (m/s).")
+@click.option(
+    "--priority", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="F3548 priority."
+)
+@click.option(
+    "--calibration-runs",
+    type=click.IntRange(20, 100_000),
+    default=200,
+    show_default=True,
+    help="Runs to calibrate a model without time bounds.",
+)
+@click.option(
+    "--out", "out", required=True, type=OutputPath(), help="F3548 OperationalIntentDetails JSON to write."
+)
+@click.option("--geojson", "geojson", type=OutputPath(), help="Also write the volumes and route as GeoJSON.")
+@click.option("--json", "as_json", is_flag=True, help="Print a machine-readable summary.")
+def intent(  # type: ignore[no-untyped-def]
+    model_path, plan_path, wind_text, start_text, coverage, lateral_buffer, vertical_buffer, geoid_height,
+    home_alt, speed, climb_rate, descent_rate, priority, calibration_runs, out, geojson, as_json,
+):  # fmt: skip
+    """An ASTM F3548 operational intent (W84 volumes) whose volumes contain the predicted 4D
+    trajectory with its calibrated time bounds and the buffers."""
+    import pymap3d
+
+    from uasnav.cli.utm import parse_time
+    from uasnav.io.operational_intent import write_intent, write_intent_geojson
+    from uasnav.io.plans import read_plan
+    from uasnav.trajectory.calibration import calibrate as fit_bounds
+    from uasnav.trajectory.calibration import simulated_runs
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+    from uasnav.utm.intent import build_intent
+
+    wind = parse_wind(wind_text)
+    start = parse_time(start_text, "--start")
+    check_outputs([model_path, plan_path], {"--out": out, "--geojson": geojson})
+    model = TrajectoryPredictor.load(model_path)
+    plan = read_plan(plan_path)
+    if model.time_bounds_ is None:
+        with click.progressbar(
+            length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
+        ) as bar:
+            runs = simulated_runs(model, calibration_runs, progress=lambda i, n: bar.update(1))
+        model.time_bounds_ = fit_bounds(runs, source=f"{calibration_runs} simulated runs, seed 0")
+    b = build_intent(
+        plan, model, wind, start, coverage=coverage, lateral_buffer_m=lateral_buffer,
+        vertical_buffer_m=vertical_buffer, geoid_height_m=geoid_height, home_amsl_m=home_alt,
+        climb_ms=climb_rate, descent_ms=descent_rate, cruise_ms=speed, priority=priority,
+    )  # fmt: skip
+    write_intent(b.details, out)
+    if geojson:
+        la, lo, _ = pymap3d.enu2geodetic(
+            b.route_en[:, 0], b.route_en[:, 1], 0.0, b.origin[0], b.origin[1], 0.0
+        )
+        write_intent_geojson(
+            b.details,
+            geojson,
+            [(float(x), float(y), float(z)) for x, y, z in zip(la, lo, b.route_alt_w84, strict=True)],
+        )
+    summary = {
+        "volumes": len(b.details.volumes),
+        "eta_s": b.eta_s,
+        "eta_bounds_s": list(b.eta_bounds_s),
+        "coverage": coverage,
+        "waypoint_times_s": b.t_arrive_s,
+        "waypoint_bounds_s": [[float(x), float(y)] for x, y in zip(b.t_lo_s, b.t_hi_s, strict=True)],
+        "low_confidence_elements": sum(bool(f) for f in b.flags),
+    }
+    if as_json:
+        echo_json(summary)
+        return
+    click.echo(
+        f"{len(b.details.volumes)} volumes; ETA {b.eta_s:.0f} s "
+        f"({b.eta_bounds_s[0]:.0f}–{b.eta_bounds_s[1]:.0f} s at {coverage:.0%}); wrote {out}"
+    )

@@ -25,6 +25,8 @@ from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from typing import Any
 
+import numpy as np
+
 from uasnav import jsoncheck as jc
 from uasnav.atomicfile import atomic_write_text
 from uasnav.errors import DataFormatError, InputError
@@ -225,6 +227,59 @@ def write_intent(details: Any, path: str | os.PathLike[str]) -> None:
     atomic_write_text(path, text + "\n")
 
 
+def intent_geojson(details: Any, route: list[tuple[float, float, float]] | None = None) -> dict[str, Any]:
+    """A GeoJSON FeatureCollection of an intent's volumes (Polygon features; circles as
+    64-gons, with their centre and radius kept in the properties) and, if given, the route
+    (a LineString of (lon, lat, alt W84)). Properties: ``altitude_lower_w84_m``,
+    ``altitude_upper_w84_m``, ``time_start``, ``time_end``, ``index``."""
+    import pymap3d
+
+    feats: list[dict[str, Any]] = []
+    for k, v in enumerate(details.volumes):
+        vol = v.volume
+        props: dict[str, Any] = {
+            "index": k,
+            "altitude_lower_w84_m": float(vol.altitude_lower.value),
+            "altitude_upper_w84_m": float(vol.altitude_upper.value),
+            "time_start": str(v.time_start.value),
+            "time_end": str(v.time_end.value),
+        }
+        if vol.get("outline_polygon") is not None:
+            ring = [[float(p.lng), float(p.lat)] for p in vol.outline_polygon.vertices]
+        else:
+            c = vol.outline_circle
+            r = float(c.radius.value)
+            props["circle"] = {"center": [float(c.center.lng), float(c.center.lat)], "radius_m": r}
+            a = np.linspace(0.0, 2 * np.pi, 65)[:-1]
+            la, lo, _ = pymap3d.enu2geodetic(
+                r * np.cos(a), r * np.sin(a), 0.0, c.center.lat, c.center.lng, 0.0
+            )
+            ring = [[float(x), float(y)] for x, y in zip(lo, la, strict=True)]
+        feats.append(
+            {
+                "type": "Feature",
+                "properties": props,
+                "geometry": {"type": "Polygon", "coordinates": [[*ring, ring[0]]]},
+            }
+        )
+    if route is not None:
+        feats.append(
+            {
+                "type": "Feature",
+                "properties": {"kind": "route"},
+                "geometry": {"type": "LineString", "coordinates": [[lo, la, al] for la, lo, al in route]},
+            }
+        )
+    return {"type": "FeatureCollection", "features": feats}
+
+
+def write_intent_geojson(
+    details: Any, path: str | os.PathLike[str], route: list[tuple[float, float, float]] | None = None
+) -> None:
+    """Write :func:`intent_geojson` atomically."""
+    atomic_write_text(path, json.dumps(intent_geojson(details, route), indent=1, allow_nan=False) + "\n")
+
+
 def rfc3339(t: datetime) -> str:
     """``t`` as F3548 wants it: RFC 3339 in UTC with a ``Z``."""
     if t.tzinfo is None:
@@ -239,10 +294,12 @@ __all__ = [
     "check_details",
     "check_times",
     "check_volume",
+    "intent_geojson",
     "parse_details",
     "parse_intents",
     "read_intents",
     "rfc3339",
     "to_json",
     "write_intent",
+    "write_intent_geojson",
 ]
