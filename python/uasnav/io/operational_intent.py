@@ -284,7 +284,7 @@ def rfc3339(t: datetime) -> str:
     """``t`` as F3548 wants it: RFC 3339 in UTC with a ``Z``."""
     if t.tzinfo is None:
         raise InputError(f"time {t.isoformat()} has no time zone")
-    return t.astimezone(timezone.utc).isoformat(timespec="milliseconds").replace("+00:00", "Z")
+    return t.astimezone(timezone.utc).isoformat(timespec="microseconds").replace("+00:00", "Z")
 
 
 __all__ = [
