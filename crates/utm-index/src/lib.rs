@@ -30,6 +30,7 @@
 #![deny(clippy::unwrap_used, clippy::expect_used)]
 
 pub mod geometry;
+pub mod synthetic;
 
 use core::fmt;
 use geometry::{outline_dist, Outline, Pt};
@@ -278,6 +279,8 @@ impl Encounter {
 /// The exact test of volumes `a` and `b` (any order); None if they are of the same intent,
 /// do not overlap in time, or are farther apart than the buffers.
 fn exact(v: &Volumes, a: usize, b: usize, s: &Search) -> Option<Encounter> {
+    // one order for the arithmetic, whatever the caller's: bit-identical results
+    let (a, b) = (a.min(b), a.max(b));
     if v.intent[a] == v.intent[b] {
         return None;
     }
@@ -362,14 +365,18 @@ fn median(mut xs: Vec<f64>) -> f64 {
 }
 
 /// LSD radix sort of (key, value) pairs packed as `key << 32 | value`, by the key's low
-/// `key_bits` bits, 16 bits per pass.
+/// `key_bits` bits, in passes of at most 11 bits (2048 buckets: the counters stay in L1).
 fn radix_sort(entries: &mut Vec<u64>, key_bits: u32) {
+    let passes = key_bits.div_ceil(11).max(1);
+    let width = key_bits.div_ceil(passes).max(1);
+    let mask = (1u64 << width) - 1;
     let mut buf = vec![0u64; entries.len()];
-    let mut shift = 32;
-    while shift < 32 + key_bits {
-        let mut count = vec![0usize; 1 << 16];
+    let mut count = vec![0usize; 1 << width];
+    for p in 0..passes {
+        let shift = 32 + p * width;
+        count.iter_mut().for_each(|c| *c = 0);
         for &e in entries.iter() {
-            count[((e >> shift) & 0xffff) as usize] += 1;
+            count[((e >> shift) & mask) as usize] += 1;
         }
         let mut sum = 0;
         for c in count.iter_mut() {
@@ -378,12 +385,11 @@ fn radix_sort(entries: &mut Vec<u64>, key_bits: u32) {
             sum += n;
         }
         for &e in entries.iter() {
-            let d = ((e >> shift) & 0xffff) as usize;
+            let d = ((e >> shift) & mask) as usize;
             buf[count[d]] = e;
             count[d] += 1;
         }
         std::mem::swap(entries, &mut buf);
-        shift += 16;
     }
 }
 
@@ -397,8 +403,15 @@ pub struct SpaceTimeIndex<'a> {
     entries: Vec<u64>,
     /// Volumes spanning too many cells: tested against every volume.
     big: Vec<u32>,
+    /// Volumes renumbered in the order of their lowest cell, so that volumes tested together
+    /// lie together in memory: `order[new] = original`, `rank[original] = new`. Every array
+    /// below and the entries use the new numbers.
+    order: Vec<u32>,
+    rank: Vec<u32>,
     /// Per volume: its box grown by h/2 horizontally (x0, y0, x1, y1).
     grown: Vec<[f64; 4]>,
+    time: Vec<[f64; 2]>,
+    intent: Vec<u32>,
 }
 
 impl<'a> SpaceTimeIndex<'a> {
@@ -456,9 +469,33 @@ impl<'a> SpaceTimeIndex<'a> {
             dims,
         };
         let key_bits = 64 - (dims[0] * dims[1] * dims[2]).leading_zeros();
+        // renumber the volumes by their lowest cell (locality of the scans below)
+        let mut first: Vec<u64> = grown
+            .iter()
+            .zip(&volumes.time)
+            .enumerate()
+            .map(|(i, (b, t))| {
+                let k = grid.key(
+                    grid.range(b[0], b[0], 0).0,
+                    grid.range(b[1], b[1], 1).0,
+                    grid.range(t[0], t[0], 2).0,
+                );
+                k << 32 | i as u64
+            })
+            .collect();
+        radix_sort(&mut first, key_bits.max(1));
+        let order: Vec<u32> = first.iter().map(|e| (e & 0xffff_ffff) as u32).collect();
+        drop(first);
+        let mut rank = vec![0u32; order.len()];
+        for (new, &orig) in order.iter().enumerate() {
+            rank[orig as usize] = new as u32;
+        }
+        let grown: Vec<[f64; 4]> = order.iter().map(|&o| grown[o as usize]).collect();
+        let time: Vec<[f64; 2]> = order.iter().map(|&o| volumes.time[o as usize]).collect();
+        let intent: Vec<u32> = order.iter().map(|&o| volumes.intent[o as usize]).collect();
         let mut entries = Vec::with_capacity(volumes.len() * 4);
         let mut big = Vec::new();
-        for (i, (b, t)) in grown.iter().zip(&volumes.time).enumerate() {
+        for (i, (b, t)) in grown.iter().zip(&time).enumerate() {
             let (x0, x1) = grid.range(b[0], b[2], 0);
             let (y0, y1) = grid.range(b[1], b[3], 1);
             let (t0, t1) = grid.range(t[0], t[1], 2);
@@ -482,7 +519,11 @@ impl<'a> SpaceTimeIndex<'a> {
             grid,
             entries,
             big,
+            order,
+            rank,
             grown,
+            time,
+            intent,
         })
     }
 
@@ -494,7 +535,7 @@ impl<'a> SpaceTimeIndex<'a> {
     /// The cell key of the lower corner of the intersection of the boxes of `a` and `b`.
     fn owner(&self, a: usize, b: usize) -> u64 {
         let (ba, bb) = (self.grown[a], self.grown[b]);
-        let (ta, tb) = (self.volumes.time[a], self.volumes.time[b]);
+        let (ta, tb) = (self.time[a], self.time[b]);
         let g = &self.grid;
         let cx = g.range(ba[0].max(bb[0]), 0.0, 0).0;
         let cy = g.range(ba[1].max(bb[1]), 0.0, 1).0;
@@ -504,7 +545,7 @@ impl<'a> SpaceTimeIndex<'a> {
 
     fn boxes_meet(&self, a: usize, b: usize) -> bool {
         let (ba, bb) = (self.grown[a], self.grown[b]);
-        let (ta, tb) = (self.volumes.time[a], self.volumes.time[b]);
+        let (ta, tb) = (self.time[a], self.time[b]);
         ba[0] <= bb[2]
             && bb[0] <= ba[2]
             && ba[1] <= bb[3]
@@ -538,13 +579,14 @@ impl<'a> SpaceTimeIndex<'a> {
                 let a = (ea & 0xffff_ffff) as usize;
                 for &eb in &members[k + 1..] {
                     let b = (eb & 0xffff_ffff) as usize;
-                    if v.intent[a] == v.intent[b]
+                    if self.intent[a] == self.intent[b]
                         || !self.boxes_meet(a, b)
                         || self.owner(a, b) != key
                     {
                         continue;
                     }
-                    if let Some(enc) = exact(v, a, b, &self.search) {
+                    let (oa, ob) = (self.order[a] as usize, self.order[b] as usize);
+                    if let Some(enc) = exact(v, oa, ob, &self.search) {
                         out.push(enc);
                     }
                 }
@@ -601,7 +643,8 @@ impl<'a> SpaceTimeIndex<'a> {
                     continue;
                 }
                 if self.boxes_meet(a, b) {
-                    if let Some(enc) = exact(v, a, b, &self.search) {
+                    let (oa, ob) = (self.order[a] as usize, self.order[b] as usize);
+                    if let Some(enc) = exact(v, oa, ob, &self.search) {
                         out.push(enc);
                     }
                 }
@@ -649,8 +692,9 @@ impl<'a> SpaceTimeIndex<'a> {
         let none = Search::default();
         for b in (0..v.len()).filter(|&i| v.intent[i] == intent) {
             let tb = v.time[b];
-            for c in self.candidates(self.grown[b], tb[0], tb[1] + max_delay_s) {
-                let c = c as usize;
+            let gb = self.grown[self.rank[b] as usize];
+            for c in self.candidates(gb, tb[0], tb[1] + max_delay_s) {
+                let c = self.order[c as usize] as usize;
                 if v.intent[c] == intent {
                     continue;
                 }
