@@ -66,21 +66,23 @@ def random_plan(rng: np.random.Generator) -> np.ndarray:
     return np.array(pts)
 
 
-def simulate_run(predictor: TrajectoryPredictor, seed: int) -> SimulatedRun:
-    """One simulated run with its prediction (see module)."""
+def simulate_run(predictor: TrajectoryPredictor, seed: int, cruise_ms: float | None = None) -> SimulatedRun:
+    """One simulated run with its prediction (see module), at ``cruise_ms`` (default the
+    model's speed): calibrate at the speed the missions will fly."""
+    v = predictor.cruise_ms_ if cruise_ms is None else float(cruise_ms)
     rng = np.random.default_rng(seed)
     plan = random_plan(rng)
     speed, from_deg = float(rng.uniform(0.0, 8.0)), float(rng.uniform(0.0, 360.0))
     wind = WindModel(speed_ms=speed, from_deg=from_deg)
     tel = simulate_flight(
         plan,
-        params=MultirotorParams(cruise_ms=predictor.cruise_ms_),
+        params=MultirotorParams(cruise_ms=v),
         wind=wind,
         seed=int(rng.integers(2**31)),
         dt=CALIBRATION_DT_S,
     )
     w_ne = wind_vector(speed, from_deg)
-    pred = predictor.predict(plan, w_ne)
+    pred = predictor.predict(plan, w_ne, v)
     el = pred.elements
     s_knots = np.concatenate([[el.s_start_m[0]], el.s_end_m])
     t_pred = np.concatenate([[0.0], np.cumsum(pred.time_s)])
@@ -98,11 +100,12 @@ def simulated_runs(
     n_runs: int,
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
+    cruise_ms: float | None = None,
 ) -> list[SimulatedRun]:
     """``n_runs`` runs, run i from seed ``seed·100003 + i`` (distinct seeds → independent sets)."""
     out = []
     for i in range(n_runs):
-        out.append(simulate_run(predictor, seed * 100_003 + i))
+        out.append(simulate_run(predictor, seed * 100_003 + i, cruise_ms))
         if progress is not None:
             progress(i + 1, n_runs)
     return out
