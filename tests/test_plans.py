@@ -341,3 +341,28 @@ def test_bad_kml_and_geojson(tmp_path, name, text, match):
     with pytest.raises(DataFormatError, match=match) as ei:
         read_plan(f)
     assert name in str(ei.value)
+
+
+def test_plans_embedded_in_logs(shared_data):
+    plan = read_plan(shared_data / "flights" / "phoenix_mission1_arducopter.tlog")
+    # the mission the README describes: take-off to 20 m → waypoint → waypoint → land
+    assert [it.kind for it in plan.items] == [
+        ItemKind.TAKEOFF,
+        ItemKind.WAYPOINT,
+        ItemKind.WAYPOINT,
+        ItemKind.LAND,
+    ]
+    assert plan.items[0].alt_m == 20 and plan.home is not None
+    route, _ = plan_route(plan)
+    assert route.shape == (2, 2) and 95 < float(np.hypot(*route[1])) < 105  # the ~100 m leg
+    # the same waypoints as the flight reader takes from the log
+    from uasnav.io import read_flight
+
+    log = read_flight(shared_data / "flights" / "phoenix_mission1_arducopter.tlog")
+    wps = [log.waypoints[s] for s in sorted(log.waypoints)]
+    np.testing.assert_allclose(
+        [(it.lat_deg, it.lon_deg) for it in plan.items[1:3]], [w[:2] for w in wps], atol=1e-9
+    )
+    # log171 carries only ArduPilot's home item: no mission, said so
+    with pytest.raises(DataFormatError, match="only a home position"):
+        read_plan(shared_data / "logs" / "ardupilot_log171.bin")

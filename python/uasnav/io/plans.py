@@ -7,7 +7,8 @@
 The format follows the extension (:data:`PLAN_READERS`): QGroundControl ``.plan`` (JSON),
 Mission Planner ``.waypoints`` / ``.txt`` (``QGC WPL 110``), uasnav's plan ``.csv``
 (``lat,lon[,alt]`` or ``north,east``), KML (``.kml``: a LineString or Point placemarks) and
-GeoJSON (``.geojson``: a LineString or Points, with an explicit ``altitude_frame``). Writers
+GeoJSON (``.geojson``: a LineString or Points, with an explicit ``altitude_frame``), and the
+plan embedded in a log (``.tlog`` MISSION_ITEM(_INT), ``.bin`` DataFlash CMD). Writers
 are atomic and round-trip their own format item for item (KML and GeoJSON: the positioned
 waypoints only). The model (items, altitude frames, command kinds, home position, speed changes,
 loiter times) is :mod:`uasnav.io.mission_plan`; :func:`plan_route` turns a plan into the
@@ -42,6 +43,7 @@ from uasnav.io.mission_plan import (
 from uasnav.io.plan_formats.csv_plan import read_plan_csv, write_plan_csv
 from uasnav.io.plan_formats.geojson import read_geojson, write_geojson
 from uasnav.io.plan_formats.kml import read_kml, write_kml
+from uasnav.io.plan_formats.logs import read_dataflash_plan, read_tlog_plan
 from uasnav.io.plan_formats.qgc import read_qgc_plan, write_qgc_plan
 from uasnav.io.plan_formats.source import MAX_PLAN_BYTES
 from uasnav.io.plan_formats.wpl import read_wpl, write_wpl
@@ -54,6 +56,8 @@ PLAN_READERS: dict[str, Callable[[str | os.PathLike[str]], MissionPlan]] = {
     ".csv": read_plan_csv,
     ".kml": read_kml,
     ".geojson": read_geojson,
+    ".tlog": read_tlog_plan,
+    ".bin": read_dataflash_plan,
 }
 #: Extension → writer.
 PLAN_WRITERS: dict[str, Callable[[MissionPlan, str | os.PathLike[str]], None]] = {
