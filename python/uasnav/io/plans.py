@@ -1,8 +1,10 @@
 """Mission plans: read and write every plan format into one typed :class:`MissionPlan`.
 
->>> from uasnav.io.plans import read_plan, plan_route    # doctest: +SKIP
->>> plan = read_plan("survey.plan")                      # doctest: +SKIP
->>> route_ne, origin = plan_route(plan)                  # doctest: +SKIP
+Usage (``survey.plan`` being any plan file)::
+
+    from uasnav.io.plans import read_plan, plan_route
+    plan = read_plan("survey.plan")
+    route_ne, origin = plan_route(plan)
 
 The format follows the extension (:data:`PLAN_READERS`): QGroundControl ``.plan`` (JSON),
 Mission Planner ``.waypoints`` / ``.txt`` (``QGC WPL 110``), uasnav's plan ``.csv``
