@@ -233,6 +233,10 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
                 "element_e_pct_mean": float(np.mean(e.element_pct)),
                 "element_e_pct_median": float(np.median(e.element_pct)),
                 "run_e_pct_mean": float(np.mean(e.run_pct)),
+                # per-run ETA error |e%|: median, 95th percentile, worst (issue 17)
+                "run_abs_e_pct_median": float(np.median(np.abs(e.run_pct))),
+                "run_abs_e_pct_p95": float(np.percentile(np.abs(e.run_pct), 95)),
+                "run_abs_e_pct_worst": float(np.max(np.abs(e.run_pct))),
                 "run_e_pct": list(e.run_pct),
             }
             if e.applicable
@@ -247,7 +251,12 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         if not d["applicable"]:
             click.echo(f"{name:24s} not applicable: {d['reason']}")
             continue
-        extra = f"  run e% {d['run_e_pct_mean']:6.2f}" if "run_e_pct_mean" in d else ""
+        extra = (
+            f"  run |e%| median {d['run_abs_e_pct_median']:6.2f} p95 {d['run_abs_e_pct_p95']:6.2f} "
+            f"worst {d['run_abs_e_pct_worst']:6.2f}"
+            if "run_abs_e_pct_median" in d
+            else ""
+        )
         click.echo(f"{name:24s} element e% mean {d['element_e_pct_mean']:6.2f}{extra}")
     for row in out.get("table17", []):
         click.echo(
