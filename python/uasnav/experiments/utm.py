@@ -204,7 +204,7 @@ def run(
     progress: Callable[[int, int], None] | None = None,
 ) -> UtmResult:
     """The experiment (see module); ``model`` gets calibrated time bounds."""
-    n_cal, n_test = (25, 10) if quick else (200, 100)
+    n_cal, n_test = (25, 10) if quick else (200, 60)
     cov, _ = time_bound_coverage(model, n_cal, n_test, seed=seed, progress=progress)
     wind = wind_vector(*WIND)
     mission = survey_mission()
