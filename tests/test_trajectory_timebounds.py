@@ -199,7 +199,7 @@ def test_cli_intent_then_deconflict(model, runs, shared_data, tmp_path):
             ],
         )
         assert r.exit_code == 0, r.output
-    s = json.loads(r.output)
+    s = json.loads(r.stdout)
     assert s["eta_bounds_s"][0] < s["eta_s"] < s["eta_bounds_s"][1] and len(s["waypoint_bounds_s"]) == len(
         s["waypoint_times_s"]
     )
@@ -231,3 +231,41 @@ def test_cli_intent_then_deconflict(model, runs, shared_data, tmp_path):
     v = volume_arrays([a, NamedIntent("b", bb.details)])
     assert not deconflict(v.shifted(1, c["delay_s"] + 1e-3)).conflicts
     assert deconflict(v.shifted(1, c["delay_s"] - 1.0)).conflicts
+
+
+def test_cli_intent_calibrates_a_model_without_bounds(model, runs, shared_data, tmp_path):
+    keep, model.time_bounds_ = model.time_bounds_, None
+    try:
+        model.save(tmp_path / "raw.json")
+    finally:
+        model.time_bounds_ = keep
+    assert "time_bounds" not in json.loads((tmp_path / "raw.json").read_text())
+    plan = shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan"
+    argv = [
+        "trajectory",
+        "intent",
+        "--model",
+        str(tmp_path / "raw.json"),
+        "--plan",
+        str(plan),
+        "--wind",
+        "0@0",
+    ]
+    argv += ["--start", "2026-11-24T12:00:00Z", "--geoid-height", "47.4", "--calibration-runs", "20"]
+    r = CliRunner().invoke(main, [*argv, "--out", str(tmp_path / "i.json")])
+    assert r.exit_code == 0, r.output
+    assert len(read_intents(tmp_path / "i.json")[0].details.volumes) > 0
+    # calibrate writes a model whose bounds the intent then uses as they are
+    cal = [
+        "trajectory",
+        "calibrate",
+        "--model",
+        str(tmp_path / "raw.json"),
+        "--out",
+        str(tmp_path / "cal.json"),
+    ]
+    r = CliRunner().invoke(main, [*cal, "--runs", "20", "--test-runs", "5", "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout)
+    assert out["runs"] == 20 and 0 <= out["covered"] <= 5
+    assert TrajectoryPredictor.load(tmp_path / "cal.json").time_bounds_.n_runs == 20

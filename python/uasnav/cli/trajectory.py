@@ -398,7 +398,7 @@ def intent(  # type: ignore[no-untyped-def]
 
     from uasnav.cli.utm import parse_time
     from uasnav.io.operational_intent import write_intent, write_intent_geojson
-    from uasnav.io.plans import read_plan
+    from uasnav.io.plans import plan_cruise_speed, read_plan
     from uasnav.trajectory.calibration import calibrate as fit_bounds
     from uasnav.trajectory.calibration import simulated_runs
     from uasnav.trajectory.predictor import TrajectoryPredictor
@@ -413,8 +413,12 @@ def intent(  # type: ignore[no-untyped-def]
         with click.progressbar(
             length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
         ) as bar:
-            runs = simulated_runs(model, calibration_runs, progress=lambda i, n: bar.update(1))
-        model.time_bounds_ = fit_bounds(runs, source=f"{calibration_runs} simulated runs, seed 0")
+            # calibrated at the speed this mission flies (the band depends on it)
+            v = speed or plan_cruise_speed(plan) or model.cruise_ms_
+            runs = simulated_runs(model, calibration_runs, progress=lambda i, n: bar.update(1), cruise_ms=v)
+        model.time_bounds_ = fit_bounds(
+            runs, source=f"{calibration_runs} simulated runs at {v:g} m/s, seed 0"
+        )
     b = build_intent(
         plan, model, wind, start, coverage=coverage, lateral_buffer_m=lateral_buffer,
         vertical_buffer_m=vertical_buffer, geoid_height_m=geoid_height, home_amsl_m=home_alt,
