@@ -18,33 +18,34 @@ fn err(py: Python<'_>, e: IndexError) -> PyErr {
     input_error(py, e.to_string())
 }
 
+/// The volumes as borrowed views of the numpy arrays (zero-copy; only the offsets are
+/// converted to `usize`).
 #[allow(clippy::too_many_arguments)]
-fn volumes(
+fn volumes<'a>(
     py: Python<'_>,
-    intent: &PyReadonlyArray1<'_, u32>,
-    alt: &PyReadonlyArray2<'_, f64>,
-    time: &PyReadonlyArray2<'_, f64>,
+    intent: &'a PyReadonlyArray1<'_, u32>,
+    alt: &'a PyReadonlyArray2<'_, f64>,
+    time: &'a PyReadonlyArray2<'_, f64>,
     offsets: &PyReadonlyArray1<'_, u64>,
-    vertices: &PyReadonlyArray2<'_, f64>,
-    circle: &PyReadonlyArray2<'_, f64>,
-) -> PyResult<Volumes> {
+    vertices: &'a PyReadonlyArray2<'_, f64>,
+    circle: &'a PyReadonlyArray2<'_, f64>,
+) -> PyResult<Volumes<'a>> {
     let intent = intent
         .as_slice()
-        .map_err(|_| input_error(py, "intent: expected a C-contiguous uint32 array".into()))?
-        .to_vec();
+        .map_err(|_| input_error(py, "intent: expected a C-contiguous uint32 array".into()))?;
     let offsets: Vec<usize> = offsets
         .as_slice()
         .map_err(|_| input_error(py, "offsets: expected a C-contiguous uint64 array".into()))?
         .iter()
-        .map(|&o| o as usize)
+        .map(|&o| usize::try_from(o).unwrap_or(usize::MAX))
         .collect();
     Volumes::new(
         intent,
-        rows::<2>(py, "alt", alt)?.to_vec(),
-        rows::<2>(py, "time", time)?.to_vec(),
+        rows::<2>(py, "alt", alt)?,
+        rows::<2>(py, "time", time)?,
         offsets,
-        rows::<2>(py, "vertices", vertices)?.to_vec(),
-        rows::<3>(py, "circle", circle)?.to_vec(),
+        rows::<2>(py, "vertices", vertices)?,
+        rows::<3>(py, "circle", circle)?,
     )
     .map_err(|e| err(py, e))
 }

@@ -34,6 +34,7 @@ pub mod synthetic;
 
 use core::fmt;
 use geometry::{outline_dist, Outline, Pt};
+use std::borrow::Cow;
 
 /// Volumes spanning more grid cells than this are tested against every volume instead.
 pub const MAX_CELLS_PER_VOLUME: u64 = 256;
@@ -84,18 +85,21 @@ impl std::error::Error for IndexError {}
 /// A set of volumes in structure-of-arrays form (what Python hands over without copies of
 /// objects). Volume `i` belongs to intent `intent[i]`; its outline is the polygon
 /// `vertices[offsets[i]..offsets[i+1]]`, or, if that range is empty, the circle `circle[i]`.
+///
+/// The arrays are borrowed or owned ([`Cow`]): the Python binding lends numpy's buffers
+/// without copying them.
 #[derive(Clone, Debug)]
-pub struct Volumes {
-    intent: Vec<u32>,
-    alt: Vec<[f64; 2]>,
-    time: Vec<[f64; 2]>,
+pub struct Volumes<'a> {
+    intent: Cow<'a, [u32]>,
+    alt: Cow<'a, [[f64; 2]]>,
+    time: Cow<'a, [[f64; 2]]>,
     offsets: Vec<usize>,
-    vertices: Vec<Pt>,
-    circle: Vec<[f64; 3]>,
+    vertices: Cow<'a, [Pt]>,
+    circle: Cow<'a, [[f64; 3]]>,
     bbox: Vec<[f64; 4]>,
 }
 
-impl Volumes {
+impl<'a> Volumes<'a> {
     /// Checks and stores a volume set.
     ///
     /// * `intent` — intent number of each volume (n).
@@ -105,13 +109,15 @@ impl Volumes {
     /// * `vertices` — polygon vertices (x east, y north), m; a polygon has ≥ 3.
     /// * `circle` — (x, y, radius) m for volumes with no vertices (radius > 0); ignored otherwise.
     pub fn new(
-        intent: Vec<u32>,
-        alt: Vec<[f64; 2]>,
-        time: Vec<[f64; 2]>,
+        intent: impl Into<Cow<'a, [u32]>>,
+        alt: impl Into<Cow<'a, [[f64; 2]]>>,
+        time: impl Into<Cow<'a, [[f64; 2]]>>,
         offsets: Vec<usize>,
-        vertices: Vec<Pt>,
-        circle: Vec<[f64; 3]>,
+        vertices: impl Into<Cow<'a, [Pt]>>,
+        circle: impl Into<Cow<'a, [[f64; 3]]>>,
     ) -> Result<Self, IndexError> {
+        let (intent, alt, time) = (intent.into(), alt.into(), time.into());
+        let (vertices, circle) = (vertices.into(), circle.into());
         let n = intent.len();
         for (what, got) in [
             ("alt", alt.len()),
@@ -278,7 +284,7 @@ impl Encounter {
 
 /// The exact test of volumes `a` and `b` (any order); None if they are of the same intent,
 /// do not overlap in time, or are farther apart than the buffers.
-fn exact(v: &Volumes, a: usize, b: usize, s: &Search) -> Option<Encounter> {
+fn exact(v: &Volumes<'_>, a: usize, b: usize, s: &Search) -> Option<Encounter> {
     // one order for the arithmetic, whatever the caller's: bit-identical results
     let (a, b) = (a.min(b), a.max(b));
     if v.intent[a] == v.intent[b] {
@@ -315,7 +321,7 @@ fn exact(v: &Volumes, a: usize, b: usize, s: &Search) -> Option<Encounter> {
 }
 
 /// Every encounter by testing all pairs: O(n²), the reference for tests and benchmarks.
-pub fn brute_force(v: &Volumes, s: &Search) -> Result<Vec<Encounter>, IndexError> {
+pub fn brute_force(v: &Volumes<'_>, s: &Search) -> Result<Vec<Encounter>, IndexError> {
     s.check()?;
     let mut out = Vec::new();
     for a in 0..v.len() {
@@ -396,7 +402,7 @@ fn radix_sort(entries: &mut Vec<u64>, key_bits: u32) {
 /// The space-time index of a volume set (borrowed), built once per search buffer.
 #[derive(Debug)]
 pub struct SpaceTimeIndex<'a> {
-    volumes: &'a Volumes,
+    volumes: &'a Volumes<'a>,
     search: Search,
     grid: Grid,
     /// (cell key << 32 | volume), sorted by key.
@@ -416,7 +422,7 @@ pub struct SpaceTimeIndex<'a> {
 
 impl<'a> SpaceTimeIndex<'a> {
     /// Builds the index for conflicts and near misses within `search`'s buffers.
-    pub fn new(volumes: &'a Volumes, search: Search) -> Result<Self, IndexError> {
+    pub fn new(volumes: &'a Volumes<'a>, search: Search) -> Result<Self, IndexError> {
         search.check()?;
         if volumes.len() >= u32::MAX as usize {
             return Err(IndexError::Parameter("too many volumes (at most 2³² − 1)"));
@@ -438,7 +444,7 @@ impl<'a> SpaceTimeIndex<'a> {
         let mut size = [2.0 * ext.max(1.0), 2.0 * ext.max(1.0), 2.0 * dur.max(1.0)];
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for (b, t) in grown.iter().zip(&volumes.time) {
+        for (b, t) in grown.iter().zip(volumes.time.iter()) {
             for (k, (l, h)) in [(b[0], b[2]), (b[1], b[3]), (t[0], t[1])]
                 .into_iter()
                 .enumerate()
@@ -472,7 +478,7 @@ impl<'a> SpaceTimeIndex<'a> {
         // renumber the volumes by their lowest cell (locality of the scans below)
         let mut first: Vec<u64> = grown
             .iter()
-            .zip(&volumes.time)
+            .zip(volumes.time.iter())
             .enumerate()
             .map(|(i, (b, t))| {
                 let k = grid.key(
@@ -741,7 +747,7 @@ mod tests {
 
     type Spec = (u32, Vec<Pt>, [f64; 2], [f64; 2]);
 
-    fn set(vols: &[Spec]) -> Volumes {
+    fn set(vols: &[Spec]) -> Volumes<'static> {
         let mut offsets = vec![0];
         let mut verts = Vec::new();
         for v in vols {
@@ -749,9 +755,9 @@ mod tests {
             offsets.push(verts.len());
         }
         Volumes::new(
-            vols.iter().map(|v| v.0).collect(),
-            vols.iter().map(|v| v.2).collect(),
-            vols.iter().map(|v| v.3).collect(),
+            vols.iter().map(|v| v.0).collect::<Vec<_>>(),
+            vols.iter().map(|v| v.2).collect::<Vec<_>>(),
+            vols.iter().map(|v| v.3).collect::<Vec<_>>(),
             offsets,
             verts,
             vec![[0.0; 3]; vols.len()],

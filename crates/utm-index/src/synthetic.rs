@@ -31,7 +31,7 @@ impl SplitMix64 {
 }
 
 /// `n_intents` synthetic intents (see module).
-pub fn synthetic(n_intents: usize, seed: u64) -> Result<Volumes, IndexError> {
+pub fn synthetic(n_intents: usize, seed: u64) -> Result<Volumes<'static>, IndexError> {
     let mut rng = SplitMix64::new(seed);
     let (city, day, buf) = (30_000.0, 86_400.0, 15.0);
     let mut intent = Vec::new();

@@ -35,7 +35,7 @@ fn volume() -> impl Strategy<Value = Spec> {
 
 type Spec = (u32, Vec<[f64; 2]>, [f64; 3], [f64; 2], [f64; 2]);
 
-fn build(vols: &[Spec]) -> Volumes {
+fn build(vols: &[Spec]) -> Volumes<'static> {
     let mut offsets = vec![0];
     let mut verts = Vec::new();
     for v in vols {
@@ -43,12 +43,12 @@ fn build(vols: &[Spec]) -> Volumes {
         offsets.push(verts.len());
     }
     Volumes::new(
-        vols.iter().map(|v| v.0).collect(),
-        vols.iter().map(|v| v.3).collect(),
-        vols.iter().map(|v| v.4).collect(),
+        vols.iter().map(|v| v.0).collect::<Vec<_>>(),
+        vols.iter().map(|v| v.3).collect::<Vec<_>>(),
+        vols.iter().map(|v| v.4).collect::<Vec<_>>(),
         offsets,
         verts,
-        vols.iter().map(|v| v.2).collect(),
+        vols.iter().map(|v| v.2).collect::<Vec<_>>(),
     )
     .unwrap_or_else(|e| panic!("{e}"))
 }
