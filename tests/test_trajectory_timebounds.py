@@ -269,3 +269,28 @@ def test_cli_intent_calibrates_a_model_without_bounds(model, runs, shared_data, 
     out = json.loads(r.stdout)
     assert out["runs"] == 20 and 0 <= out["covered"] <= 5
     assert TrajectoryPredictor.load(tmp_path / "cal.json").time_bounds_.n_runs == 20
+
+
+def test_speed_change_shortens_the_following_legs(model, runs):
+    """A DO_CHANGE_SPEED to twice the speed halves the predicted time of the legs after it."""
+    import pymap3d
+
+    def wp(n: float) -> MissionItem:
+        lat, lon, _ = pymap3d.enu2geodetic(0.0, n, 0.0, 47.0, 8.0, 0.0)
+        return MissionItem(16, 3, lat_deg=float(lat), lon_deg=float(lon), alt_m=30.0)
+
+    legs = (wp(0), wp(100), wp(200), wp(300))
+    home = HomePosition(47.0, 8.0, 400.0)
+    v0 = model.cruise_ms_
+    change = MissionItem(178, 2, params=(1.0, 2 * v0, -1.0, 0.0))
+    plain = build_intent(MissionPlan(items=legs, home=home), model, np.zeros(2), T0, geoid_height_m=47.0)
+    faster = build_intent(
+        MissionPlan(items=(*legs[:2], change, *legs[2:]), home=home),
+        model,
+        np.zeros(2),
+        T0,
+        geoid_height_m=47.0,
+    )
+    d0, d1 = np.diff(plain.t_arrive_s), np.diff(faster.t_arrive_s)
+    assert d1[0] == pytest.approx(d0[0])  # the leg before the change
+    np.testing.assert_allclose(d1[1:], d0[1:] / 2)  # the legs into and after it

@@ -441,8 +441,9 @@ class RoutePoint:
     frame : AltitudeFrame
     hold_s : float — time spent at the point before going on, s (NaN: unknown, a loiter of
         N turns; inf: an unlimited loiter).
-    speed_ms : float or None — commanded horizontal speed from this point on (a
-        ``DO_CHANGE_SPEED`` before it), m/s.
+    speed_ms : float or None — the speed a ``DO_CHANGE_SPEED`` just before this point's item
+        set, m/s: the leg *into* this point flies it (autopilots run a DO command alongside the
+        next navigation command), and so do the following legs until the next change.
     kind : ItemKind — the item that made the point (``TAKEOFF`` for the ground point before a
         take-off, ``LAND`` for the touch-down).
     item : int or None — index of that item in :attr:`MissionPlan.items` (None for points the

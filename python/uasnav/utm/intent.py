@@ -8,7 +8,9 @@ Steps:
 2. Times: the horizontal legs by the trajectory predictor (LVQ element times, wind), climbs
    and descents at the vertical speeds (ArduPilot's defaults ``WPNAV_SPEED_UP`` 2.5 m/s,
    ``WPNAV_SPEED_DN`` 1.5 m/s), a leg that climbs while it moves taking the longer of the
-   two; holds and loiters added at their points.
+   two; holds and loiters added at their points; after a ``DO_CHANGE_SPEED`` the predicted
+   leg times are scaled by (prediction speed ÷ new speed) — first order: the elements' speed
+   changes ΔV stay those predicted at the first speed.
 3. Time bounds: the model's calibrated split-conformal band (:mod:`uasnav.trajectory.timebounds`)
    at the requested coverage, widened by the predictor's flagged elements.
 4. Volumes: each leg is cut into pieces of at most ``piece_m`` metres; a piece's volume is the
@@ -170,8 +172,8 @@ def build_intent(
     keep = np.concatenate([[True], moves])
     route_ne = en[keep][:, ::-1]
     flags: list[list[str]] = []
+    v_ref = float(cruise_ms or plan_cruise_speed(plan) or predictor.cruise_ms_)
     if route_ne.shape[0] >= 2:
-        v_ref = cruise_ms or plan_cruise_speed(plan) or predictor.cruise_ms_
         pred = predictor.predict(route_ne, np.asarray(wind_ne, dtype=float), v_ref)
         t_wp = pred.waypoint_times_s
         el = pred.elements
@@ -185,8 +187,17 @@ def build_intent(
     m = len(pts)
     t_arr = np.zeros(m)
     w = w_wp[hidx]
+    # DO_CHANGE_SPEED: the leg into a point flies the latest speed set before that point; the
+    # predicted leg time is scaled by v_ref / v (first-order: the element dynamics stay those of
+    # v_ref), unless the caller fixed the speed (cruise_ms)
+    v_leg = np.full(m, v_ref)
+    if cruise_ms is None:
+        v = v_ref
+        for i, p in enumerate(pts):
+            v = p.speed_ms if p.speed_ms is not None and i > 0 else v
+            v_leg[i] = v
     for i in range(m - 1):
-        th = float(t_wp[hidx[i + 1]] - t_wp[hidx[i]])
+        th = float(t_wp[hidx[i + 1]] - t_wp[hidx[i]]) * v_ref / v_leg[i + 1]
         dz = z[i + 1] - z[i]
         tz = dz / climb_ms if dz > 0 else -dz / descent_ms
         t_arr[i + 1] = t_arr[i] + pts[i].hold_s + max(th, tz)
