@@ -102,7 +102,7 @@ fn utm_encounters<'py>(
             if brute {
                 brute_force(&v, &s)
             } else {
-                SpaceTimeIndex::new(&v, s).map(|idx| idx.encounters(threads))
+                SpaceTimeIndex::with_threads(&v, s, threads).map(|idx| idx.encounters(threads))
             }
         })
         .map_err(|e| err(py, e))?;

@@ -334,16 +334,18 @@ pub fn brute_force(v: &Volumes<'_>, s: &Search) -> Result<Vec<Encounter>, IndexE
     Ok(out)
 }
 
-/// Grid cell of a coordinate.
-fn cell(x: f64, origin: f64, size: f64) -> i64 {
-    ((x - origin) / size).floor() as i64
+/// Grid cell of a coordinate (`inv` = 1 / cell size: a multiply, not a divide, per call —
+/// the build computes 9 of these per volume). Monotone in x, which is all the owner rule needs.
+fn cell(x: f64, origin: f64, inv: f64) -> i64 {
+    ((x - origin) * inv).floor() as i64
 }
 
 /// The grid: cell sizes, origin and extent (in cells) of the data.
 #[derive(Clone, Copy, Debug)]
 struct Grid {
     origin: [f64; 3],
-    size: [f64; 3],
+    /// 1 / cell size per axis, 1/m, 1/m, 1/s.
+    inv: [f64; 3],
     dims: [u64; 3],
 }
 
@@ -351,8 +353,8 @@ impl Grid {
     fn range(&self, lo: f64, hi: f64, axis: usize) -> (i64, i64) {
         let max = self.dims[axis] as i64 - 1;
         (
-            cell(lo, self.origin[axis], self.size[axis]).clamp(0, max),
-            cell(hi, self.origin[axis], self.size[axis]).clamp(0, max),
+            cell(lo, self.origin[axis], self.inv[axis]).clamp(0, max),
+            cell(hi, self.origin[axis], self.inv[axis]).clamp(0, max),
         )
     }
 
@@ -414,16 +416,29 @@ pub struct SpaceTimeIndex<'a> {
     /// below and the entries use the new numbers.
     order: Vec<u32>,
     rank: Vec<u32>,
-    /// Per volume: its box grown by h/2 horizontally (x0, y0, x1, y1).
-    grown: Vec<[f64; 4]>,
-    time: Vec<[f64; 2]>,
+    /// Per volume, in one cache line: its box grown by h/2 horizontally, its time interval
+    /// and its altitude range (x0, y0, x1, y1, t0, t1, z0, z1) — the whole pre-filter of a
+    /// candidate pair reads two lines and rejects before touching the original arrays.
+    boxes: Vec<[f64; 8]>,
     intent: Vec<u32>,
 }
 
 impl<'a> SpaceTimeIndex<'a> {
-    /// Builds the index for conflicts and near misses within `search`'s buffers.
+    /// Builds the index for conflicts and near misses within `search`'s buffers (this thread).
     pub fn new(volumes: &'a Volumes<'a>, search: Search) -> Result<Self, IndexError> {
+        Self::with_threads(volumes, search, 1)
+    }
+
+    /// Builds the index with up to `threads` threads: the cell entries are split by grid
+    /// column (the most significant part of the key), generated and sorted per column
+    /// range in parallel, then concatenated — the same sorted entries as one thread.
+    pub fn with_threads(
+        volumes: &'a Volumes<'a>,
+        search: Search,
+        threads: usize,
+    ) -> Result<Self, IndexError> {
         search.check()?;
+        let threads = threads.clamp(1, 64);
         if volumes.len() >= u32::MAX as usize {
             return Err(IndexError::Parameter("too many volumes (at most 2³² − 1)"));
         }
@@ -471,22 +486,25 @@ impl<'a> SpaceTimeIndex<'a> {
         };
         let grid = Grid {
             origin: lo,
-            size,
+            inv: size.map(|s| 1.0 / s),
             dims,
         };
         let key_bits = 64 - (dims[0] * dims[1] * dims[2]).leading_zeros();
         // renumber the volumes by their lowest cell (locality of the scans below)
+        let first_cell = |b: &[f64; 4], t: &[f64; 2]| {
+            (
+                grid.range(b[0], b[0], 0).0,
+                grid.range(b[1], b[1], 1).0,
+                grid.range(t[0], t[0], 2).0,
+            )
+        };
         let mut first: Vec<u64> = grown
             .iter()
             .zip(volumes.time.iter())
             .enumerate()
             .map(|(i, (b, t))| {
-                let k = grid.key(
-                    grid.range(b[0], b[0], 0).0,
-                    grid.range(b[1], b[1], 1).0,
-                    grid.range(t[0], t[0], 2).0,
-                );
-                k << 32 | i as u64
+                let (cx, cy, ct) = first_cell(b, t);
+                grid.key(cx, cy, ct) << 32 | i as u64
             })
             .collect();
         radix_sort(&mut first, key_bits.max(1));
@@ -496,29 +514,90 @@ impl<'a> SpaceTimeIndex<'a> {
         for (new, &orig) in order.iter().enumerate() {
             rank[orig as usize] = new as u32;
         }
-        let grown: Vec<[f64; 4]> = order.iter().map(|&o| grown[o as usize]).collect();
-        let time: Vec<[f64; 2]> = order.iter().map(|&o| volumes.time[o as usize]).collect();
+        let boxes: Vec<[f64; 8]> = order
+            .iter()
+            .map(|&o| {
+                let (b, t, z) = (
+                    grown[o as usize],
+                    volumes.time[o as usize],
+                    volumes.alt[o as usize],
+                );
+                [b[0], b[1], b[2], b[3], t[0], t[1], z[0], z[1]]
+            })
+            .collect();
+        drop(grown);
         let intent: Vec<u32> = order.iter().map(|&o| volumes.intent[o as usize]).collect();
-        let mut entries = Vec::with_capacity(volumes.len() * 4);
+        // cell ranges of every volume; the large ones aside
         let mut big = Vec::new();
-        for (i, (b, t)) in grown.iter().zip(&time).enumerate() {
-            let (x0, x1) = grid.range(b[0], b[2], 0);
-            let (y0, y1) = grid.range(b[1], b[3], 1);
-            let (t0, t1) = grid.range(t[0], t[1], 2);
-            let n = ((x1 - x0 + 1) * (y1 - y0 + 1) * (t1 - t0 + 1)) as u64;
-            if n > MAX_CELLS_PER_VOLUME {
-                big.push(i as u32);
-                continue;
+        let spans: Vec<([i64; 6], u64)> = boxes
+            .iter()
+            .enumerate()
+            .filter_map(|(i, b)| {
+                let (x0, x1) = grid.range(b[0], b[2], 0);
+                let (y0, y1) = grid.range(b[1], b[3], 1);
+                let (t0, t1) = grid.range(b[4], b[5], 2);
+                let n = ((x1 - x0 + 1) * (y1 - y0 + 1) * (t1 - t0 + 1)) as u64;
+                if n > MAX_CELLS_PER_VOLUME {
+                    big.push(i as u32);
+                    None
+                } else {
+                    Some(([x0, x1, y0, y1, t0, t1], i as u64))
+                }
+            })
+            .collect();
+        // column ranges [cuts[k], cuts[k+1]) of about equal entry counts, one per thread
+        let dx = dims[0] as i64;
+        let cuts: Vec<i64> = if threads == 1 || spans.len() < 65_536 {
+            vec![0, dx]
+        } else {
+            let mut per_col = vec![0usize; dims[0] as usize];
+            for (s, _) in &spans {
+                per_col[s[0] as usize] += 1;
             }
-            for cx in x0..=x1 {
-                for cy in y0..=y1 {
-                    for ct in t0..=t1 {
-                        entries.push(grid.key(cx, cy, ct) << 32 | i as u64);
+            let mut cuts = vec![0];
+            let mut acc = 0;
+            for (c, n) in per_col.iter().enumerate() {
+                acc += n;
+                if acc * threads >= spans.len() * cuts.len() && cuts.len() < threads {
+                    cuts.push(c as i64 + 1);
+                }
+            }
+            cuts.push(dx);
+            cuts.dedup();
+            cuts
+        };
+        let entries_of = |lo: i64, hi: i64| {
+            let mut entries = Vec::with_capacity(spans.len() * 3 / cuts.len().max(2) + 16);
+            for &(s, i) in &spans {
+                for cx in s[0].max(lo)..=s[1].min(hi - 1) {
+                    for cy in s[2]..=s[3] {
+                        for ct in s[4]..=s[5] {
+                            entries.push(grid.key(cx, cy, ct) << 32 | i);
+                        }
                     }
                 }
             }
-        }
-        radix_sort(&mut entries, key_bits.max(1));
+            radix_sort(&mut entries, key_bits.max(1));
+            entries
+        };
+        let entries = if cuts.len() <= 2 {
+            entries_of(0, dx)
+        } else {
+            let parts: Vec<Vec<u64>> = std::thread::scope(|sc| {
+                let hs: Vec<_> = cuts
+                    .windows(2)
+                    .map(|w| {
+                        let (lo, hi) = (w[0], w[1]);
+                        let f = &entries_of;
+                        sc.spawn(move || f(lo, hi))
+                    })
+                    .collect();
+                hs.into_iter()
+                    .map(|h| h.join().unwrap_or_default())
+                    .collect()
+            });
+            parts.concat()
+        };
         Ok(SpaceTimeIndex {
             volumes,
             search,
@@ -527,8 +606,7 @@ impl<'a> SpaceTimeIndex<'a> {
             big,
             order,
             rank,
-            grown,
-            time,
+            boxes,
             intent,
         })
     }
@@ -540,24 +618,31 @@ impl<'a> SpaceTimeIndex<'a> {
 
     /// The cell key of the lower corner of the intersection of the boxes of `a` and `b`.
     fn owner(&self, a: usize, b: usize) -> u64 {
-        let (ba, bb) = (self.grown[a], self.grown[b]);
-        let (ta, tb) = (self.time[a], self.time[b]);
+        let (ba, bb) = (&self.boxes[a], &self.boxes[b]);
         let g = &self.grid;
         let cx = g.range(ba[0].max(bb[0]), 0.0, 0).0;
         let cy = g.range(ba[1].max(bb[1]), 0.0, 1).0;
-        let ct = g.range(ta[0].max(tb[0]), 0.0, 2).0;
+        let ct = g.range(ba[4].max(bb[4]), 0.0, 2).0;
         g.key(cx, cy, ct)
     }
 
+    /// Whether the grown boxes of `a` and `b` meet and their times overlap.
     fn boxes_meet(&self, a: usize, b: usize) -> bool {
-        let (ba, bb) = (self.grown[a], self.grown[b]);
-        let (ta, tb) = (self.time[a], self.time[b]);
+        let (ba, bb) = (&self.boxes[a], &self.boxes[b]);
         ba[0] <= bb[2]
             && bb[0] <= ba[2]
             && ba[1] <= bb[3]
             && bb[1] <= ba[3]
-            && ta[0] < tb[1]
-            && tb[0] < ta[1]
+            && ba[4] < bb[5]
+            && bb[4] < ba[5]
+    }
+
+    /// [`Self::boxes_meet`] and the altitude gap within the vertical buffer, computed as in
+    /// [`exact`] (same floating-point expression, so never stricter than it).
+    fn may_meet(&self, a: usize, b: usize) -> bool {
+        let (ba, bb) = (&self.boxes[a], &self.boxes[b]);
+        self.boxes_meet(a, b)
+            && (ba[6].max(bb[6]) - ba[7].min(bb[7])).max(0.0) <= self.search.vertical_m
     }
 
     fn groups(&self) -> Vec<(usize, usize)> {
@@ -586,7 +671,7 @@ impl<'a> SpaceTimeIndex<'a> {
                 for &eb in &members[k + 1..] {
                     let b = (eb & 0xffff_ffff) as usize;
                     if self.intent[a] == self.intent[b]
-                        || !self.boxes_meet(a, b)
+                        || !self.may_meet(a, b)
                         || self.owner(a, b) != key
                     {
                         continue;
@@ -648,7 +733,7 @@ impl<'a> SpaceTimeIndex<'a> {
                 if b == a || (b_big && b < a) {
                     continue;
                 }
-                if self.boxes_meet(a, b) {
+                if self.may_meet(a, b) {
                     let (oa, ob) = (self.order[a] as usize, self.order[b] as usize);
                     if let Some(enc) = exact(v, oa, ob, &self.search) {
                         out.push(enc);
@@ -698,7 +783,8 @@ impl<'a> SpaceTimeIndex<'a> {
         let none = Search::default();
         for b in (0..v.len()).filter(|&i| v.intent[i] == intent) {
             let tb = v.time[b];
-            let gb = self.grown[self.rank[b] as usize];
+            let r = &self.boxes[self.rank[b] as usize];
+            let gb = [r[0], r[1], r[2], r[3]];
             for c in self.candidates(gb, tb[0], tb[1] + max_delay_s) {
                 let c = self.order[c as usize] as usize;
                 if v.intent[c] == intent {
