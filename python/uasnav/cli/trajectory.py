@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 import numpy as np
@@ -20,6 +23,9 @@ from uasnav.cli._common import (
     parse_float_list,
 )
 from uasnav.errors import InputError
+
+if TYPE_CHECKING:
+    from uasnav.io.autopilot_limits import AutopilotLimits
 
 
 def parse_wind(text: str) -> np.ndarray:
@@ -185,6 +191,19 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
     )
 
 
+def _log_limits(flights: Sequence[str]) -> AutopilotLimits:
+    """The autopilot limits of the first log among ``flights`` that carries an acceleration
+    limit, completed with the defaults (CSV flights carry no parameters)."""
+    from uasnav.io.autopilot_limits import AutopilotLimits, read_autopilot_limits
+
+    for f in flights:
+        if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg"):
+            lim = read_autopilot_limits(f)
+            if lim.accel_ms2 is not None:
+                return lim.or_defaults()
+    return AutopilotLimits().or_defaults()
+
+
 @command.command("evaluate")
 @click.argument("flights", nargs=-1, type=click.Path(dir_okay=False))
 @_apply(_common_opts)
@@ -224,7 +243,8 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
-            errors = leave_one_run_out(fs, segment, random_state=seed)
+            limits = _log_limits(flights)
+            errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
         for w in caught:
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
         table = {
@@ -243,7 +263,16 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             else {"applicable": False, "reason": e.reason}
             for e in errors
         }
-        out = {"methods": table, "n_runs": len(fs), "n_elements": fs.n_elements}
+        out = {
+            "methods": table,
+            "n_runs": len(fs),
+            "n_elements": fs.n_elements,
+            # the kinematic models' limits: from the logs' parameters, else the stated defaults
+            "limits": {
+                "accel_ms2": limits.accel_ms2,
+                "from_log": "accel_ms2" in limits.source,
+            },
+        }
     if as_json:
         echo_json(out)
         return
