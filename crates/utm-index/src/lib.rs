@@ -527,38 +527,36 @@ impl<'a> SpaceTimeIndex<'a> {
             .collect();
         drop(grown);
         let intent: Vec<u32> = order.iter().map(|&o| volumes.intent[o as usize]).collect();
-        // cell ranges of every volume; the large ones aside
+        // cell ranges of a volume, and whether it is large (kept aside); recomputed where
+        // needed rather than stored: a table of them would be ≈ 100 MB of fresh memory
+        let span = |b: &[f64; 8]| {
+            let (x0, x1) = grid.range(b[0], b[2], 0);
+            let (y0, y1) = grid.range(b[1], b[3], 1);
+            let (t0, t1) = grid.range(b[4], b[5], 2);
+            let n = ((x1 - x0 + 1) * (y1 - y0 + 1) * (t1 - t0 + 1)) as u64;
+            ([x0, x1, y0, y1, t0, t1], n > MAX_CELLS_PER_VOLUME)
+        };
         let mut big = Vec::new();
-        let spans: Vec<([i64; 6], u64)> = boxes
-            .iter()
-            .enumerate()
-            .filter_map(|(i, b)| {
-                let (x0, x1) = grid.range(b[0], b[2], 0);
-                let (y0, y1) = grid.range(b[1], b[3], 1);
-                let (t0, t1) = grid.range(b[4], b[5], 2);
-                let n = ((x1 - x0 + 1) * (y1 - y0 + 1) * (t1 - t0 + 1)) as u64;
-                if n > MAX_CELLS_PER_VOLUME {
-                    big.push(i as u32);
-                    None
-                } else {
-                    Some(([x0, x1, y0, y1, t0, t1], i as u64))
-                }
-            })
-            .collect();
-        // column ranges [cuts[k], cuts[k+1]) of about equal entry counts, one per thread
+        // column ranges [cuts[k], cuts[k+1]) of about equal volume counts, one per thread
         let dx = dims[0] as i64;
-        let cuts: Vec<i64> = if threads == 1 || spans.len() < 65_536 {
-            vec![0, dx]
-        } else {
-            let mut per_col = vec![0usize; dims[0] as usize];
-            for (s, _) in &spans {
+        let mut per_col = vec![0usize; if threads > 1 { dims[0] as usize } else { 0 }];
+        for (i, b) in boxes.iter().enumerate() {
+            let (s, is_big) = span(b);
+            if is_big {
+                big.push(i as u32);
+            } else if threads > 1 {
                 per_col[s[0] as usize] += 1;
             }
+        }
+        let n_small = boxes.len() - big.len();
+        let cuts: Vec<i64> = if threads == 1 || n_small < 65_536 {
+            vec![0, dx]
+        } else {
             let mut cuts = vec![0];
             let mut acc = 0;
             for (c, n) in per_col.iter().enumerate() {
                 acc += n;
-                if acc * threads >= spans.len() * cuts.len() && cuts.len() < threads {
+                if acc * threads >= n_small * cuts.len() && cuts.len() < threads {
                     cuts.push(c as i64 + 1);
                 }
             }
@@ -566,13 +564,18 @@ impl<'a> SpaceTimeIndex<'a> {
             cuts.dedup();
             cuts
         };
+        drop(per_col);
         let entries_of = |lo: i64, hi: i64| {
-            let mut entries = Vec::with_capacity(spans.len() * 3 / cuts.len().max(2) + 16);
-            for &(s, i) in &spans {
+            let mut entries = Vec::with_capacity(n_small * 3 / (cuts.len() - 1).max(1) + 16);
+            for (i, b) in boxes.iter().enumerate() {
+                let (s, is_big) = span(b);
+                if is_big || s[1] < lo || s[0] >= hi {
+                    continue;
+                }
                 for cx in s[0].max(lo)..=s[1].min(hi - 1) {
                     for cy in s[2]..=s[3] {
                         for ct in s[4]..=s[5] {
-                            entries.push(grid.key(cx, cy, ct) << 32 | i);
+                            entries.push(grid.key(cx, cy, ct) << 32 | i as u64);
                         }
                     }
                 }
