@@ -294,3 +294,30 @@ def test_speed_change_shortens_the_following_legs(model, runs):
     d0, d1 = np.diff(plain.t_arrive_s), np.diff(faster.t_arrive_s)
     assert d1[0] == pytest.approx(d0[0])  # the leg before the change
     np.testing.assert_allclose(d1[1:], d0[1:] / 2)  # the legs into and after it
+
+
+def test_cli_intent_limits_from_log(model, shared_data, tmp_path):
+    """--limits-from: the log's WPNAV_SPEED_UP/DN (log171: 400/300 cm/s) replace the default
+    climb/descent rates unless given explicitly; faster vertical limits shorten the intent."""
+    mpath = tmp_path / "m.json"
+    model.save(mpath)
+    plan = shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan"
+    base = ["trajectory", "intent", "--model", str(mpath), "--plan", str(plan), "--wind", "3@45"]
+    base += ["--start", "2026-11-24T12:00:00Z", "--geoid-height", "47.4", "--json"]
+    log = str(shared_data / "logs" / "ardupilot_log171.bin")
+
+    def run(*extra):
+        r = CliRunner().invoke(main, [*base, "--out", str(tmp_path / "i.json"), *extra])
+        assert r.exit_code == 0, r.output
+        return json.loads(r.stdout)
+
+    default = run()
+    assert (default["climb_ms"], default["descent_ms"], default["limits_from_log"]) == (2.5, 1.5, [])
+    logged = run("--limits-from", log)
+    assert (logged["climb_ms"], logged["descent_ms"]) == (4.0, 3.0)
+    assert {"climb_ms", "descent_ms"} <= set(logged["limits_from_log"])
+    assert logged["eta_s"] < default["eta_s"]
+    explicit = run("--limits-from", log, "--climb-rate", "1.0")
+    assert explicit["climb_ms"] == 1.0 and "climb_ms" not in explicit["limits_from_log"]
+    r = CliRunner().invoke(main, [*base, "--out", str(tmp_path / "j.json"), "--limits-from", str(plan)])
+    assert r.exit_code == 1 and "no autopilot parameters" in r.output

@@ -403,6 +403,14 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
 @click.option("--climb-rate", type=POSITIVE, default=2.5, show_default=True, help="Climb speed (m/s).")
 @click.option("--descent-rate", type=POSITIVE, default=1.5, show_default=True, help="Descent speed (m/s).")
 @click.option(
+    "--limits-from",
+    "limits_log",
+    type=click.Path(dir_okay=False),
+    help="Flight log (.tlog .bin .ulg) of the vehicle: its WPNAV_SPEED_UP/DN or MPC_Z_VEL_MAX_UP/DN "
+    "replace the default climb/descent rates, its WPNAV_SPEED or MPC_XY_CRUISE the model's speed "
+    "(explicit options and the plan's own speed win).",
+)
+@click.option(
     "--priority", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="F3548 priority."
 )
 @click.option(
@@ -419,7 +427,7 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
 @click.option("--json", "as_json", is_flag=True, help="Print a machine-readable summary.")
 def intent(  # type: ignore[no-untyped-def]
     model_path, plan_path, wind_text, start_text, coverage, lateral_buffer, vertical_buffer, geoid_height,
-    home_alt, speed, climb_rate, descent_rate, priority, calibration_runs, out, geojson, as_json,
+    home_alt, speed, climb_rate, descent_rate, limits_log, priority, calibration_runs, out, geojson, as_json,
 ):  # fmt: skip
     """An ASTM F3548 operational intent (W84 volumes) whose volumes contain the predicted 4D
     trajectory with its calibrated time bounds and the buffers."""
@@ -438,6 +446,23 @@ def intent(  # type: ignore[no-untyped-def]
     check_outputs([model_path, plan_path], {"--out": out, "--geojson": geojson})
     model = TrajectoryPredictor.load(model_path)
     plan = read_plan(plan_path)
+    from_log: list[str] = []
+    if limits_log:
+        from uasnav.io.autopilot_limits import read_autopilot_limits
+
+        lim = read_autopilot_limits(limits_log)
+        ctx = click.get_current_context()
+        explicit = {
+            n
+            for n in ("climb_rate", "descent_rate")
+            if ctx.get_parameter_source(n) == click.core.ParameterSource.COMMANDLINE
+        }
+        if lim.climb_ms is not None and "climb_rate" not in explicit:
+            climb_rate, from_log = lim.climb_ms, [*from_log, "climb_ms"]
+        if lim.descent_ms is not None and "descent_rate" not in explicit:
+            descent_rate, from_log = lim.descent_ms, [*from_log, "descent_ms"]
+        if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
+            speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
     if model.time_bounds_ is None:
         with click.progressbar(
             length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
@@ -471,6 +496,9 @@ def intent(  # type: ignore[no-untyped-def]
         "waypoint_times_s": b.t_arrive_s,
         "waypoint_bounds_s": [[float(x), float(y)] for x, y in zip(b.t_lo_s, b.t_hi_s, strict=True)],
         "low_confidence_elements": sum(bool(f) for f in b.flags),
+        "climb_ms": climb_rate,
+        "descent_ms": descent_rate,
+        "limits_from_log": from_log,
     }
     if as_json:
         echo_json(summary)
