@@ -337,6 +337,72 @@ def bench_mission(n_uas: int, n_cam: int, repeat: int) -> None:
     )
 
 
+def bench_utm(n_intents: int, n_sub: int, repeat: int) -> None:
+    """Issue 17: all conflicts among seeded synthetic intents (city 30 km, a day, 10–50 volumes
+    each) from arrays in memory: the Rust space-time index (build + exact 4D tests) vs a shapely
+    STRtree implementation and brute force (all pairs, Rust) on a subsample; JSON parsing and
+    the delay search timed separately."""
+    import json
+    import os
+
+    from uasnav.io.operational_intent import NamedIntent, parse_details
+    from uasnav.utm.deconflict import earliest_delays, encounters
+    from uasnav.utm.strtree import strtree_encounters
+    from uasnav.utm.synthetic import subsample, synthetic_intents
+
+    v = synthetic_intents(n_intents, seed=0)
+    pairs = encounters(v)[0]
+    n_conf = len(set(zip(v.intent[pairs[:, 0]].tolist(), v.intent[pairs[:, 1]].tolist(), strict=True)))
+    t1 = median_time(lambda: encounters(v, threads=1), repeat)
+    t2 = median_time(lambda: encounters(v, threads=2), repeat)
+    print(
+        f"utm {n_intents:.0e} intents, {len(v)} volumes: {pairs.shape[0]} conflicting volume pairs, "
+        f"{n_conf} conflicting intent pairs | index 1 thread {t1:6.3f} s, 2 threads {t2:6.3f} s "
+        f"(load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs)"
+    )
+    s = subsample(v, n_sub)
+    t_idx = median_time(lambda: encounters(s, threads=1), repeat)
+    t_tree = median_time(lambda: strtree_encounters(s), 1 if n_sub > 2000 else repeat)
+    t_brute = median_time(lambda: encounters(s, brute=True), 1)
+    same = np.array_equal(encounters(s)[0], strtree_encounters(s)[0]) and np.array_equal(
+        encounters(s)[0], encounters(s, brute=True)[0]
+    )
+    print(
+        f"utm subsample {n_sub} intents, {len(s)} volumes: index {t_idx * 1e3:8.1f} ms | shapely STRtree "
+        f"{t_tree * 1e3:8.1f} ms ({t_tree / t_idx:5.0f}x) | brute force {t_brute * 1e3:9.1f} ms "
+        f"({t_brute / t_idx:6.0f}x) | same pairs: {same}"
+    )
+    # delay search for the later intent of each conflicting pair (separately timed)
+    later = np.unique(np.maximum(v.intent[pairs[:, 0]], v.intent[pairs[:, 1]]))[:1000]
+    t_delay = median_time(lambda: earliest_delays(v, later), 1)
+    print(
+        f"utm delay search: {later.size} intents in {t_delay:6.2f} s "
+        f"({t_delay / max(later.size, 1) * 1e3:.2f} ms each)"
+    )
+    # JSON parsing of F3548 intents (uas-standards types, checked), per intent
+    square = [(47.0, 8.0), (47.0, 8.001), (47.001, 8.001), (47.001, 8.0)]
+    base = json.dumps({
+        "volumes": [{
+            "volume": {
+                "outline_polygon": {"vertices": [{"lat": a, "lng": b} for a, b in square]},
+                "altitude_lower": {"value": 500.0, "reference": "W84", "units": "M"},
+                "altitude_upper": {"value": 520.0, "reference": "W84", "units": "M"},
+            },
+            "time_start": {"value": "2026-11-24T12:00:00Z", "format": "RFC3339"},
+            "time_end": {"value": "2026-11-24T12:01:00Z", "format": "RFC3339"},
+        }] * 30,
+        "priority": 0,
+    })  # fmt: skip
+    n_json = 200
+    t_json = median_time(
+        lambda: [NamedIntent(str(i), parse_details(json.loads(base))) for i in range(n_json)], 1
+    )
+    print(
+        f"utm F3548 JSON parse + check: {t_json / n_json * 1e3:.2f} ms per 30-volume intent "
+        f"(≈ {t_json / n_json * n_intents:.0f} s for {n_intents:.0e} intents)"
+    )
+
+
 CASES: dict[str, Callable[[bool], None]] = {
     "trajectory": lambda quick: bench_trajectory(10**5 if quick else 10**6, 10**4 if quick else 10**5, 3),
     "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
@@ -350,6 +416,7 @@ CASES: dict[str, Callable[[bool], None]] = {
     "noise": lambda quick: bench_noise(0.5 if quick else 2.0, 3 if quick else 5),
     "io": lambda quick: bench_io(10**4 if quick else 10**5, 1 if quick else 3),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
+    "utm": lambda quick: bench_utm(10**4 if quick else 10**5, 500 if quick else 3000, 3),
 }
 
 

@@ -274,3 +274,95 @@ def test_endless_jump_and_model_checks():
         MissionPlan(items=(wp,), cruise_speed_ms=0.0)
     # 0°, 0° on a navigation item means "here": no position
     assert not MissionItem(command=22, frame=3, lat_deg=0.0, lon_deg=0.0, alt_m=10).has_position
+
+
+def test_kml_and_geojson_plans(shared_data, tmp_path):
+    import pymap3d
+
+    kml = read_plan(shared_data / "utm" / "interuss_rid_zurich.kml")
+    # the first LineString (the "Train" track), clampToGround: on the terrain
+    assert len(kml) == 66 and {it.altitude_frame for it in kml.items} == {AltitudeFrame.TERRAIN}
+    assert (kml.items[0].lon_deg, kml.items[0].lat_deg) == (8.5233997, 47.3714318)
+    route, origin = plan_route(kml)
+    n, e, _ = pymap3d.geodetic2ned(47.3716534, 8.5231624, 0.0, *origin)
+    np.testing.assert_allclose(route[1], [n, e], atol=1e-6)
+    from uasnav.io.plan_formats.kml import read_kml
+
+    assert len(read_kml(shared_data / "utm" / "interuss_rid_zurich.kml", name="ETH")) > 2
+    # round trips: an AMSL plan through KML and GeoJSON keeps positions, altitudes and frame
+    amsl = MissionPlan(
+        items=tuple(
+            MissionItem(16, 0, lat_deg=47.0 + 1e-3 * k, lon_deg=8.0, alt_m=500.0 + k) for k in range(3)
+        ),
+        source="a",
+    )
+    for ext in (".kml", ".geojson"):
+        write_plan(amsl, tmp_path / f"p{ext}")
+        back = read_plan(tmp_path / f"p{ext}")
+        assert [(it.lat_deg, it.lon_deg, it.alt_m, it.altitude_frame) for it in back.items] == [
+            (it.lat_deg, it.lon_deg, it.alt_m, AltitudeFrame.AMSL) for it in amsl.items
+        ]
+    rel = read_plan(shared_data / M / "qgc_unittest_missionplanner.waypoints")
+    with pytest.raises(InputError, match="KML holds one altitude frame"):
+        write_plan(rel, tmp_path / "r.kml")
+    write_plan(rel, tmp_path / "r.geojson")  # GeoJSON says "relative" explicitly
+    assert read_plan(tmp_path / "r.geojson").items[0].altitude_frame is AltitudeFrame.RELATIVE
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "match"),
+    [
+        ("x.kml", '<?xml version="1.0"?><!DOCTYPE kml [<!ENTITY a "b">]><kml/>', "DTD"),
+        ("x.kml", "<kml><Placemark>", "malformed XML"),
+        (
+            "x.kml",
+            "<kml><Placemark><LineString><coordinates>8,47,0 8,x</coordinates>"
+            "</LineString></Placemark></kml>",
+            "is not lon,lat",
+        ),
+        ("x.kml", "<kml/>", "no LineString or Point placemark"),
+        (
+            "x.geojson",
+            '{"type": "LineString", "coordinates": [[8, 47, 10], [8.1, 47, 10]]}',
+            "no .altitude_frame",
+        ),
+        ("x.geojson", '{"type": "LineString", "coordinates": [[8, 47], [8.1]]}', r"coordinates\[1\]"),
+        ("x.geojson", '{"type": "Polygon"}', "expected a FeatureCollection"),
+        (
+            "x.geojson",
+            '{"type": "LineString", "altitude_frame": "w84", "coordinates": [[8, 47, 1], [8, 48, 1]]}',
+            "not one of",
+        ),
+    ],
+)
+def test_bad_kml_and_geojson(tmp_path, name, text, match):
+    f = tmp_path / name
+    f.write_text(text)
+    with pytest.raises(DataFormatError, match=match) as ei:
+        read_plan(f)
+    assert name in str(ei.value)
+
+
+def test_plans_embedded_in_logs(shared_data):
+    plan = read_plan(shared_data / "flights" / "phoenix_mission1_arducopter.tlog")
+    # the mission the README describes: take-off to 20 m → waypoint → waypoint → land
+    assert [it.kind for it in plan.items] == [
+        ItemKind.TAKEOFF,
+        ItemKind.WAYPOINT,
+        ItemKind.WAYPOINT,
+        ItemKind.LAND,
+    ]
+    assert plan.items[0].alt_m == 20 and plan.home is not None
+    route, _ = plan_route(plan)
+    assert route.shape == (2, 2) and 95 < float(np.hypot(*route[1])) < 105  # the ~100 m leg
+    # the same waypoints as the flight reader takes from the log
+    from uasnav.io import read_flight
+
+    log = read_flight(shared_data / "flights" / "phoenix_mission1_arducopter.tlog")
+    wps = [log.waypoints[s] for s in sorted(log.waypoints)]
+    np.testing.assert_allclose(
+        [(it.lat_deg, it.lon_deg) for it in plan.items[1:3]], [w[:2] for w in wps], atol=1e-9
+    )
+    # log171 carries only ArduPilot's home item: no mission, said so
+    with pytest.raises(DataFormatError, match="only a home position"):
+        read_plan(shared_data / "logs" / "ardupilot_log171.bin")

@@ -85,6 +85,11 @@ def test_cli_train_predict_evaluate(shared_data, tmp_path):
     assert r.exit_code == 0, r.output
     ev = json.loads(r.output)
     assert ev["n_runs"] == 5 and "distance ÷ speed" in ev["methods"]
+    # the kinematic models use the log's WPNAV_ACCEL (100 cm/s²), and the learned residual is
+    # evaluated beside the plain point mass (issue 17 follow-up)
+    assert ev["limits"] == {"accel_ms2": 1.0, "from_log": True}
+    assert ev["methods"]["kinematic + residual"]["applicable"]
+    assert len(ev["methods"]["kinematic + residual"]["run_e_pct"]) == 5
     # 4D feasibility: the predicted times themselves are feasible, half of them are not.
     times = ",".join(f"{x:.3f}" for x in out["waypoint_times_s"])
     half = ",".join(f"{x / 2:.3f}" for x in out["waypoint_times_s"])

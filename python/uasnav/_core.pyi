@@ -251,3 +251,35 @@ def redundancy_wahba(
     v_ref: NDArray[np.float64], v_sensor: NDArray[np.float64], weights: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """Rotation C (3, 3), reference → sensor, with v_sensor ≈ C·v_ref."""
+
+# --- utm (issue 17): the utm-index crate --------------------------------------------------
+
+def utm_encounters(
+    intent: NDArray[np.uint32],
+    alt: NDArray[np.float64],
+    time: NDArray[np.float64],
+    offsets: NDArray[np.uint64],
+    vertices: NDArray[np.float64],
+    circle: NDArray[np.float64],
+    horizontal_m: float = 0.0,
+    vertical_m: float = 0.0,
+    threads: int = 1,
+    brute: bool = False,
+) -> tuple[NDArray[np.uint32], NDArray[np.float64], NDArray[np.float64]]:
+    """Encounters of volumes of different intents: (pairs (k, 2) volume indices, overlap
+    (k, 2) s, distances (k, 2) horizontal/vertical m). ``brute`` selects the O(n²) reference."""
+
+def utm_earliest_delays(
+    intent: NDArray[np.uint32],
+    alt: NDArray[np.float64],
+    time: NDArray[np.float64],
+    offsets: NDArray[np.uint64],
+    vertices: NDArray[np.float64],
+    circle: NDArray[np.float64],
+    which: NDArray[np.uint32],
+    max_delay_s: float,
+) -> NDArray[np.float64]:
+    """Smallest departure delay (s) of each intent in ``which`` that leaves it free of conflict
+    with every other intent, NaN where none within ``max_delay_s``."""
+
+__all__ += ["utm_earliest_delays", "utm_encounters"]

@@ -10,6 +10,7 @@ mod earth;
 mod errors;
 mod mlp;
 mod redundancy;
+mod utm;
 mod zupt;
 
 use pyo3::prelude::*;
@@ -24,5 +25,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     earth::register(m)?;
     zupt::register(m)?;
     redundancy::register(m)?;
+    utm::register(m)?;
     Ok(())
 }

@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import math
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 import numpy as np
@@ -10,13 +14,18 @@ import numpy as np
 from uasnav.cli._common import (
     NON_NEGATIVE,
     POSITIVE,
+    PROBABILITY,
     SEED,
     OutputPath,
+    Real,
     check_outputs,
     echo_json,
     parse_float_list,
 )
 from uasnav.errors import InputError
+
+if TYPE_CHECKING:
+    from uasnav.io.autopilot_limits import AutopilotLimits
 
 
 def parse_wind(text: str) -> np.ndarray:
@@ -182,6 +191,19 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
     )
 
 
+def _log_limits(flights: Sequence[str]) -> AutopilotLimits:
+    """The autopilot limits of the first log among ``flights`` that carries an acceleration
+    limit, completed with the defaults (CSV flights carry no parameters)."""
+    from uasnav.io.autopilot_limits import AutopilotLimits, read_autopilot_limits
+
+    for f in flights:
+        if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg"):
+            lim = read_autopilot_limits(f)
+            if lim.accel_ms2 is not None:
+                return lim.or_defaults()
+    return AutopilotLimits().or_defaults()
+
+
 @command.command("evaluate")
 @click.argument("flights", nargs=-1, type=click.Path(dir_okay=False))
 @_apply(_common_opts)
@@ -216,20 +238,41 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         if not flights:
             raise click.UsageError("give FLIGHT files or --simulated")
         wind = parse_wind(wind_text) if wind_text else None
-        fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
+        # warnings (telemetry gaps) are shown once the evaluation succeeded: a failed run
+        # prints its one error line only
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
+            limits = _log_limits(flights)
+            errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
+        for w in caught:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
         table = {
             e.name: {
                 "applicable": True,
                 "element_e_pct_mean": float(np.mean(e.element_pct)),
                 "element_e_pct_median": float(np.median(e.element_pct)),
                 "run_e_pct_mean": float(np.mean(e.run_pct)),
+                # per-run ETA error |e%|: median, 95th percentile, worst (issue 17)
+                "run_abs_e_pct_median": float(np.median(np.abs(e.run_pct))),
+                "run_abs_e_pct_p95": float(np.percentile(np.abs(e.run_pct), 95)),
+                "run_abs_e_pct_worst": float(np.max(np.abs(e.run_pct))),
                 "run_e_pct": list(e.run_pct),
             }
             if e.applicable
             else {"applicable": False, "reason": e.reason}
-            for e in leave_one_run_out(fs, segment, random_state=seed)
+            for e in errors
         }
-        out = {"methods": table, "n_runs": len(fs), "n_elements": fs.n_elements}
+        out = {
+            "methods": table,
+            "n_runs": len(fs),
+            "n_elements": fs.n_elements,
+            # the kinematic models' limits: from the logs' parameters, else the stated defaults
+            "limits": {
+                "accel_ms2": limits.accel_ms2,
+                "from_log": "accel_ms2" in limits.source,
+            },
+        }
     if as_json:
         echo_json(out)
         return
@@ -237,10 +280,230 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         if not d["applicable"]:
             click.echo(f"{name:24s} not applicable: {d['reason']}")
             continue
-        extra = f"  run e% {d['run_e_pct_mean']:6.2f}" if "run_e_pct_mean" in d else ""
+        extra = (
+            f"  run |e%| median {d['run_abs_e_pct_median']:6.2f} p95 {d['run_abs_e_pct_p95']:6.2f} "
+            f"worst {d['run_abs_e_pct_worst']:6.2f}"
+            if "run_abs_e_pct_median" in d
+            else ""
+        )
         click.echo(f"{name:24s} element e% mean {d['element_e_pct_mean']:6.2f}{extra}")
     for row in out.get("table17", []):
         click.echo(
             f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
             + ", ".join(f"{x:.2f}" for x in row["t_real_s"])
         )
+
+
+@command.command("calibrate")
+@click.option(
+    "--model", "model_path", required=True, type=click.Path(dir_okay=False), help="Model JSON (from train)."
+)
+@click.option(
+    "--out", "out", required=True, type=OutputPath(), help="Model JSON to write, with its time bounds."
+)
+@click.option(
+    "--runs",
+    type=click.IntRange(20, 100_000),
+    default=200,
+    show_default=True,
+    help="Simulated calibration runs.",
+)
+@click.option(
+    "--test-runs",
+    type=click.IntRange(0, 100_000),
+    default=0,
+    show_default=True,
+    help="Held-out simulated runs to report the coverage on.",
+)
+@click.option(
+    "--coverage",
+    type=PROBABILITY,
+    default=0.95,
+    show_default=True,
+    help="Coverage reported for the held-out runs.",
+)
+@click.option("--seed", type=SEED, default=0, show_default=True)
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # type: ignore[no-untyped-def]
+    """Calibrate the time bounds of a model (split-conformal on simulated runs with truth)."""
+    from uasnav.trajectory.calibration import calibrate as fit_bounds
+    from uasnav.trajectory.calibration import covered, simulated_runs
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+    from uasnav.trajectory.timebounds import clopper_pearson
+
+    check_outputs([model_path], {"--out": out})
+    model = TrajectoryPredictor.load(model_path)
+    with click.progressbar(
+        length=runs + test_runs, label="simulated runs", file=click.get_text_stream("stderr")
+    ) as bar:
+        cal = simulated_runs(model, runs, seed=2 * seed, progress=lambda i, n: bar.update(1))
+        test = simulated_runs(model, test_runs, seed=2 * seed + 1, progress=lambda i, n: bar.update(1))
+    model.time_bounds_ = fit_bounds(cal, source=f"{runs} simulated runs, seed {seed}")
+    q = model.time_bounds_.quantile(coverage)
+    res = {"runs": runs, "coverage": coverage, "quantile": q, "tau_s": model.time_bounds_.tau_s}
+    if test_runs:
+        k = sum(covered(model.time_bounds_, r, coverage) for r in test)
+        lo, hi = clopper_pearson(k, test_runs)
+        res |= {"test_runs": test_runs, "covered": k, "covered_ci95": [lo, hi]}
+    model.save(out)
+    if as_json:
+        echo_json(res)
+        return
+    click.echo(
+        f"time bounds: ±{q:.3f}·(t + {model.time_bounds_.tau_s:g} s) at {coverage:.0%} coverage, {runs} runs"
+    )
+    if test_runs:
+        click.echo(
+            f"held-out coverage {res['covered']}/{test_runs} (Clopper–Pearson 95 %: {lo:.3f}–{hi:.3f})"
+        )
+
+
+@command.command("intent")
+@click.option(
+    "--model",
+    "model_path",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="Model JSON (from train/calibrate).",
+)
+@click.option(
+    "--plan",
+    "plan_path",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="Plan: .plan, .waypoints, .csv.",
+)
+@click.option("--wind", "wind_text", required=True, help="SPEED@DIR: m/s @ degrees the wind comes from.")
+@click.option(
+    "--start",
+    "start_text",
+    required=True,
+    help="Departure time, ISO 8601 with a zone (2026-05-01T09:30:00Z).",
+)
+@click.option(
+    "--coverage", type=PROBABILITY, default=0.95, show_default=True, help="Coverage of the time bounds."
+)
+@click.option(
+    "--lateral-buffer",
+    type=POSITIVE,
+    default=15.0,
+    show_default=True,
+    help="Horizontal buffer around the path (m).",
+)
+@click.option(
+    "--vertical-buffer", type=NON_NEGATIVE, default=10.0, show_default=True, help="Vertical buffer (m)."
+)
+@click.option(
+    "--geoid-height",
+    type=Real(-120.0, 120.0),
+    help="Geoid height N at the site (m; W84 = AMSL + N). Required.",
+)
+@click.option("--home-alt", type=Real(-1000.0, 9000.0), help="Home altitude AMSL (m) if the plan has none.")
+@click.option("--speed", type=POSITIVE, help="Horizontal speed (m/s); default the plan's, else the model's.")
+@click.option("--climb-rate", type=POSITIVE, default=2.5, show_default=True, help="Climb speed (m/s).")
+@click.option("--descent-rate", type=POSITIVE, default=1.5, show_default=True, help="Descent speed (m/s).")
+@click.option(
+    "--limits-from",
+    "limits_log",
+    type=click.Path(dir_okay=False),
+    help="Flight log (.tlog .bin .ulg) of the vehicle: its WPNAV_SPEED_UP/DN or MPC_Z_VEL_MAX_UP/DN "
+    "replace the default climb/descent rates, its WPNAV_SPEED or MPC_XY_CRUISE the model's speed "
+    "(explicit options and the plan's own speed win).",
+)
+@click.option(
+    "--priority", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="F3548 priority."
+)
+@click.option(
+    "--calibration-runs",
+    type=click.IntRange(20, 100_000),
+    default=200,
+    show_default=True,
+    help="Runs to calibrate a model without time bounds.",
+)
+@click.option(
+    "--out", "out", required=True, type=OutputPath(), help="F3548 OperationalIntentDetails JSON to write."
+)
+@click.option("--geojson", "geojson", type=OutputPath(), help="Also write the volumes and route as GeoJSON.")
+@click.option("--json", "as_json", is_flag=True, help="Print a machine-readable summary.")
+def intent(  # type: ignore[no-untyped-def]
+    model_path, plan_path, wind_text, start_text, coverage, lateral_buffer, vertical_buffer, geoid_height,
+    home_alt, speed, climb_rate, descent_rate, limits_log, priority, calibration_runs, out, geojson, as_json,
+):  # fmt: skip
+    """An ASTM F3548 operational intent (W84 volumes) whose volumes contain the predicted 4D
+    trajectory with its calibrated time bounds and the buffers."""
+    import pymap3d
+
+    from uasnav.cli.utm import parse_time
+    from uasnav.io.operational_intent import write_intent, write_intent_geojson
+    from uasnav.io.plans import plan_cruise_speed, read_plan
+    from uasnav.trajectory.calibration import calibrate as fit_bounds
+    from uasnav.trajectory.calibration import simulated_runs
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+    from uasnav.utm.intent import build_intent
+
+    wind = parse_wind(wind_text)
+    start = parse_time(start_text, "--start")
+    check_outputs([model_path, plan_path], {"--out": out, "--geojson": geojson})
+    model = TrajectoryPredictor.load(model_path)
+    plan = read_plan(plan_path)
+    from_log: list[str] = []
+    if limits_log:
+        from uasnav.io.autopilot_limits import read_autopilot_limits
+
+        lim = read_autopilot_limits(limits_log)
+        ctx = click.get_current_context()
+        explicit = {
+            n
+            for n in ("climb_rate", "descent_rate")
+            if ctx.get_parameter_source(n) == click.core.ParameterSource.COMMANDLINE
+        }
+        if lim.climb_ms is not None and "climb_rate" not in explicit:
+            climb_rate, from_log = lim.climb_ms, [*from_log, "climb_ms"]
+        if lim.descent_ms is not None and "descent_rate" not in explicit:
+            descent_rate, from_log = lim.descent_ms, [*from_log, "descent_ms"]
+        if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
+            speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
+    if model.time_bounds_ is None:
+        with click.progressbar(
+            length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
+        ) as bar:
+            # calibrated at the speed this mission flies (the band depends on it)
+            v = speed or plan_cruise_speed(plan) or model.cruise_ms_
+            runs = simulated_runs(model, calibration_runs, progress=lambda i, n: bar.update(1), cruise_ms=v)
+        model.time_bounds_ = fit_bounds(
+            runs, source=f"{calibration_runs} simulated runs at {v:g} m/s, seed 0"
+        )
+    b = build_intent(
+        plan, model, wind, start, coverage=coverage, lateral_buffer_m=lateral_buffer,
+        vertical_buffer_m=vertical_buffer, geoid_height_m=geoid_height, home_amsl_m=home_alt,
+        climb_ms=climb_rate, descent_ms=descent_rate, cruise_ms=speed, priority=priority,
+    )  # fmt: skip
+    write_intent(b.details, out)
+    if geojson:
+        la, lo, _ = pymap3d.enu2geodetic(
+            b.route_en[:, 0], b.route_en[:, 1], 0.0, b.origin[0], b.origin[1], 0.0
+        )
+        write_intent_geojson(
+            b.details,
+            geojson,
+            [(float(x), float(y), float(z)) for x, y, z in zip(la, lo, b.route_alt_w84, strict=True)],
+        )
+    summary = {
+        "volumes": len(b.details.volumes),
+        "eta_s": b.eta_s,
+        "eta_bounds_s": list(b.eta_bounds_s),
+        "coverage": coverage,
+        "waypoint_times_s": b.t_arrive_s,
+        "waypoint_bounds_s": [[float(x), float(y)] for x, y in zip(b.t_lo_s, b.t_hi_s, strict=True)],
+        "low_confidence_elements": sum(bool(f) for f in b.flags),
+        "climb_ms": climb_rate,
+        "descent_ms": descent_rate,
+        "limits_from_log": from_log,
+    }
+    if as_json:
+        echo_json(summary)
+        return
+    click.echo(
+        f"{len(b.details.volumes)} volumes; ETA {b.eta_s:.0f} s "
+        f"({b.eta_bounds_s[0]:.0f}–{b.eta_bounds_s[1]:.0f} s at {coverage:.0%}); wrote {out}"
+    )

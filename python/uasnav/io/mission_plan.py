@@ -428,3 +428,111 @@ __all__ = [
     "plan_route",
     "route_items",
 ]
+
+
+@dataclass(frozen=True)
+class RoutePoint:
+    """A point of the 3D route a plan flies (:func:`route_points`).
+
+    Attributes
+    ----------
+    lat_deg, lon_deg : float — WGS-84 position, degrees.
+    alt_m : float — altitude in ``frame``, m.
+    frame : AltitudeFrame
+    hold_s : float — time spent at the point before going on, s (NaN: unknown, a loiter of
+        N turns; inf: an unlimited loiter).
+    speed_ms : float or None — the speed a ``DO_CHANGE_SPEED`` just before this point's item
+        set, m/s: the leg *into* this point flies it (autopilots run a DO command alongside the
+        next navigation command), and so do the following legs until the next change.
+    kind : ItemKind — the item that made the point (``TAKEOFF`` for the ground point before a
+        take-off, ``LAND`` for the touch-down).
+    item : int or None — index of that item in :attr:`MissionPlan.items` (None for points the
+        route adds: the ground before take-off, the touch-down below a land or RTL point).
+    """
+
+    lat_deg: float
+    lon_deg: float
+    alt_m: float
+    frame: AltitudeFrame
+    hold_s: float = 0.0
+    speed_ms: float | None = None
+    kind: ItemKind = ItemKind.WAYPOINT
+    item: int | None = None
+
+
+def route_points(plan: MissionPlan) -> list[RoutePoint]:
+    """The 3D route of a geodetic plan in flown order (``DO_JUMP`` expanded).
+
+    * A take-off climbs from the ground (0 m relative to home) at the home position — or at
+      its own position if it has one — to its altitude.
+    * Waypoints and loiters are flown to; their hold/loiter time is :attr:`RoutePoint.hold_s`.
+    * A land item flies to its position (if any) at the current altitude, then descends to the
+      ground (0 m relative to home); return-to-launch flies to home at the current altitude
+      and lands there.
+    * A ``DO_CHANGE_SPEED`` sets :attr:`RoutePoint.speed_ms` of the next point.
+
+    Raises :class:`InputError` for a local plan, a plan without positioned items, or a take-off
+    or return whose position is unknown (no home position and no item position).
+    """
+    if plan.is_local:
+        raise InputError(f"{plan.source}: a local north/east plan has no geodetic route")
+    rel = AltitudeFrame.RELATIVE
+    out: list[RoutePoint] = []
+    speed: float | None = None
+    home = plan.home
+
+    def last() -> RoutePoint:
+        if not out:
+            raise InputError(f"{plan.source}: the route starts with an item that has no position")
+        return out[-1]
+
+    for i in flight_sequence(plan):
+        it = plan.items[i]
+        if it.speed_ms is not None:
+            speed = it.speed_ms
+            continue
+        k = it.kind
+        if k is ItemKind.TAKEOFF:
+            if it.has_position:
+                la, lo = it.lat_deg, it.lon_deg
+            elif home is not None:
+                la, lo = home.lat_deg, home.lon_deg
+            elif out:
+                la, lo = out[-1].lat_deg, out[-1].lon_deg
+            else:
+                raise InputError(f"{plan.source}: item {i}: take-off without a position and no home position")
+            if not out:
+                out.append(RoutePoint(la, lo, 0.0, rel, kind=ItemKind.TAKEOFF))
+            out.append(RoutePoint(la, lo, it.alt_m, it.altitude_frame, speed_ms=speed, kind=k, item=i))
+            speed = None
+        elif k in (ItemKind.WAYPOINT, ItemKind.LOITER) and it.has_position:
+            out.append(
+                RoutePoint(it.lat_deg, it.lon_deg, it.alt_m, it.altitude_frame, it.hold_s, speed, k, i)
+            )
+            speed = None
+        elif k is ItemKind.LAND:
+            p = last()
+            la, lo = (it.lat_deg, it.lon_deg) if it.has_position else (p.lat_deg, p.lon_deg)
+            if it.has_position:
+                out.append(
+                    RoutePoint(la, lo, p.alt_m, p.frame, speed_ms=speed, kind=ItemKind.WAYPOINT, item=i)
+                )
+                speed = None
+            out.append(RoutePoint(la, lo, 0.0, rel, kind=ItemKind.LAND, item=i))
+        elif k is ItemKind.RETURN:
+            if home is None:
+                raise InputError(
+                    f"{plan.source}: item {i}: return to launch but the plan has no home position"
+                )
+            p = last()
+            out.append(
+                RoutePoint(home.lat_deg, home.lon_deg, p.alt_m, p.frame, speed_ms=speed, kind=k, item=i)
+            )
+            out.append(RoutePoint(home.lat_deg, home.lon_deg, 0.0, rel, kind=ItemKind.LAND))
+            speed = None
+    if len(out) < 2:
+        raise InputError(f"{plan.source}: the plan has no route (fewer than two positioned points)")
+    return out
+
+
+__all__ += ["RoutePoint", "route_points"]

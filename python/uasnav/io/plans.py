@@ -1,13 +1,18 @@
 """Mission plans: read and write every plan format into one typed :class:`MissionPlan`.
 
->>> from uasnav.io.plans import read_plan, plan_route    # doctest: +SKIP
->>> plan = read_plan("survey.plan")                      # doctest: +SKIP
->>> route_ne, origin = plan_route(plan)                  # doctest: +SKIP
+Usage (``survey.plan`` being any plan file)::
+
+    from uasnav.io.plans import read_plan, plan_route
+    plan = read_plan("survey.plan")
+    route_ne, origin = plan_route(plan)
 
 The format follows the extension (:data:`PLAN_READERS`): QGroundControl ``.plan`` (JSON),
-Mission Planner ``.waypoints`` / ``.txt`` (``QGC WPL 110``) and uasnav's plan ``.csv``
-(``lat,lon[,alt]`` or ``north,east``). Writers are atomic and round-trip their own format
-item for item. The model (items, altitude frames, command kinds, home position, speed changes,
+Mission Planner ``.waypoints`` / ``.txt`` (``QGC WPL 110``), uasnav's plan ``.csv``
+(``lat,lon[,alt]`` or ``north,east``), KML (``.kml``: a LineString or Point placemarks) and
+GeoJSON (``.geojson``: a LineString or Points, with an explicit ``altitude_frame``), and the
+plan embedded in a log (``.tlog`` MISSION_ITEM(_INT), ``.bin`` DataFlash CMD). Writers
+are atomic and round-trip their own format item for item (KML and GeoJSON: the positioned
+waypoints only). The model (items, altitude frames, command kinds, home position, speed changes,
 loiter times) is :mod:`uasnav.io.mission_plan`; :func:`plan_route` turns a plan into the
 horizontal route (north/east m) that :class:`~uasnav.trajectory.predictor.TrajectoryPredictor`
 predicts, and :func:`plan_cruise_speed` gives the speed the plan commands.
@@ -38,6 +43,9 @@ from uasnav.io.mission_plan import (
     plan_route,
 )
 from uasnav.io.plan_formats.csv_plan import read_plan_csv, write_plan_csv
+from uasnav.io.plan_formats.geojson import read_geojson, write_geojson
+from uasnav.io.plan_formats.kml import read_kml, write_kml
+from uasnav.io.plan_formats.logs import read_dataflash_plan, read_tlog_plan
 from uasnav.io.plan_formats.qgc import read_qgc_plan, write_qgc_plan
 from uasnav.io.plan_formats.source import MAX_PLAN_BYTES
 from uasnav.io.plan_formats.wpl import read_wpl, write_wpl
@@ -48,6 +56,10 @@ PLAN_READERS: dict[str, Callable[[str | os.PathLike[str]], MissionPlan]] = {
     ".waypoints": read_wpl,
     ".txt": read_wpl,
     ".csv": read_plan_csv,
+    ".kml": read_kml,
+    ".geojson": read_geojson,
+    ".tlog": read_tlog_plan,
+    ".bin": read_dataflash_plan,
 }
 #: Extension → writer.
 PLAN_WRITERS: dict[str, Callable[[MissionPlan, str | os.PathLike[str]], None]] = {
@@ -55,6 +67,8 @@ PLAN_WRITERS: dict[str, Callable[[MissionPlan, str | os.PathLike[str]], None]] =
     ".waypoints": write_wpl,
     ".txt": write_wpl,
     ".csv": write_plan_csv,
+    ".kml": write_kml,
+    ".geojson": write_geojson,
 }
 PLAN_EXTENSIONS = tuple(PLAN_READERS)
 

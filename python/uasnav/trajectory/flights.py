@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import InputError
+from uasnav.io.autopilot_limits import DEFAULT_LIMITS
 from uasnav.trajectory.baselines import evaluate_methods, kinematic_times
 from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, discretise, geodetic_to_local
 from uasnav.trajectory.plans import read_plan
@@ -140,11 +141,18 @@ class RunErrors:
 
 
 def leave_one_run_out(
-    flights: FlightSamples, segment_m: float = DEFAULT_SEGMENT_M, random_state: int = 0
+    flights: FlightSamples,
+    segment_m: float = DEFAULT_SEGMENT_M,
+    random_state: int = 0,
+    accel_ms2: float = DEFAULT_LIMITS.accel_ms2 or 1.0,
 ) -> list[RunErrors]:
     """Predict each run with every method trained on the other runs.
 
-    The kinematic point mass is included for runs cut from a mission (it needs the plan).
+    The kinematic point mass (acceleration limit ``accel_ms2``, m/s²: the vehicle's
+    ``WPNAV_ACCEL``/``MPC_ACC_HOR`` when its log carries it, see
+    :func:`uasnav.io.autopilot_limits.read_autopilot_limits`) is included when every run is cut
+    from a mission (it needs the plan), and with it the kinematic model plus a residual learned
+    on the other runs.
 
     Returns
     -------
@@ -159,21 +167,35 @@ def leave_one_run_out(
     samples = flights.samples
     if len(samples) < 2:
         raise InputError("leave-one-run-out needs at least two mission runs")
+    if not (np.isfinite(accel_ms2) and accel_ms2 > 0):
+        raise InputError(f"acceleration limit must be finite and > 0 m/s², got {accel_ms2}")
     per: dict[str, tuple[list[float], list[float]]] = {}
     reasons: dict[str, str] = {}
+    kins: list[np.ndarray | None] = []
+    for (_, run), s in zip(flights.runs, samples, strict=True):
+        if run is None:
+            kins.append(None)
+            continue
+        el = discretise(run.plan_ne, segment_m)
+        kins.append(
+            kinematic_times(
+                run.plan_ne,
+                el.s_start_m[s.element],
+                el.s_start_m[s.element] + s.length_m,
+                s.v_ref_ms[0],
+                accel_ms2=accel_ms2,
+            )
+        )
     for k, test in enumerate(samples):
         train = ElementSamples.concat([s for i, s in enumerate(samples) if i != k])
-        _, run = flights.runs[k]
-        kin = None
-        if run is not None:
-            el = discretise(run.plan_ne, segment_m)
-            kin = kinematic_times(
-                run.plan_ne,
-                el.s_start_m[test.element],
-                el.s_start_m[test.element] + test.length_m,
-                test.v_ref_ms[0],
-            )
-        for m in evaluate_methods(train, test, kinematic_s=kin, random_state=random_state):
+        kin = kins[k]
+        others = [x for i, x in enumerate(kins) if i != k]
+        kin_train: np.ndarray | None = None
+        if kin is not None and all(x is not None for x in others):
+            kin_train = np.concatenate([x for x in others if x is not None])
+        for m in evaluate_methods(
+            train, test, kinematic_s=kin, random_state=random_state, kinematic_train_s=kin_train
+        ):
             element, whole = per.setdefault(m.name, ([], []))
             if not m.applicable:
                 # One fold the method cannot be fitted in makes the whole comparison unfair

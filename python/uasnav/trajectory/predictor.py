@@ -26,6 +26,7 @@ from uasnav.trajectory.features import N_CELLS, WIND_MAX_MS, Features, cell_inde
 from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, Elements, discretise
 from uasnav.trajectory.lvq import LVQClassifier
 from uasnav.trajectory.samples import ElementSamples
+from uasnav.trajectory.timebounds import TimeBounds
 
 MODEL_FORMAT = "uasnav-trajectory-lvq/1"
 _N_TABLE = 3 * N_CELLS
@@ -157,6 +158,9 @@ class TrajectoryPredictor:
             raise InputError(str(e)) from None
         if len(samples) == 0:
             raise InputError("no training elements")
+        # calibrated time bounds belong to one fitted model: set after fitting
+        # (:mod:`uasnav.trajectory.calibration`), saved with it
+        self.time_bounds_: TimeBounds | None = None
         good = np.isfinite(samples.dv_ms)
         if not good.all():
             raise InputError(f"{int((~good).sum())} training element(s) have a NaN ΔV")
@@ -325,6 +329,9 @@ class TrajectoryPredictor:
             "dv_table_ms": {str(c): float(self.dv_table_[c]) for c in np.flatnonzero(self.count_table_)},
             "count_table": {str(c): int(self.count_table_[c]) for c in np.flatnonzero(self.count_table_)},
         }
+        bounds = getattr(self, "time_bounds_", None)
+        if bounds is not None:
+            d["time_bounds"] = bounds.to_dict()
         if self.lvq_ is not None:
             d["lvq"] = {
                 "classes": self.lvq_.classes_.tolist(),
@@ -398,6 +405,7 @@ class TrajectoryPredictor:
             self.single_cell_ = jc.integer(d["single_cell"], "single_cell", lo=lab_lo, hi=lab_hi)
             if self.labels_.tolist() != [self.single_cell_]:
                 raise jc.fail("single_cell", f"{self.single_cell_} is not the one class of label_dv_ms")
+        self.time_bounds_ = _time_bounds(d["time_bounds"]) if "time_bounds" in d else None
         return self
 
     @classmethod
@@ -415,8 +423,17 @@ _PARAM_KEYS = (
 )  # fmt: skip
 _FILE_KEYS = (
     "format", "params", "label_dv_ms", "cruise_ms", "wind_range_ms", "n_train", "dv_global_ms",
-    "dv_table_ms", "count_table", "lvq", "single_cell",
+    "dv_table_ms", "count_table", "lvq", "single_cell", "time_bounds",
 )  # fmt: skip
+
+
+def _time_bounds(x: object) -> TimeBounds:
+    """The optional ``time_bounds`` of a model file (:mod:`uasnav.trajectory.timebounds`)."""
+    d = jc.only(jc.obj(x, "time_bounds"), ("scores", "tau_s", "source"), "time_bounds")
+    scores = jc.vector(jc.field(d, "scores", "time_bounds"), "time_bounds.scores", lo=0.0, hi=1e6)
+    tau = jc.number(jc.field(d, "tau_s", "time_bounds"), "time_bounds.tau_s", lo=0.0, hi=1e6, unit="s")
+    source = jc.string(d.get("source", ""), "time_bounds.source")
+    return TimeBounds(scores, tau, source)
 
 
 def _check_params(p: dict[str, Any], path: str = "") -> dict[str, Any]:

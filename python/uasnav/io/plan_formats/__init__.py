@@ -6,5 +6,7 @@ extension                  module                                       reader /
 ``.plan``                  :mod:`~uasnav.io.plan_formats.qgc`           QGroundControl JSON
 ``.waypoints`` ``.txt``    :mod:`~uasnav.io.plan_formats.wpl`           QGC WPL 110
 ``.csv``                   :mod:`~uasnav.io.plan_formats.csv_plan`      uasnav plan CSV
+``.kml``                   :mod:`~uasnav.io.plan_formats.kml`           KML LineString/Points
+``.geojson``               :mod:`~uasnav.io.plan_formats.geojson`       GeoJSON LineString/Points
 ========================== ============================================ ===================
 """

@@ -1,0 +1,305 @@
+"""ASTM F3548-21 operational intents as JSON, typed with the ``uas-standards`` package.
+
+The types are the field's own (``uas_standards.astm.f3548.v21.api``): an
+``OperationalIntentDetails`` (``volumes``, ``off_nominal_volumes``, ``priority``) of
+``Volume4D`` (a ``Volume3D`` — one outline, polygon or circle, between ``altitude_lower`` and
+``altitude_upper`` — alive from ``time_start`` to ``time_end``). ``ImplicitDict.parse`` checks
+the types (numbers, enums such as the ``W84`` altitude reference, RFC 3339 times);
+:func:`check_details` then checks what the standard states in words and the types cannot:
+exactly one outline per volume, a polygon of at least 3 distinct vertices whose edges do not
+cross, a positive radius in metres, finite latitudes/longitudes within range, both altitudes
+and both times present, lower ≤ upper and start < end.
+
+Files read (:func:`read_intents`): an ``OperationalIntentDetails`` object, a full
+``OperationalIntent`` (``{"reference": …, "details": …}``; only the details are used), or
+``{"intents": {name: details, …}}`` holding several; InterUSS flight-intent templates (YAML)
+are read by :mod:`uasnav.io.interuss`. Every error names the file and the JSON path.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass
+from datetime import datetime, timedelta, timezone
+from typing import Any
+
+import numpy as np
+
+from uasnav import jsoncheck as jc
+from uasnav.atomicfile import atomic_write_text
+from uasnav.errors import DataFormatError, InputError
+
+#: Largest intent file read (bytes).
+MAX_INTENT_BYTES = 64 * 2**20
+#: F3548 ``OiMaxPlanHorizon``: an intent may not start more than 30 days ahead.
+MAX_PLAN_HORIZON = timedelta(days=30)
+#: F3548 ``TimeSyncMaxDifferentialSeconds``: clocks may differ by 5 s, so an intent whose end
+#: is 5 s or more in the past has ended.
+TIME_SYNC_TOLERANCE = timedelta(seconds=5)
+#: Altitude bounds F3548 data may hold, m (W84).
+ALTITUDE_RANGE_M = (-8000.0, 100_000.0)
+
+
+def _api() -> Any:
+    from uas_standards.astm.f3548.v21 import api
+
+    return api
+
+
+@dataclass(frozen=True)
+class NamedIntent:
+    """An operational intent and the name it goes by in messages (file name, template key).
+
+    ``details`` is a ``uas_standards.astm.f3548.v21.api.OperationalIntentDetails``.
+    """
+
+    name: str
+    details: Any
+    source: str = "<intent>"
+
+
+def parse_details(d: object, where: str = "") -> Any:
+    """An ``OperationalIntentDetails`` from JSON data, type- and rule-checked (see module).
+
+    Raises :class:`DataFormatError` naming the JSON path below ``where``.
+    """
+    from implicitdict import ImplicitDict
+
+    api = _api()
+    obj = jc.obj(d, where or "intent")
+    try:
+        details = ImplicitDict.parse(obj, api.OperationalIntentDetails)
+    except (ValueError, TypeError, KeyError, OverflowError) as e:
+        msg = str(e)
+        if msg.startswith("At "):  # ImplicitDict names the path: "At volumes[0].…: problem"
+            path, _, problem = msg[3:].partition(": ")
+            raise jc.fail(f"{where}.{path}" if where else path, problem) from None
+        raise jc.fail(
+            where or "intent", f"not an F3548 OperationalIntentDetails ({type(e).__name__}: {msg})"
+        ) from None
+    except Exception as e:  # dateutil's ParserError etc.: a malformed value
+        msg = str(e)
+        path, _, problem = msg[3:].partition(": ") if msg.startswith("At ") else ("", "", msg)
+        raise jc.fail(f"{where}.{path}".strip(".") or "intent", problem or type(e).__name__) from None
+    check_details(details, where)
+    return details
+
+
+def _finite(x: float, path: str, lo: float, hi: float, unit: str) -> float:
+    v = float(x)
+    if not (math.isfinite(v) and lo <= v <= hi):
+        raise jc.fail(path, f"{x!r} {unit} outside [{lo:g}, {hi:g}] {unit}")
+    return v
+
+
+def check_volume(v: Any, path: str) -> None:
+    """The F3548 rules of one ``Volume4D`` that its types do not enforce (see module)."""
+    vol = v.volume
+    poly, circ = vol.get("outline_polygon"), vol.get("outline_circle")
+    if (poly is None) == (circ is None):
+        raise jc.fail(f"{path}.volume", "exactly one of outline_polygon and outline_circle must be given")
+    if poly is not None:
+        verts = poly.vertices
+        if len(verts) < 3:
+            raise jc.fail(
+                f"{path}.volume.outline_polygon.vertices", f"{len(verts)} vertices, a polygon needs 3"
+            )
+        pts = []
+        for k, p in enumerate(verts):
+            vp = f"{path}.volume.outline_polygon.vertices[{k}]"
+            pts.append(
+                (_finite(p.lng, vp + ".lng", -180, 180, "°"), _finite(p.lat, vp + ".lat", -90, 90, "°"))
+            )
+        if len(set(pts)) != len(pts):
+            raise jc.fail(
+                f"{path}.volume.outline_polygon.vertices",
+                "duplicated vertex (F3548: vertices may not be duplicated)",
+            )
+        import shapely
+
+        if not shapely.Polygon(pts).is_valid:
+            raise jc.fail(f"{path}.volume.outline_polygon", "edges cross (F3548: edges may not cross)")
+    else:
+        cp = f"{path}.volume.outline_circle"
+        if circ.get("center") is None or circ.get("radius") is None:
+            raise jc.fail(cp, "a circle needs center and radius")
+        _finite(circ.center.lat, cp + ".center.lat", -90, 90, "°")
+        _finite(circ.center.lng, cp + ".center.lng", -180, 180, "°")
+        r = _finite(circ.radius.value, cp + ".radius.value", 0, 1e6, "m")
+        if not r > 0:
+            raise jc.fail(cp + ".radius.value", "radius must be > 0 m")
+    lo, hi = vol.get("altitude_lower"), vol.get("altitude_upper")
+    for name, a in (("altitude_lower", lo), ("altitude_upper", hi)):
+        if a is None:
+            raise jc.fail(f"{path}.volume.{name}", "missing (F3548: required in an operational intent)")
+        _finite(a.value, f"{path}.volume.{name}.value", *ALTITUDE_RANGE_M, "m")
+    if lo.value > hi.value:
+        raise jc.fail(f"{path}.volume", f"altitude_lower {lo.value} m is above altitude_upper {hi.value} m")
+    for name in ("time_start", "time_end"):
+        if v.get(name) is None:
+            raise jc.fail(f"{path}.{name}", "missing (F3548: required in an operational intent)")
+    if not v.time_start.value.datetime < v.time_end.value.datetime:
+        raise jc.fail(path, "time_start is not before time_end")
+
+
+def check_details(details: Any, where: str = "") -> None:
+    """Check every volume of an ``OperationalIntentDetails`` (:func:`check_volume`); at least
+    one volume in ``volumes``."""
+    pre = f"{where}." if where else ""
+    vols = details.get("volumes") or []
+    if not vols:
+        raise jc.fail(f"{pre}volumes", "an operational intent needs at least one volume")
+    for key in ("volumes", "off_nominal_volumes"):
+        for k, v in enumerate(details.get(key) or []):
+            check_volume(v, f"{pre}{key}[{k}]")
+
+
+def check_times(intent: NamedIntent, now: datetime) -> None:
+    """The F3548 time rules at ``now``: no volume may end more than
+    :data:`TIME_SYNC_TOLERANCE` in the past, none may start beyond :data:`MAX_PLAN_HORIZON`.
+
+    Raises :class:`InputError` naming the intent and volume.
+    """
+    for k, v in enumerate(intent.details.volumes):
+        t0, t1 = v.time_start.value.datetime, v.time_end.value.datetime
+        if t1 <= now - TIME_SYNC_TOLERANCE:
+            raise InputError(
+                f"{intent.name}: volumes[{k}] ended at {t1.isoformat()}, before now ({now.isoformat()}): "
+                "F3548 intents may not end in the past"
+            )
+        if t0 > now + MAX_PLAN_HORIZON:
+            raise InputError(
+                f"{intent.name}: volumes[{k}] starts at {t0.isoformat()}, more than 30 days after now "
+                f"({now.isoformat()}): beyond the F3548 planning horizon (OiMaxPlanHorizon)"
+            )
+
+
+def parse_intents(d: object, source: str, name: str) -> list[NamedIntent]:
+    """Intents from the JSON data of one file (see module for the accepted shapes)."""
+    with jc.reraise_in(source):
+        obj = jc.obj(d, "")
+        if "intents" in obj:
+            group = jc.obj(obj["intents"], "intents")
+            if not group:
+                raise jc.fail("intents", "no intents")
+            return [
+                NamedIntent(str(k), _one(jc.obj(v, f"intents.{k}"), f"intents.{k}"), source)
+                for k, v in group.items()
+            ]
+        return [NamedIntent(name, _one(obj, ""), source)]
+
+
+def _one(obj: dict[str, Any], where: str) -> Any:
+    if "details" in obj:
+        return parse_details(obj["details"], f"{where}.details".lstrip("."))
+    return parse_details(obj, where)
+
+
+def read_intents(path: str | os.PathLike[str]) -> list[NamedIntent]:
+    """Read the operational intent(s) of a JSON file (named by the file's stem, or by their
+    keys under ``"intents"``)."""
+    p = os.fspath(path)
+    if not os.path.exists(p):
+        raise InputError(f"no such intent file: {p}")
+    if os.path.isdir(p):
+        raise InputError(f"{p}: is a directory, not an intent file")
+    with jc.reraise_in(p):
+        d = jc.parse(jc.read_text(p, MAX_INTENT_BYTES), "not an operational intent: not valid JSON")
+    return parse_intents(d, p, os.path.splitext(os.path.basename(p))[0])
+
+
+def to_json(details: Any) -> dict[str, Any]:
+    """The JSON data of an ``OperationalIntentDetails`` (re-parsed and checked first, so a
+    file written is a file :func:`read_intents` accepts)."""
+    data = json.loads(json.dumps(details))
+    parse_details(data)
+    return data
+
+
+def write_intent(details: Any, path: str | os.PathLike[str]) -> None:
+    """Write an ``OperationalIntentDetails`` as JSON, checked (:func:`to_json`), atomically."""
+    try:
+        text = json.dumps(to_json(details), indent=1, allow_nan=False)
+    except DataFormatError as e:
+        raise InputError(f"refusing to write an invalid operational intent: {e}") from None
+    atomic_write_text(path, text + "\n")
+
+
+def intent_geojson(details: Any, route: list[tuple[float, float, float]] | None = None) -> dict[str, Any]:
+    """A GeoJSON FeatureCollection of an intent's volumes (Polygon features; circles as
+    64-gons, with their centre and radius kept in the properties) and, if given, the route
+    (a LineString of (lon, lat, alt W84)). Properties: ``altitude_lower_w84_m``,
+    ``altitude_upper_w84_m``, ``time_start``, ``time_end``, ``index``."""
+    import pymap3d
+
+    feats: list[dict[str, Any]] = []
+    for k, v in enumerate(details.volumes):
+        vol = v.volume
+        props: dict[str, Any] = {
+            "index": k,
+            "altitude_lower_w84_m": float(vol.altitude_lower.value),
+            "altitude_upper_w84_m": float(vol.altitude_upper.value),
+            "time_start": str(v.time_start.value),
+            "time_end": str(v.time_end.value),
+        }
+        if vol.get("outline_polygon") is not None:
+            ring = [[float(p.lng), float(p.lat)] for p in vol.outline_polygon.vertices]
+        else:
+            c = vol.outline_circle
+            r = float(c.radius.value)
+            props["circle"] = {"center": [float(c.center.lng), float(c.center.lat)], "radius_m": r}
+            a = np.linspace(0.0, 2 * np.pi, 65)[:-1]
+            la, lo, _ = pymap3d.enu2geodetic(
+                r * np.cos(a), r * np.sin(a), 0.0, c.center.lat, c.center.lng, 0.0
+            )
+            ring = [[float(x), float(y)] for x, y in zip(lo, la, strict=True)]
+        feats.append(
+            {
+                "type": "Feature",
+                "properties": props,
+                "geometry": {"type": "Polygon", "coordinates": [[*ring, ring[0]]]},
+            }
+        )
+    if route is not None:
+        feats.append(
+            {
+                "type": "Feature",
+                "properties": {"kind": "route"},
+                "geometry": {"type": "LineString", "coordinates": [[lo, la, al] for la, lo, al in route]},
+            }
+        )
+    return {"type": "FeatureCollection", "features": feats}
+
+
+def write_intent_geojson(
+    details: Any, path: str | os.PathLike[str], route: list[tuple[float, float, float]] | None = None
+) -> None:
+    """Write :func:`intent_geojson` atomically."""
+    atomic_write_text(path, json.dumps(intent_geojson(details, route), indent=1, allow_nan=False) + "\n")
+
+
+def rfc3339(t: datetime) -> str:
+    """``t`` as F3548 wants it: RFC 3339 in UTC with a ``Z``."""
+    if t.tzinfo is None:
+        raise InputError(f"time {t.isoformat()} has no time zone")
+    return t.astimezone(timezone.utc).isoformat(timespec="microseconds").replace("+00:00", "Z")
+
+
+__all__ = [
+    "MAX_PLAN_HORIZON",
+    "TIME_SYNC_TOLERANCE",
+    "NamedIntent",
+    "check_details",
+    "check_times",
+    "check_volume",
+    "intent_geojson",
+    "parse_details",
+    "parse_intents",
+    "read_intents",
+    "rfc3339",
+    "to_json",
+    "write_intent",
+    "write_intent_geojson",
+]

@@ -1,0 +1,288 @@
+"""An ASTM F3548 operational intent from a mission plan and a calibrated trajectory prediction.
+
+Steps:
+
+1. The plan's 3D route (:func:`uasnav.io.mission_plan.route_points`): take-off climb, waypoints
+   with hold times, landing descent; altitudes converted to WGS-84 ellipsoidal heights
+   (:func:`uasnav.utm.altitude.w84_altitudes`).
+2. Times: the horizontal legs by the trajectory predictor (LVQ element times, wind), climbs
+   and descents at the vertical speeds (ArduPilot's defaults ``WPNAV_SPEED_UP`` 2.5 m/s,
+   ``WPNAV_SPEED_DN`` 1.5 m/s), a leg that climbs while it moves taking the longer of the
+   two; holds and loiters added at their points; after a ``DO_CHANGE_SPEED`` the predicted
+   leg times are scaled by (prediction speed ÷ new speed) — first order: the elements' speed
+   changes ΔV stay those predicted at the first speed.
+3. Time bounds: the model's calibrated split-conformal band (:mod:`uasnav.trajectory.timebounds`)
+   at the requested coverage, widened by the predictor's flagged elements.
+4. Volumes: each leg is cut into pieces of at most ``piece_m`` metres; a piece's volume is the
+   piece's segment grown by the lateral buffer (a polygon with round caps; a circle for a
+   vertical-only piece), between its lowest and highest altitude ∓ the vertical buffer, alive
+   from the lower time bound at its start to the upper bound at its end (holds included). A
+   vehicle whose arrival times lie within the band and whose path stays within the lateral
+   buffer of the plan is therefore inside some volume at every instant.
+
+The default buffers come from navigation accuracy: lateral 15 m (GNSS 95 % horizontal
+≈ 5 m plus a multirotor's flight technical error ≈ 10 m), vertical 10 m (barometric/GNSS
+altitude hold). The conformal guarantee covers the horizontal timing as calibrated; climb,
+descent and hold times are predicted deterministically and carried inside the same band.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from datetime import datetime, timedelta
+from typing import Any
+
+import numpy as np
+
+from uasnav.errors import InputError
+from uasnav.io.mission_plan import MissionPlan, RoutePoint, plan_cruise_speed, route_points
+from uasnav.io.operational_intent import parse_details, rfc3339
+from uasnav.trajectory.predictor import TrajectoryPredictor
+from uasnav.trajectory.timebounds import DEFAULT_COVERAGE, widening
+from uasnav.utm.altitude import w84_altitudes
+
+DEFAULT_LATERAL_BUFFER_M = 15.0
+DEFAULT_VERTICAL_BUFFER_M = 10.0
+DEFAULT_CLIMB_MS = 2.5
+DEFAULT_DESCENT_MS = 1.5
+DEFAULT_PIECE_M = 100.0
+#: Shortest volume, s (a volume must end after it starts).
+MIN_VOLUME_S = 1.0
+#: Horizontal distance (m) below which two route points are one place.
+SAME_PLACE_M = 0.01
+
+
+@dataclass(frozen=True)
+class IntentBuild:
+    """An operational intent and the prediction it was made from.
+
+    Attributes
+    ----------
+    details : uas_standards OperationalIntentDetails — the intent (checked).
+    start : datetime — departure time (UTC).
+    origin : (lat_deg, lon_deg) — the local ENU plane of the arrays below.
+    route_en : ndarray, shape (n, 2) — route points, east/north m.
+    route_alt_w84 : ndarray, shape (n,) — their altitudes, m W84.
+    t_arrive_s, t_lo_s, t_hi_s : ndarray, shape (n,) — predicted arrival at each point and its
+        bounds, s after ``start`` (the bounds of the departure after a hold for ``t_hi_s``).
+    eta_s : float — predicted mission time, s; ``eta_bounds_s`` its bounds.
+    volume_outline_en : list of ndarray (k, 2) — each volume's outline, east/north m.
+    volume_alt_w84, volume_time_s : ndarray, shape (v, 2) — altitude (m W84) and time (s after
+        ``start``) ranges of each volume.
+    coverage : float
+    flags : list of list of str — the predictor's flags per horizontal element.
+    """
+
+    details: Any
+    start: datetime
+    origin: tuple[float, float]
+    route_en: np.ndarray
+    route_alt_w84: np.ndarray
+    t_arrive_s: np.ndarray
+    t_lo_s: np.ndarray
+    t_hi_s: np.ndarray
+    eta_s: float
+    eta_bounds_s: tuple[float, float]
+    volume_outline_en: list[np.ndarray]
+    volume_alt_w84: np.ndarray
+    volume_time_s: np.ndarray
+    coverage: float
+    flags: list[list[str]]
+
+
+def _positive(x: float, name: str) -> float:
+    if not (math.isfinite(x) and x > 0):
+        raise InputError(f"{name} must be finite and > 0, got {x!r}")
+    return float(x)
+
+
+def build_intent(
+    plan: MissionPlan,
+    predictor: TrajectoryPredictor,
+    wind_ne: np.ndarray,
+    start: datetime,
+    *,
+    coverage: float = DEFAULT_COVERAGE,
+    lateral_buffer_m: float = DEFAULT_LATERAL_BUFFER_M,
+    vertical_buffer_m: float = DEFAULT_VERTICAL_BUFFER_M,
+    geoid_height_m: float | None = None,
+    home_amsl_m: float | None = None,
+    climb_ms: float = DEFAULT_CLIMB_MS,
+    descent_ms: float = DEFAULT_DESCENT_MS,
+    piece_m: float = DEFAULT_PIECE_M,
+    cruise_ms: float | None = None,
+    priority: int = 0,
+) -> IntentBuild:
+    """The operational intent of ``plan`` departing at ``start`` (see module).
+
+    Parameters
+    ----------
+    plan : MissionPlan
+    predictor : TrajectoryPredictor — fitted, with calibrated ``time_bounds_``.
+    wind_ne : ndarray, shape (2,) — wind velocity (m/s, toward north/east).
+    start : datetime — departure, time-zone aware.
+    coverage : float — coverage of the time bounds.
+    lateral_buffer_m, vertical_buffer_m : float — buffers around the path, m.
+    geoid_height_m : float — geoid height N at the site, m (W84 = AMSL + N); required.
+    home_amsl_m : float, optional — home altitude AMSL, m (default the plan's).
+    climb_ms, descent_ms : float — vertical speeds, m/s.
+    piece_m : float — longest piece of a leg per volume, m.
+    cruise_ms : float, optional — horizontal speed (default the plan's, else the model's).
+    priority : int — F3548 priority.
+    """
+    import pymap3d
+    import shapely
+
+    bounds = getattr(predictor, "time_bounds_", None)
+    if bounds is None:
+        raise InputError(
+            "the model has no calibrated time bounds: run `uasnav trajectory calibrate` on it first"
+        )
+    if start.tzinfo is None:
+        raise InputError("start time needs a time zone")
+    for name, x in (
+        ("lateral buffer", lateral_buffer_m),
+        ("climb rate", climb_ms),
+        ("descent rate", descent_ms),
+        ("piece length", piece_m),
+    ):
+        _positive(x, name)
+    if not (math.isfinite(vertical_buffer_m) and vertical_buffer_m >= 0):
+        raise InputError(f"vertical buffer must be finite and ≥ 0, got {vertical_buffer_m!r}")
+    bounds.quantile(coverage)  # refuses a coverage the calibration cannot give
+    pts: list[RoutePoint] = route_points(plan)
+    for p in pts:
+        if not math.isfinite(p.hold_s):
+            what = "an unlimited loiter" if p.hold_s == math.inf else "a loiter of N turns (time unknown)"
+            raise InputError(f"{plan.source}: item {p.item}: {what} has no predictable end")
+    home = (
+        home_amsl_m if home_amsl_m is not None else (plan.home.alt_amsl_m if plan.home is not None else None)
+    )
+    z = w84_altitudes(pts, home_amsl_m=home, geoid_height_m=geoid_height_m, source=plan.source)
+    lat = np.array([p.lat_deg for p in pts])
+    lon = np.array([p.lon_deg for p in pts])
+    lat0, lon0 = float(lat[0]), float(lon[0])
+    e, n, _ = pymap3d.geodetic2enu(lat, lon, 0.0, lat0, lon0, 0.0)
+    en = np.column_stack([e, n])
+    # horizontal route: points at distinct places
+    step = np.hypot(*np.diff(en, axis=0).T)
+    moves = step > SAME_PLACE_M
+    hidx = np.concatenate([[0], np.cumsum(moves)])
+    keep = np.concatenate([[True], moves])
+    route_ne = en[keep][:, ::-1]
+    flags: list[list[str]] = []
+    v_ref = float(cruise_ms or plan_cruise_speed(plan) or predictor.cruise_ms_)
+    if route_ne.shape[0] >= 2:
+        pred = predictor.predict(route_ne, np.asarray(wind_ne, dtype=float), v_ref)
+        t_wp = pred.waypoint_times_s
+        el = pred.elements
+        s_knots = np.concatenate([[el.s_start_m[0]], el.s_end_m])
+        s_wp = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(route_ne, axis=0).T))])
+        w_wp = np.interp(s_wp, s_knots, widening(pred.time_s, pred.low_confidence))
+        flags = pred.flags
+    else:
+        t_wp = np.zeros(1)
+        w_wp = np.zeros(1)
+    m = len(pts)
+    t_arr = np.zeros(m)
+    w = w_wp[hidx]
+    # DO_CHANGE_SPEED: the leg into a point flies the latest speed set before that point; the
+    # predicted leg time is scaled by v_ref / v (first-order: the element dynamics stay those of
+    # v_ref), unless the caller fixed the speed (cruise_ms)
+    v_leg = np.full(m, v_ref)
+    if cruise_ms is None:
+        v = v_ref
+        for i, p in enumerate(pts):
+            v = p.speed_ms if p.speed_ms is not None and i > 0 else v
+            v_leg[i] = v
+    for i in range(m - 1):
+        th = float(t_wp[hidx[i + 1]] - t_wp[hidx[i]]) * v_ref / v_leg[i + 1]
+        dz = z[i + 1] - z[i]
+        tz = dz / climb_ms if dz > 0 else -dz / descent_ms
+        t_arr[i + 1] = t_arr[i] + pts[i].hold_s + max(th, tz)
+    hold = np.array([p.hold_s for p in pts])
+    t_dep = t_arr + hold
+    lo_arr, _ = bounds.band(t_arr, w, coverage)
+    _, hi_dep = bounds.band(t_dep, w, coverage)
+    outlines: list[np.ndarray] = []
+    alts, times, vols = [], [], []
+    for i in range(m - 1):
+        dh = float(step[i])
+        seg = t_arr[i + 1] - t_dep[i]
+        k = max(1, math.ceil(dh / piece_m))
+        for j in range(k):
+            a, b = j / k, (j + 1) / k
+            pa, pb = en[i] + a * (en[i + 1] - en[i]), en[i] + b * (en[i + 1] - en[i])
+            za, zb = z[i] + a * (z[i + 1] - z[i]), z[i] + b * (z[i + 1] - z[i])
+            wa, wb = w[i] + a * (w[i + 1] - w[i]), w[i] + b * (w[i + 1] - w[i])
+            ta = t_arr[i] if j == 0 else t_dep[i] + a * seg
+            tb = t_dep[i + 1] if j == k - 1 else t_dep[i] + b * seg
+            t_lo = float(bounds.band(np.array([ta]), wa, coverage)[0][0])
+            t_hi = float(bounds.band(np.array([tb]), wb, coverage)[1][0])
+            t_hi = max(t_hi, t_lo + MIN_VOLUME_S)
+            alt = (min(za, zb) - vertical_buffer_m, max(za, zb) + vertical_buffer_m)
+            if dh > SAME_PLACE_M:
+                poly = shapely.LineString([pa, pb]).buffer(lateral_buffer_m, quad_segs=4)
+                ring = np.asarray(poly.exterior.coords)[:-1]
+                la, lo_, _ = pymap3d.enu2geodetic(ring[:, 0], ring[:, 1], 0.0, lat0, lon0, 0.0)
+                outline: dict[str, Any] = {
+                    "outline_polygon": {
+                        "vertices": [{"lat": float(x), "lng": float(y)} for x, y in zip(la, lo_, strict=True)]
+                    }
+                }
+                outlines.append(ring)
+            else:
+                la, lo_, _ = pymap3d.enu2geodetic(pa[0], pa[1], 0.0, lat0, lon0, 0.0)
+                outline = {
+                    "outline_circle": {
+                        "center": {"lat": float(la), "lng": float(lo_)},
+                        "radius": {"value": float(lateral_buffer_m), "units": "M"},
+                    }
+                }
+                ang = np.linspace(0, 2 * np.pi, 33)[:-1]
+                outlines.append(pa + lateral_buffer_m * np.column_stack([np.cos(ang), np.sin(ang)]))
+            vols.append(
+                {
+                    "volume": {
+                        **outline,
+                        "altitude_lower": {"value": float(alt[0]), "reference": "W84", "units": "M"},
+                        "altitude_upper": {"value": float(alt[1]), "reference": "W84", "units": "M"},
+                    },
+                    "time_start": {"value": rfc3339(start + timedelta(seconds=t_lo)), "format": "RFC3339"},
+                    "time_end": {"value": rfc3339(start + timedelta(seconds=t_hi)), "format": "RFC3339"},
+                }
+            )
+            alts.append(alt)
+            times.append((t_lo, t_hi))
+    details = parse_details({"volumes": vols, "off_nominal_volumes": [], "priority": int(priority)}, "intent")
+    eta = float(t_dep[-1])
+    eta_lo, eta_hi = bounds.band(np.array([eta]), w[-1], coverage)
+    return IntentBuild(
+        details=details,
+        start=start,
+        origin=(lat0, lon0),
+        route_en=en,
+        route_alt_w84=z,
+        t_arrive_s=t_arr,
+        t_lo_s=lo_arr,
+        t_hi_s=hi_dep,
+        eta_s=eta,
+        eta_bounds_s=(float(eta_lo[0]), float(eta_hi[0])),
+        volume_outline_en=outlines,
+        volume_alt_w84=np.array(alts).reshape(-1, 2),
+        volume_time_s=np.array(times).reshape(-1, 2),
+        coverage=coverage,
+        flags=flags,
+    )
+
+
+__all__ = [
+    "DEFAULT_CLIMB_MS",
+    "DEFAULT_DESCENT_MS",
+    "DEFAULT_LATERAL_BUFFER_M",
+    "DEFAULT_PIECE_M",
+    "DEFAULT_VERTICAL_BUFFER_M",
+    "IntentBuild",
+    "build_intent",
+]
