@@ -3,11 +3,13 @@
 use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
 use super::slope::SlopeEstimator;
-use super::{BiasTemperatureDerivative, HeadingSource, Levelling, Mode, ZuptConfig, N_MEAS, N_STATES};
+use super::{
+    BiasTemperatureDerivative, HeadingSource, Levelling, Mode, ZuptConfig, N_MEAS, N_STATES,
+};
 use crate::attitude::{quat_from_rotation_vector, quat_to_array, quat_to_dcm};
 use crate::earth;
-use crate::strapdown::{self, ErrorDynamics};
 use crate::scalar::lit;
+use crate::strapdown::{self, ErrorDynamics};
 use crate::{NavError, Real};
 
 type Mat15<T> = SMatrix<T, N_STATES, N_STATES>;

@@ -61,9 +61,9 @@ mod filter;
 mod init;
 mod slope;
 
-pub use detect::{detect_static, StationarityConfig, StationarityDetector, DETECT_CAPACITY};
 #[cfg(test)]
 use crate::strapdown::skew as filter_test_skew;
+pub use detect::{detect_static, StationarityConfig, StationarityDetector, DETECT_CAPACITY};
 pub use filter::{BatchInput, BatchOutput, BatchSummary, ZuptFilter};
 pub use init::{HeadingSource, Levelling};
 pub use slope::{SlopeEstimator, SLOPE_CAPACITY};
