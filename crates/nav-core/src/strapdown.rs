@@ -268,6 +268,8 @@ pub(crate) struct Gain<T: Real, const M: usize> {
 }
 
 /// Factorises `S = H·P·Hᵀ + diag(r)` (no state change).
+// Indices below M and N_STATES, the matrices' compile-time sizes.
+#[allow(clippy::indexing_slicing)]
 #[inline]
 pub(crate) fn gain<T: Real, const M: usize>(
     p: &Mat15<T>,
@@ -287,6 +289,8 @@ pub(crate) fn gain<T: Real, const M: usize>(
 /// The Joseph-form update `P ← (I−KH)P(I−KH)ᵀ + K·R·Kᵀ` (symmetrised) for the innovation
 /// `z = h(x̂) − y` (predicted minus measured); returns `δx = K·z`. `P` is left
 /// unchanged on error.
+// Indices below M and N_STATES, the matrices' compile-time sizes.
+#[allow(clippy::indexing_slicing)]
 #[inline]
 pub(crate) fn joseph_update<T: Real, const M: usize>(
     p: &mut Mat15<T>,

@@ -140,8 +140,8 @@ fn ins_step_updates_and_batch_do_not_allocate() {
             )
             .unwrap();
             let region = Region::new(GLOBAL);
-            for k in 0..200 {
-                f.predict(&gyro[k], &acc, 0.01, &Vector3::zeros()).unwrap();
+            for (k, g) in gyro.iter().take(200).enumerate() {
+                f.predict(g, &acc, 0.01, &Vector3::zeros()).unwrap();
                 if k % 20 == 0 {
                     f.update_gnss(&llh[0], &[0.0; 3], &gacc[0], 0.005).unwrap();
                     f.update_height(300.0).unwrap();

@@ -8,6 +8,10 @@ use crate::scalar::lit;
 use crate::strapdown::{self, skew, ErrorDynamics, Mat15, N_STATES};
 use crate::zupt::{BiasTemperatureDerivative, HeadingSource, Levelling, SlopeEstimator};
 use crate::{NavError, Real};
+// f64 maths (sin, cos, sqrt, abs) without std: the trait's methods; with std the inherent
+// ones are used and the import is idle.
+#[allow(unused_imports)]
+use num_traits::Float as _;
 
 type Vec6<T> = SVector<T, 6>;
 type Mat6<T> = SMatrix<T, 6, 6>;
@@ -396,7 +400,8 @@ impl<T: Real> InsFilter<T> {
         let g = strapdown::gain(&self.p, &hm, &r, "GNSS innovation covariance S")?;
         let nis = z.dot(&g.chol.solve(&z));
         self.last_nis = nis;
-        if !(nis <= cfg.gate_chi2) {
+        let passes = nis <= cfg.gate_chi2; // false for NaN too
+        if !passes {
             return Ok(FixStatus::ExcludedSnapshot);
         }
         // Averaged innovation over the window (the stored fixes and this one).
@@ -410,7 +415,8 @@ impl<T: Real> InsFilter<T> {
             // mean z = zs/n, cov(mean) = Σs/n²: the statistic is zsᵀ·Σs⁻¹·zs.
             if let Some(ch) = ss_sum.cholesky() {
                 let t = zs.dot(&ch.solve(&zs));
-                if !(t <= cfg.gate_chi2) {
+                let passes = t <= cfg.gate_chi2;
+                if !passes {
                     return Ok(FixStatus::ExcludedWindow);
                 }
             }
@@ -488,7 +494,8 @@ impl<T: Real> InsFilter<T> {
         finite3("mag", self.index, mag_body)?;
         let m = quat_to_dcm(&self.q) * Vector3::from(*mag_body);
         let mh2 = m.x * m.x + m.y * m.y;
-        if !(mh2 > T::default_epsilon()) {
+        let horizontal = mh2 > T::default_epsilon();
+        if !horizontal {
             return Ok(()); // no horizontal field: nothing to learn
         }
         let z = SVector::<T, 1>::new(wrap_pi(
