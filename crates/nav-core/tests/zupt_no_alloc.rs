@@ -144,7 +144,7 @@ fn ins_step_updates_and_batch_do_not_allocate() {
                 f.predict(g, &acc, 0.01, &Vector3::zeros()).unwrap();
                 if k % 20 == 0 {
                     f.update_gnss(&llh[0], &[0.0; 3], &gacc[0], 0.005).unwrap();
-                    f.update_height(300.0).unwrap();
+                    f.update_height(300.0, 0.5).unwrap();
                     f.update_static().unwrap();
                     f.update_mag_heading(&mag[0]).unwrap();
                 }

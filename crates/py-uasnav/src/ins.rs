@@ -16,6 +16,7 @@ use crate::{floats_arg, uint_arg};
 uint_arg!(levelling_arg, "levelling_samples", usize, usize_arg);
 uint_arg!(decimation_arg, "decimation", usize, usize_arg);
 uint_arg!(window_arg, "window_fixes", usize, usize_arg);
+uint_arg!(reset_arg, "reset_after_exclusions", usize, usize_arg);
 floats_arg!(lever_arm_arg, "lever_arm", 3);
 floats_arg!(gyro_bias0_arg, "gyro_bias0", 3);
 
@@ -111,12 +112,7 @@ fn bools<'a>(
         .map_err(|_| input_error(py, format!("{name}: expected a contiguous bool array")))
 }
 
-fn pair<A, B>(
-    py: Python<'_>,
-    what: &str,
-    a: Option<A>,
-    b: Option<B>,
-) -> PyResult<Option<(A, B)>> {
+fn pair<A, B>(py: Python<'_>, what: &str, a: Option<A>, b: Option<B>) -> PyResult<Option<(A, B)>> {
     match (a, b) {
         (Some(a), Some(b)) => Ok(Some((a, b))),
         (None, None) => Ok(None),
@@ -147,7 +143,7 @@ type Hist = (
     gnss_use=None, baro_t=None, baro_h=None, mag_t=None, mag=None, temp=None,
     dbias_dtemp=None, stationary=None, initial_attitude=None, levelling_samples=100,
     gyro_bias0=[0.0; 3], mode="classic", discretisation="first_order", config=None,
-    lever_arm=[0.0; 3], window_fixes=10, decimation=1))]
+    lever_arm=[0.0; 3], window_fixes=10, reset_after_exclusions=50, decimation=1))]
 #[allow(clippy::too_many_arguments)]
 fn ins_run<'py>(
     py: Python<'py>,
@@ -174,6 +170,7 @@ fn ins_run<'py>(
     config: Option<Bound<'py, PyDict>>,
     #[pyo3(from_py_with = lever_arm_arg)] lever_arm: [f64; 3],
     #[pyo3(from_py_with = window_arg)] window_fixes: usize,
+    #[pyo3(from_py_with = reset_arg)] reset_after_exclusions: usize,
     #[pyo3(from_py_with = decimation_arg)] decimation: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cfg = self::config(
@@ -184,6 +181,10 @@ fn ins_run<'py>(
         lever_arm,
         window_fixes,
     )?;
+    let cfg = InsConfig {
+        reset_after_exclusions,
+        ..cfg
+    };
     let it = slice1(py, "imu_t", &imu_t)?;
     let g = rows::<3>(py, "gyro", &gyro)?;
     let a = rows::<3>(py, "accel", &accel)?;
@@ -302,6 +303,8 @@ fn ins_run<'py>(
     dict.set_item("baro_updates", s.baro_updates)?;
     dict.set_item("mag_updates", s.mag_updates)?;
     dict.set_item("course_reset", s.course_reset)?;
+    dict.set_item("imu_gaps", s.imu_gaps)?;
+    dict.set_item("gnss_resets", s.gnss_resets)?;
     Ok(dict)
 }
 

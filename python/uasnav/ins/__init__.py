@@ -19,7 +19,7 @@ True
 
 from uasnav.ins import evaluate
 from uasnav.ins.core import FIX_STATUS, TRACK_COLUMNS, InsConfig, InsResult, integrity_thresholds, run
-from uasnav.ins.data import BaroData, Flight, GnssData, MagData, Trajectory
+from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 
 __all__ = [
     "FIX_STATUS",

@@ -1,4 +1,4 @@
-"""Run the GNSS/INS filter over a :class:`~uasnav.ins.data.Flight` (one FFI call, GIL released).
+"""Run the GNSS/INS filter over a :class:`~uasnav.io.navdata.Flight` (one FFI call, GIL released).
 
 The filter (``nav_core::ins``) is a loosely coupled 15-state error-state Kalman filter on the
 same strapdown mechanisation and error-state kernel as the ZUPT filter: WGS-84 latitude,
@@ -31,7 +31,7 @@ from uasnav import _core
 from uasnav.atomicfile import atomic_open
 from uasnav.attitude import quat_to_euler
 from uasnav.errors import InputError
-from uasnav.ins.data import Flight
+from uasnav.io.navdata import Flight
 from uasnav.stationary import detect_static
 
 if TYPE_CHECKING:
@@ -47,7 +47,7 @@ TRACK_COLUMNS = (
     "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw,bgx,bgy,bgz,bax,bay,baz,hpl,vpl,gnss_used".split(",")
 )
 #: Fix status codes of the Rust filter.
-FIX_STATUS = {0: "used", 1: "excluded", 2: "excluded_window", 3: "masked", 4: "unused"}
+FIX_STATUS = {0: "used", 1: "excluded", 2: "excluded_window", 3: "masked", 4: "unused", 5: "reset"}
 
 
 @lru_cache(maxsize=32)
@@ -73,6 +73,21 @@ def integrity_thresholds(p_fa: float, p_md: float, p_ir: float) -> dict[str, flo
         "k_horizontal": math.sqrt(-2.0 * math.log(p_ir)),
         "k_vertical": float(stats.norm.isf(p_ir / 2.0)),
     }
+
+
+#: Process noise for logged IMU streams: a 50 Hz DataFlash ``IMU`` record (or a 10 Hz ROS
+#: ``imu/data_raw``) is a snapshot of the filtered rate, not an integrated increment, so
+#: integrating it leaves errors far above the sensor's noise (log171: gyro-only integration
+#: drifts 5–15° in 15 s of flight against the autopilot's EKF). The filter is told so: σ_VRW
+#: 0.5 m/s/√s, σ_ARW 0.02 rad/√s, bias random walks 1e-3 m/s²/√s and 1e-4 rad/s/√s, and an
+#: initial accelerometer-bias σ of 0.5 m/s² (the logs' static |f| is 9.1–9.6 m/s²).
+LOGGED_IMU_NOISE: dict[str, Any] = {
+    "sigma_vrw_m_s_sqrt_s": 0.5,
+    "sigma_arw_rad_sqrt_s": 0.02,
+    "sigma_abi_m_s2": 1e-3,
+    "sigma_gbi_rad_s": 1e-4,
+    "extra": {"init_std_accel_bias_m_s2": 0.5},
+}
 
 
 @dataclass(frozen=True)
@@ -101,7 +116,9 @@ class InsConfig:
     hal_m, val_m : float or None
         Horizontal/vertical alert limits (m): an alert when a protection level exceeds them.
     window_fixes : int
-        Fixes in the averaged-innovation (slow-ramp) test.
+        Fixes in the averaged-innovation test (1–32).
+    reset_after_exclusions : int
+        Consecutive excluded fixes after which the filter re-initialises on GNSS (0: never).
     static_updates : bool
         ZUPT/ZARU when the static detector fires and GNSS speed is below ``static_max_speed_m_s``
         (on the ground: hovering is not static, and the GLRT rejects its vibration).
@@ -125,6 +142,7 @@ class InsConfig:
     hal_m: float | None = None
     val_m: float | None = None
     window_fixes: int = 10
+    reset_after_exclusions: int = 50
     static_updates: bool = True
     static_max_speed_m_s: float = 0.3
     use_baro: bool = True
@@ -136,6 +154,16 @@ class InsConfig:
     def replace(self, **changes: Any) -> InsConfig:
         """A copy with some fields changed."""
         return replace(self, **changes)
+
+    @classmethod
+    def for_logged_imu(cls, **changes: Any) -> InsConfig:
+        """The configuration for real logs whose IMU stream is a low-rate snapshot
+        (:data:`LOGGED_IMU_NOISE`), with ``changes`` on top (``extra`` entries merged)."""
+        base = dict(LOGGED_IMU_NOISE)
+        extra = dict(base.pop("extra"))
+        extra.update(changes.pop("extra", {}) or {})
+        base.update(changes)
+        return cls(**base, extra=extra)
 
     def core_dict(self) -> dict[str, float]:
         """The nav-core configuration keys (noise, integrity thresholds, extras)."""
@@ -204,7 +232,7 @@ class InsResult:
     def excluded_fixes(self) -> list[dict[str, Any]]:
         """Every excluded GNSS fix: time (s), test, NIS."""
         out = []
-        for i in np.flatnonzero((self.fix_status == 1) | (self.fix_status == 2)):
+        for i in np.flatnonzero((self.fix_status == 1) | (self.fix_status == 2) | (self.fix_status == 5)):
             out.append(
                 {"t": float(self.fix_t[i]), "test": FIX_STATUS[int(self.fix_status[i])], "nis": float(self.fix_nis[i])}
             )
@@ -320,7 +348,7 @@ class InsResult:
 
     def plot(self, ax: Axes | None = None, *, reference: Any = None) -> Axes:
         """Plot the horizontal track (east vs north, m from the first point) with excluded
-        fixes; ``reference`` (a :class:`~uasnav.ins.data.Trajectory`) is drawn beside it."""
+        fixes; ``reference`` (a :class:`~uasnav.io.navdata.Trajectory`) is drawn beside it."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -460,6 +488,7 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         config=cfg.core_dict(),
         lever_arm=list(cfg.lever_arm_m),
         window_fixes=cfg.window_fixes,
+        reset_after_exclusions=cfg.reset_after_exclusions,
         decimation=cfg.decimation,
     )
     t = imu.t[:: cfg.decimation]
@@ -496,6 +525,8 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         "baro_updates": int(out["baro_updates"]),
         "mag_updates": int(out["mag_updates"]),
         "course_reset": bool(out["course_reset"]),
+        "imu_gaps": int(out["imu_gaps"]),
+        "gnss_resets": int(out["gnss_resets"]),
         "alerts": len(res.alerts),
         "thresholds": integrity_thresholds(cfg.p_fa, cfg.p_md, cfg.p_ir),
     }

@@ -20,7 +20,7 @@ from scipy import stats
 from uasnav import earth
 from uasnav.errors import InputError
 from uasnav.ins.core import InsConfig, InsResult, run
-from uasnav.ins.data import Flight, Trajectory
+from uasnav.io.navdata import Flight, Trajectory
 
 FloatArray = NDArray[np.float64]
 

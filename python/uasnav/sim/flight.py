@@ -38,7 +38,7 @@ from scipy.spatial.transform import Rotation
 from uasnav import earth
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog
-from uasnav.ins.data import BaroData, Flight, GnssData, MagData, Trajectory
+from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.limits import check_memory
 from uasnav.sim.core import thermal_model
 
@@ -312,3 +312,20 @@ def simulate_flight(
 def _quat(rot: Rotation) -> FloatArray:
     q = rot.as_quat()  # scalar last
     return np.column_stack([q[:, 3], q[:, :3]])
+
+
+def matched_config_values(errors: FlightErrors | None = None) -> dict[str, float]:
+    """nav-core settings matching :class:`FlightErrors` (noise densities including vibration,
+    barometer and magnetometer σ): what a filter tuned to this simulator's sensors uses, for
+    consistency (NEES) tests. Keys are those of :class:`uasnav.ins.InsConfig` fields and its
+    ``extra`` dict (``mag_heading_std_rad``, ``baro_std_m``)."""
+    e = errors or FlightErrors()
+    rate = 100.0  # vibration σ per sample is given at the default IMU rate
+    return {
+        "sigma_vrw_m_s_sqrt_s": math.hypot(e.vrw_m_s_sqrt_s, e.vibration_accel_m_s2 / math.sqrt(rate)),
+        "sigma_arw_rad_sqrt_s": math.hypot(e.arw_rad_sqrt_s, e.vibration_gyro_rad_s / math.sqrt(rate)),
+        "sigma_abi_m_s2": e.accel_rw_m_s2_sqrt_s,
+        "sigma_gbi_rad_s": e.gyro_rw_rad_s_sqrt_s,
+        "mag_heading_std_rad": math.atan2(2.0 * e.mag_std_ut, 20.0),
+        "baro_std_m": e.baro_std_m,
+    }

@@ -16,6 +16,14 @@ use num_traits::Float as _;
 type Vec6<T> = SVector<T, 6>;
 type Mat6<T> = SMatrix<T, 6, 6>;
 
+/// The barometer is used only when no GNSS fix was used for this long (s): while GNSS is
+/// used, the baro-to-ellipsoid offset is being learnt from it, and using both would count the
+/// GNSS height twice.
+const BARO_GNSS_GAP_S: f64 = 1.0;
+
+/// An IMU interval longer than this many nominal sample periods is a logging gap.
+const MAX_GAP_FACTOR: f64 = 5.0;
+
 /// `|latitude|` beyond which the east channel is refused (cos φ → 0).
 const MAX_LATITUDE_RAD: f64 = 1.56; // 89.4°
 
@@ -62,6 +70,9 @@ pub enum FixStatus {
     Masked = 3,
     /// Not reached (after the last IMU sample, or before the first).
     Unused = 4,
+    /// Excluded, and the filter re-initialised its position and velocity on it after too many
+    /// consecutive exclusions.
+    Reset = 5,
 }
 
 /// The GNSS/INS filter (see the module docs for the model). Never allocates.
@@ -450,8 +461,9 @@ impl<T: Real> InsFilter<T> {
     }
 
     /// Barometric height update: the ellipsoidal height `height_m` (m) the barometer implies
-    /// (baro altitude plus the tracked offset).
-    pub fn update_height(&mut self, height_m: f64) -> Result<(), NavError> {
+    /// (baro altitude plus the tracked offset), with `offset_var_m2` (m²), the variance of that
+    /// offset, added to the barometer's own `baro_std_m²`.
+    pub fn update_height(&mut self, height_m: f64, offset_var_m2: T) -> Result<(), NavError> {
         if !height_m.is_finite() {
             return Err(NavError::NonFinite {
                 what: "baro height",
@@ -461,10 +473,18 @@ impl<T: Real> InsFilter<T> {
         let mut hm = SMatrix::<T, 1, N_STATES>::zeros();
         hm[(0, 2)] = -T::one();
         let z = SVector::<T, 1>::new(lit(self.h - height_m));
-        let r = SVector::<T, 1>::new(self.cfg.baro_std_m * self.cfg.baro_std_m);
+        let r = SVector::<T, 1>::new(
+            self.cfg.baro_std_m * self.cfg.baro_std_m
+                + num_traits::Float::max(offset_var_m2, T::zero()),
+        );
         let g = strapdown::gain(&self.p, &hm, &r, "baro innovation covariance")?;
         let dx = strapdown::joseph_update(&mut self.p, &hm, &z, &r, &g)?;
         self.feedback(&dx);
+        // The offset error is common to every baro sample, so averaging them cannot take the
+        // vertical σ below it: floor the height variance there (conservative, keeps P ≥ 0).
+        if self.p[(2, 2)] < offset_var_m2 {
+            self.p[(2, 2)] = offset_var_m2;
+        }
         self.check_health()
     }
 
@@ -510,6 +530,58 @@ impl<T: Real> InsFilter<T> {
         let g = strapdown::gain(&self.p, &hm, &r, "heading innovation covariance")?;
         let dx = strapdown::joseph_update(&mut self.p, &hm, &z, &r, &g)?;
         self.feedback(&dx);
+        // A magnetic heading error is mostly a bias (declination, iron), common to every
+        // sample: averaging cannot take the heading σ below the single-sample σ.
+        if self.p[(8, 8)] < r[0] {
+            self.p[(8, 8)] = r[0];
+        }
+        self.check_health()
+    }
+
+    /// Re-initialises position and velocity on a GNSS fix (antenna position and velocity,
+    /// lever arm removed), with the fix's accuracies as their σ and their cross-covariances
+    /// cleared; the attitude and biases are kept.
+    pub fn reset_to_gnss(
+        &mut self,
+        llh: &[f64; 3],
+        vel_ned_m_s: &[T; 3],
+        acc: &[T; 3],
+    ) -> Result<(), NavError> {
+        if !llh.iter().all(|x| x.is_finite()) {
+            return Err(NavError::NonFinite {
+                what: "gnss position",
+                index: self.index,
+            });
+        }
+        finite3("gnss velocity", self.index, vel_ned_m_s)?;
+        let c = quat_to_dcm(&self.q);
+        let cl_b = c * Vector3::from(self.cfg.lever_arm_m);
+        let (sl, cl) = (
+            num_traits::Float::sin(llh[0]),
+            num_traits::Float::cos(llh[0]),
+        );
+        let d = 1.0 - earth::WGS84_E2 * sl * sl;
+        let re = earth::WGS84_A / d.sqrt();
+        let rn = re * (1.0 - earth::WGS84_E2) / d;
+        self.lat = llh[0] - to_f64(cl_b.x) / (rn + llh[2]);
+        self.lon = llh[1] - to_f64(cl_b.y) / ((re + llh[2]) * cl);
+        self.h = llh[2] + to_f64(cl_b.z);
+        self.vel = Vector3::from(*vel_ned_m_s);
+        let sh = num_traits::Float::max(acc[0], self.cfg.gnss_min_std_position_m);
+        let sv = num_traits::Float::max(acc[1], self.cfg.gnss_min_std_position_m);
+        let ss = num_traits::Float::max(acc[2], self.cfg.gnss_min_std_velocity_m_s);
+        for i in 0..6 {
+            for j in 0..N_STATES {
+                self.p[(i, j)] = T::zero();
+                self.p[(j, i)] = T::zero();
+            }
+        }
+        let var = [sh * sh, sh * sh, sv * sv, ss * ss, ss * ss, ss * ss];
+        for (i, v) in var.iter().enumerate() {
+            self.p[(i, i)] = *v;
+        }
+        self.win_len = 0;
+        self.win_head = 0;
         self.check_health()
     }
 
@@ -619,6 +691,10 @@ pub struct InsBatchSummary<T> {
     pub mag_updates: usize,
     /// Whether the heading was reset to the GNSS course.
     pub course_reset: bool,
+    /// IMU logging gaps bridged (intervals longer than 5 nominal periods).
+    pub imu_gaps: usize,
+    /// Resets to GNSS after `reset_after_exclusions` consecutive excluded fixes.
+    pub gnss_resets: usize,
 }
 
 fn check_increasing(what: &'static str, t: &[f64]) -> Result<(), NavError> {
@@ -793,7 +869,8 @@ impl<T: Real> InsFilter<T> {
         let have_mag = input.mag.is_some_and(|mg| !mg.t_s.is_empty());
         let mut heading_known = have_mag || input.initial_attitude.is_some();
         let span = input.imu_t_s[n - 1] - t0;
-        let dt_nominal: T = lit(span / (n - 1) as f64);
+        let dt_nominal_s = span / (n - 1) as f64;
+        let dt_nominal: T = lit(dt_nominal_s);
         let mut slope = SlopeEstimator::new(config.temp_slope_window_s, dt_nominal);
         let zupt_every = to_f64(config.zupt_interval_s);
         let mag_every = to_f64(config.mag_interval_s);
@@ -815,7 +892,10 @@ impl<T: Real> InsFilter<T> {
             baro_updates: 0,
             mag_updates: 0,
             course_reset: false,
+            imu_gaps: 0,
+            gnss_resets: 0,
         };
+        let mut consecutive_excluded = 0usize;
         // Cursors into the aiding streams (everything up to t0 is consumed).
         let mut jg = j0 + 1;
         while jg < m && input.gnss_t_s[jg] <= t0 {
@@ -823,6 +903,10 @@ impl<T: Real> InsFilter<T> {
         }
         let mut jb = 0usize;
         let mut baro_offset: Option<f64> = None;
+        // Variance (m²) of the offset estimate: a first-order filter of independent
+        // differences, var ← (1−a)²·var + a²·(σ_v² + σ_baro²).
+        let mut baro_offset_var = 0.0_f64;
+        let baro_var = to_f64(config.baro_std_m * config.baro_std_m);
         let mut last_fix_llh = input.gnss_llh[j0];
         let mut jm = 0usize;
         let mut last_mag = f64::NEG_INFINITY;
@@ -848,7 +932,13 @@ impl<T: Real> InsFilter<T> {
                         rate = deriv.dbias_dtemp(k, temp) * dtdt;
                     }
                 }
-                f.predict(&input.gyro_rad_s[k], &input.accel_m_s2[k], dt, &rate)
+                // A logging gap: the sample after it averages over an unknown part of the gap
+                // (a 2 s gap of a 50 Hz log once read −4.7 m/s² for gravity), so the gap is
+                // bridged with the last sample before it, as a dead-reckoning outage.
+                let gap = tk - input.imu_t_s[k - 1] > MAX_GAP_FACTOR * dt_nominal_s;
+                let j = if gap { k - 1 } else { k };
+                summary.imu_gaps += usize::from(gap);
+                f.predict(&input.gyro_rad_s[j], &input.accel_m_s2[j], dt, &rate)
                     .map_err(|e| reindex(e, k))?;
             } else if config.mode == Mode::Tczupt {
                 if let Some(temps) = input.temp_c {
@@ -867,10 +957,12 @@ impl<T: Real> InsFilter<T> {
                     }
                     if baro_offset.is_none() {
                         baro_offset = Some(last_fix_llh[2] - hb);
+                        let s = num_traits::Float::max(acc0[1], floor_p);
+                        baro_offset_var = to_f64(s * s);
                     }
                     if let Some(o) = baro_offset {
-                        if bt[jb] >= t0 {
-                            f.update_height(hb + o)?;
+                        if bt[jb] >= t0 && tk - gnss_t_last_used > BARO_GNSS_GAP_S {
+                            f.update_height(hb + o, lit(baro_offset_var))?;
                             summary.baro_updates += 1;
                         }
                     }
@@ -918,6 +1010,7 @@ impl<T: Real> InsFilter<T> {
                     out.fix_status[jg] = st as u8;
                     out.fix_nis[jg] = f.last_nis;
                     if st == FixStatus::Used {
+                        consecutive_excluded = 0;
                         summary.fixes_used += 1;
                         used_since_row = true;
                         last_fix_llh = input.gnss_llh[jg];
@@ -927,12 +1020,28 @@ impl<T: Real> InsFilter<T> {
                                 let hb = to_f64(bh[jb - 1]);
                                 let a = ((input.gnss_t_s[jg] - gnss_t_last_used) / tau).min(1.0);
                                 *o += a * (input.gnss_llh[jg][2] - hb - *o);
+                                let sv =
+                                    to_f64(num_traits::Float::max(input.gnss_acc[jg][1], floor_p));
+                                baro_offset_var = (1.0 - a) * (1.0 - a) * baro_offset_var
+                                    + a * a * (sv * sv + baro_var);
                                 let _ = bt;
                             }
                         }
                         gnss_t_last_used = input.gnss_t_s[jg];
                     } else {
                         summary.fixes_excluded += 1;
+                        consecutive_excluded += 1;
+                        if config.reset_after_exclusions > 0
+                            && consecutive_excluded >= config.reset_after_exclusions
+                        {
+                            // Persistent disagreement: either GNSS has been faulty for that long
+                            // or the filter has diverged. Without a second position source the
+                            // filter cannot tell which; it re-initialises on GNSS and reports it.
+                            f.reset_to_gnss(&input.gnss_llh[jg], &vel, &input.gnss_acc[jg])?;
+                            out.fix_status[jg] = FixStatus::Reset as u8;
+                            summary.gnss_resets += 1;
+                            consecutive_excluded = 0;
+                        }
                     }
                 } else {
                     out.fix_status[jg] = FixStatus::Masked as u8;

@@ -30,13 +30,18 @@
 //! * Barometric height (1 row, `H = −e_D` on δr): `z = ĥ − (h_baro + o)`, the offset `o`
 //!   between the barometric and the ellipsoidal height tracked by a first-order filter of the
 //!   GNSS − baro difference (time constant `baro_offset_time_constant_s`) while GNSS is used,
-//!   frozen during outages — so in an outage the vertical channel stays bounded.
+//!   frozen during outages — so in an outage the vertical channel stays bounded. The barometer
+//!   is used only after 1 s without a GNSS fix (while GNSS is used its height is what the
+//!   offset is learnt from), with `R = σ_baro² + var(o)`. The offset is not a filter state (the
+//!   filter keeps the 15 states): its error is constant over an outage, so after each baro
+//!   update the height variance is floored at var(o), which averaging cannot remove.
 //! * Zero velocity and zero angular rate (6 rows) whenever the static detector flags the
 //!   sample (every `zupt_interval_s`): `z = [v̂, ω̂ − Ĉᵀω_ie]`, `H = [0 I 0 0 0; 0 0 0 0 −I]`.
 //!   The caller decides what is static (on the ground: a hovering aircraft is not).
 //! * Heading at start-up: magnetometer heading updates for the first `heading_aiding_s`
 //!   seconds, `z = atan2(m_E, m_N) − D` with `m = Ĉ·m̃_b`,
-//!   `H_ψ = [−m_N m_D/|m_h|², −m_E m_D/|m_h|², 1]`; without a magnetometer the yaw is reset
+//!   `H_ψ = [−m_N m_D/|m_h|², −m_E m_D/|m_h|², 1]`, the heading variance floored at
+//!   `mag_heading_std_rad²` (the error is mostly a common bias); without a magnetometer the yaw is reset
 //!   once to the GNSS course when the ground speed first exceeds `course_min_speed_m_s`.
 //!
 //! # TCZUPT in flight
@@ -65,6 +70,14 @@
 //! fault sustained over the window, `W·fᵀS⁻¹f ≤ λ` and the filter may follow it fully, so
 //! `b_H ≥ √(λ/W)·√λ_max(S_NE)`. The larger of the two is used; it is held between fixes and
 //! through outages.
+//!
+//! After `reset_after_exclusions` consecutive excluded fixes (default 50, 10 s at 5 Hz) the
+//! filter cannot tell a long GNSS fault from its own divergence; it re-initialises position and
+//! velocity on the fix and reports the reset ([`FixStatus::Reset`]).
+//!
+//! # Real logs
+//! An IMU interval longer than five nominal sample periods is a logging gap: it is bridged with
+//! the last sample before it (the sample after a gap averages over an unknown part of it).
 mod filter;
 
 pub use filter::{
@@ -136,6 +149,8 @@ pub struct InsConfig<T> {
     pub k_vertical: T,
     /// Window (s) of the least-squares dT/dt slope (TCZUPT).
     pub temp_slope_window_s: T,
+    /// Consecutive excluded fixes after which the filter re-initialises on GNSS (0 = never).
+    pub reset_after_exclusions: usize,
 }
 
 impl<T: Real> Default for InsConfig<T> {
@@ -166,7 +181,7 @@ impl<T: Real> Default for InsConfig<T> {
             zaru_std_rad_s: lit(1e-3),
             zupt_interval_s: lit(0.2),
             mag_heading_std_rad: lit(5.0 * deg),
-            heading_aiding_s: lit(60.0),
+            heading_aiding_s: lit(30.0),
             mag_interval_s: lit(0.2),
             declination_rad: T::zero(),
             course_min_speed_m_s: lit(5.0),
@@ -176,6 +191,7 @@ impl<T: Real> Default for InsConfig<T> {
             k_horizontal: lit(6.0),
             k_vertical: lit(5.33),
             temp_slope_window_s: lit(30.0),
+            reset_after_exclusions: 50,
         }
     }
 }

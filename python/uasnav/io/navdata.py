@@ -10,6 +10,7 @@ constructors check shapes, finiteness and strictly increasing time and name what
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+import math
 from typing import Any
 
 import numpy as np
@@ -258,4 +259,137 @@ def _cut_traj(tr: Trajectory | None, t0: float, t1: float) -> Trajectory | None:
         tr.name,
         tr.alt_datum,
         {n: v[k] for n, v in tr.extra.items()},
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Per-format extraction
+
+
+#: ArduPilot's GPS message has no accuracy fields in older logs: σ_H = HDOP × this UERE (m),
+#: σ_V = 1.5 σ_H, and the speed accuracy below. Stated, not measured: a u-blox receiver with
+#: HDOP ≈ 1.5 typically reaches 1–3 m.
+ARDUPILOT_UERE_M = 1.0
+ARDUPILOT_SPEED_ACC_M_S = 0.3
+#: ArduPilot logs a GPS message when it arrives; the fix is valid this long before (s): the
+#: autopilot's own default ``EKF_GPS_DELAY`` / ``GPS_DELAY_MS`` of 220 ms.
+ARDUPILOT_GPS_DELAY_S = 0.22
+
+
+def _pick(tables: dict[str, dict[str, FloatArray]], names: tuple[str, ...]) -> tuple[str, dict[str, FloatArray]] | None:
+    for n in names:
+        if n in tables and tables[n]["t"].size >= 2:
+            return n, tables[n]
+    return None
+
+
+def _strictly_increasing(t: FloatArray) -> NDArray[np.bool_]:
+    """Keep the first of repeated/decreasing time stamps."""
+    keep = np.ones(t.size, dtype=bool)
+    last = -np.inf
+    for i, x in enumerate(t):
+        if x > last:
+            last = x
+        else:
+            keep[i] = False
+    return keep
+
+
+def read_dataflash_nav(path: str | Any, imu: str | None = None) -> Flight:
+    """Navigation data of an ArduPilot DataFlash log: every IMU (``IMU``/``IMU2``/``IMU3``
+    with temperature), ``GPS`` (fixes with ``Status`` ≥ 3; time from its ``T`` field, the
+    log clock, when ``TimeMS`` is GPS time of week), ``BARO`` (``Alt``), ``MAG`` (field minus
+    nothing: the logged ``MagX/Y/Z`` are already offset-corrected), and the autopilot's
+    estimate from ``XKF1``/``NKF1``/``EKF1`` (``PN/PE/PD`` from the origin, taken as the first
+    3-D fix, ``VN/VE/VD``, ``Roll/Pitch/Yaw``), else ``AHR2``.
+
+    Heights are the GPS ``Alt`` (above mean sea level: older logs carry no ellipsoidal height;
+    the filter only needs one consistent datum). Accuracies from HDOP (see
+    :data:`ARDUPILOT_UERE_M`); fix times moved back by the GPS delay
+    (:data:`ARDUPILOT_GPS_DELAY_S`).
+
+    Raises
+    ------
+    DataFormatError
+        No IMU, no GPS message, or fewer than 2 fixes with ``Status`` ≥ 3 (named).
+    """
+    from uasnav.errors import DataFormatError
+    from uasnav.io.dataflash import read_dataflash, read_dataflash_messages
+
+    imus = read_dataflash(path)
+    tables = read_dataflash_messages(path, ["GPS", "BARO", "MAG", "XKF1", "NKF1", "EKF1", "AHR2", "ATT"])
+    if "GPS" not in tables:
+        raise DataFormatError("no GPS message: the GNSS/INS filter needs GNSS fixes", path=str(path), column="GPS")
+    gp = tables["GPS"]
+    t_field = "T" if "T" in gp and np.all(np.isfinite(gp["T"])) and gp["T"].max() > 0 else None
+    t = gp["T"] * 1e-3 if t_field else gp["t"]
+    status = gp.get("Status", np.full(t.size, 3.0))
+    ok = (status >= 3) & np.isfinite(gp["Lat"]) & np.isfinite(gp["Lng"]) & (np.abs(gp["Lat"]) > 1e-6)
+    t, ok = t[ok], np.flatnonzero(ok)
+    keep = _strictly_increasing(t)
+    t, ok = t[keep], ok[keep]
+    if t.size < 2:
+        raise DataFormatError("GPS: fewer than 2 fixes with Status >= 3 (3-D fix)", path=str(path), column="GPS.Status")
+    spd, crs = gp["Spd"][ok], np.radians(gp["GCrs"][ok])
+    vz = gp["VZ"][ok] if "VZ" in gp else np.zeros(t.size)
+    hdop = gp["HDop"][ok] if "HDop" in gp else np.full(t.size, 1.5)
+    h_acc = np.maximum(np.nan_to_num(hdop, nan=5.0), 0.5) * ARDUPILOT_UERE_M
+    gnss = GnssData(
+        t - ARDUPILOT_GPS_DELAY_S,
+        gp["Lat"][ok],
+        gp["Lng"][ok],
+        gp["Alt"][ok],
+        np.column_stack([spd * np.cos(crs), spd * np.sin(crs), vz]),
+        h_acc,
+        1.5 * h_acc,
+        np.full(t.size, ARDUPILOT_SPEED_ACC_M_S),
+    )
+    baro = None
+    if "BARO" in tables and tables["BARO"]["t"].size >= 2:
+        b = tables["BARO"]
+        k = _strictly_increasing(b["t"]) & np.isfinite(b["Alt"])
+        baro = BaroData(b["t"][k], b["Alt"][k])
+    mag = None
+    if "MAG" in tables and tables["MAG"]["t"].size >= 2:
+        m = tables["MAG"]
+        k = _strictly_increasing(m["t"])
+        fld = np.column_stack([m["MagX"], m["MagY"], m["MagZ"]])[k]
+        k2 = np.all(np.isfinite(fld), axis=1) & (np.linalg.norm(fld, axis=1) > 0)
+        mag = MagData(m["t"][k][k2], fld[k2])
+    ref = None
+    ekf = _pick(tables, ("XKF1", "NKF1", "EKF1"))
+    if ekf is not None:
+        name, e = ekf
+        lat0, lon0, alt0 = float(gnss.lat[0]), float(gnss.lon[0]), float(gnss.alt[0])
+        s2 = math.sin(math.radians(lat0)) ** 2
+        d = 1.0 - 6.69437999014e-3 * s2
+        re = 6378137.0 / math.sqrt(d)
+        rn = re * (1.0 - 6.69437999014e-3) / d
+        k = _strictly_increasing(e["t"])
+        ref = Trajectory(
+            e["t"][k],
+            lat0 + np.degrees(e["PN"][k] / rn),
+            lon0 + np.degrees(e["PE"][k] / (re * math.cos(math.radians(lat0)))),
+            alt0 - e["PD"][k],
+            np.column_stack([e["VN"], e["VE"], e["VD"]])[k],
+            np.column_stack([e["Roll"], e["Pitch"], e["Yaw"]])[k],
+            name=f"ArduPilot EKF ({name}; origin = first 3-D fix)",
+            alt_datum="origin-relative",
+        )
+    elif "AHR2" in tables:
+        a = tables["AHR2"]
+        k = _strictly_increasing(a["t"]) & (np.abs(a["Lat"]) > 1e-6)
+        if k.sum() >= 2:
+            ref = Trajectory(
+                a["t"][k], a["Lat"][k], a["Lng"][k], a["Alt"][k], None,
+                np.column_stack([a["Roll"], a["Pitch"], a["Yaw"]])[k], name="ArduPilot AHR2", alt_datum="amsl",
+            )
+    key = imu or next(iter(imus))
+    if key not in imus:
+        from uasnav.errors import InputError
+
+        raise InputError(f"imu: {key!r} not in the log (has {', '.join(imus)})")
+    return Flight(
+        imus[key], gnss, baro, mag, reference=ref, imus=imus,
+        meta={"source": str(path), "format": "ardupilot-dataflash", "imu": key},
     )
