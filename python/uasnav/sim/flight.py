@@ -14,7 +14,8 @@ preset's thermal gyro-bias curve ``b_T`` (heating branch; zero at the start temp
 temperature that warms exponentially, white noise (ARW, VRW), rotor vibration while airborne (white) and bias random walks. GNSS:
 antenna position/velocity with white errors of exactly the reported σ (the filter's model; real
 receivers have time-correlated errors). Barometer: height minus a constant datum offset plus
-white noise. Magnetometer: a fixed NED field (declination 0) resolved in the body plus noise.
+white noise. Magnetometer: a fixed NED field (declination 0 plus a per-flight heading error)
+resolved in the body plus noise.
 
 Position: latitude/longitude from the local north/east with the radii at the start point
 (the mapping's relative error over a few km is ~1e-6); gravity at the start latitude with its
@@ -64,6 +65,9 @@ class FlightErrors:
     baro_std_m: float = 0.5
     baro_offset_m: float = -30.0
     mag_std_ut: float = 0.3
+    #: Heading error of the magnetometer common to a whole flight (unknown declination and
+    #: iron effects), drawn once per flight, σ in rad.
+    mag_heading_bias_std_rad: float = math.radians(2.0)
     #: Rotor vibration while airborne, white, σ per sample (m/s², rad/s): what tells hovering
     #: from standing on the ground.
     vibration_accel_m_s2: float = 0.1
@@ -287,7 +291,8 @@ def simulate_flight(
     tb = np.arange(0.0, t_end + 1e-9, 0.1)
     pb, _, _ = kin(tb)
     baro = BaroData(tb, height_m - pb[:, 2] + e.baro_offset_m + rng.normal(0.0, e.baro_std_m, tb.size))
-    m_n = np.array([20.0, 0.0, 45.0])
+    dec_err = rng.normal(0.0, e.mag_heading_bias_std_rad)
+    m_n = np.array([20.0 * math.cos(dec_err), 20.0 * math.sin(dec_err), 45.0])
     tm_ = np.arange(0.0, t_end + 1e-9, 0.05)
     im = np.clip(np.round(tm_ * rate_hz).astype(int), 0, n - 1)
     mag_field = np.einsum("nji,j->ni", c[im], m_n) + rng.normal(0.0, e.mag_std_ut, (im.size, 3))
@@ -326,6 +331,6 @@ def matched_config_values(errors: FlightErrors | None = None) -> dict[str, float
         "sigma_arw_rad_sqrt_s": math.hypot(e.arw_rad_sqrt_s, e.vibration_gyro_rad_s / math.sqrt(rate)),
         "sigma_abi_m_s2": e.accel_rw_m_s2_sqrt_s,
         "sigma_gbi_rad_s": e.gyro_rw_rad_s_sqrt_s,
-        "mag_heading_std_rad": math.atan2(2.0 * e.mag_std_ut, 20.0),
+        "mag_heading_std_rad": math.hypot(e.mag_heading_bias_std_rad, math.atan2(e.mag_std_ut, 20.0)),
         "baro_std_m": e.baro_std_m,
     }
