@@ -144,7 +144,9 @@ def test_gnss_step_fault_is_excluded_and_alerted(flight: ins.Flight) -> None:
 
 
 @pytest.mark.parametrize("rate_m_s", [1.0, 5.0])
-def test_gnss_ramp_fault_never_exceeds_the_protection_level_unannounced(flight: ins.Flight, rate_m_s: float) -> None:
+def test_gnss_ramp_fault_never_exceeds_the_protection_level_unannounced(
+    flight: ins.Flight, rate_m_s: float
+) -> None:
     g = flight.gnss
     fault = np.clip(g.t - 80.0, 0.0, None) * rate_m_s
     r = ins.run(_with_fault(flight, fault), _matched(hal_m=40.0, val_m=50.0))
@@ -183,9 +185,16 @@ def test_tczupt_beats_classic_on_a_warming_imu() -> None:
     model = PolynomialBiasModel(order=3).fit(temps, thermal_bias("lsm6dsm", temps))
     errs: dict[str, list[float]] = {"classic": [], "tczupt": []}
     for s in range(4):
-        f = simulate_flight(duration_s=300.0, seed=700 + s, errors=FlightErrors(temp_rise_c=20.0, temp_tau_s=200.0))
+        f = simulate_flight(
+            duration_s=300.0, seed=700 + s, errors=FlightErrors(temp_rise_c=20.0, temp_tau_s=200.0)
+        )
         for mode in errs:
-            cfg = ins.InsConfig(mode=mode, model=model if mode == "tczupt" else None, decimation=10, gnss_outages=((240.0, 30.0),))  # type: ignore[arg-type]
+            cfg = ins.InsConfig(
+                mode=mode,
+                model=model if mode == "tczupt" else None,
+                decimation=10,
+                gnss_outages=((240.0, 30.0),),
+            )  # type: ignore[arg-type]
             r = ins.run(f, cfg)
             errs[mode].append(ev.outage_end_error(r, f, 240.0, 30.0, against="truth").horizontal_error_m)
     assert np.median(errs["tczupt"]) < np.median(errs["classic"])
@@ -207,7 +216,9 @@ def test_outputs_track_csv_geojson_kml(tmp_path, flight: ins.Flight) -> None:  #
     r.to_kml(tmp_path / "t.kml")
     from lxml import etree
 
-    root = etree.parse(str(tmp_path / "t.kml"), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+    root = etree.parse(
+        str(tmp_path / "t.kml"), etree.XMLParser(resolve_entities=False, no_network=True)
+    ).getroot()
     assert root.tag.endswith("kml")
 
 
@@ -221,7 +232,9 @@ def test_bad_input_is_named(flight: ins.Flight) -> None:
     with pytest.raises(InputError, match="gnss.t"):
         ins.GnssData(np.array([0.0, 0.0]), *(np.zeros(2),) * 3, np.zeros((2, 3)), *(np.ones(2),) * 3)
     with pytest.raises(InputError, match="h_acc"):
-        ins.GnssData(np.array([0.0, 1.0]), *(np.zeros(2),) * 3, np.zeros((2, 3)), np.zeros(2), np.ones(2), np.ones(2))
+        ins.GnssData(
+            np.array([0.0, 1.0]), *(np.zeros(2),) * 3, np.zeros((2, 3)), np.zeros(2), np.ones(2), np.ones(2)
+        )
     with pytest.raises(InputError, match="unknown key"):
         ins.run(flight, ins.InsConfig(extra={"no_such_field": 1.0}))
     with pytest.raises(InputError, match="flight"):

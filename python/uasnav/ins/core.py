@@ -43,9 +43,10 @@ FloatArray = NDArray[np.float64]
 Mode = Literal["classic", "tczupt"]
 
 #: TRACK.csv columns (SI; degrees only for lat/lon/roll/pitch/yaw).
-TRACK_COLUMNS = (
-    "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw,bgx,bgy,bgz,bax,bay,baz,hpl,vpl,gnss_used".split(",")
-)
+TRACK_COLUMNS = "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw,bgx,bgy,bgz,bax,bay,baz,hpl,vpl,gnss_used".split(",")
+#: Below this IMU rate (Hz) strapdown integration is refused: a turn of 30 °/s would rotate
+#: the body by more than 6° between samples.
+MIN_IMU_RATE_HZ = 5.0
 #: Fix status codes of the Rust filter.
 FIX_STATUS = {0: "used", 1: "excluded", 2: "excluded_window", 3: "masked", 4: "unused", 5: "reset"}
 
@@ -234,7 +235,11 @@ class InsResult:
         out = []
         for i in np.flatnonzero((self.fix_status == 1) | (self.fix_status == 2) | (self.fix_status == 5)):
             out.append(
-                {"t": float(self.fix_t[i]), "test": FIX_STATUS[int(self.fix_status[i])], "nis": float(self.fix_nis[i])}
+                {
+                    "t": float(self.fix_t[i]),
+                    "test": FIX_STATUS[int(self.fix_status[i])],
+                    "nis": float(self.fix_nis[i]),
+                }
             )
         return out
 
@@ -264,7 +269,15 @@ class InsResult:
                 kinds.append("HAL")
             if self.val_m is not None and v > self.val_m:
                 kinds.append("VAL")
-            out.append({"t_start": float(self.t[i0]), "t_end": float(self.t[i1 - 1]), "limits": kinds, "max_hpl": h, "max_vpl": v})
+            out.append(
+                {
+                    "t_start": float(self.t[i0]),
+                    "t_end": float(self.t[i1 - 1]),
+                    "limits": kinds,
+                    "max_hpl": h,
+                    "max_vpl": v,
+                }
+            )
         return out
 
     def track_table(self) -> FloatArray:
@@ -303,7 +316,11 @@ class InsResult:
             {
                 "type": "Feature",
                 "geometry": {"type": "LineString", "coordinates": coords},
-                "properties": {"name": "uasnav INS track", "t_start": float(self.t[0]), "t_end": float(self.t[-1])},
+                "properties": {
+                    "name": "uasnav INS track",
+                    "t_start": float(self.t[0]),
+                    "t_end": float(self.t[-1]),
+                },
             }
         ]
         for ev in self.excluded_fixes:
@@ -425,7 +442,9 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
     imu = flight.imu
     t_start = max(float(g.t[0]), float(imu.t[0]))
     if t_start > imu.t[-1]:
-        raise InputError(f"gnss: the first fix ({g.t[0]:.3f} s) is after the IMU's last sample ({imu.t[-1]:.3f} s)")
+        raise InputError(
+            f"gnss: the first fix ({g.t[0]:.3f} s) is after the IMU's last sample ({imu.t[-1]:.3f} s)"
+        )
     use = np.ones(g.n, dtype=bool)
     for start, dur in cfg.gnss_outages:
         if not (math.isfinite(start) and math.isfinite(dur) and dur > 0):
@@ -439,6 +458,12 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
     if t_start > imu.t[0]:
         imu = imu.between(t_start, float(imu.t[-1]))
         flight = flight.with_imu(imu, flight.meta.get("imu"))
+    rate = imu.sample_rate
+    if rate < MIN_IMU_RATE_HZ:
+        raise InputError(
+            f"IMU rate {rate:.2f} Hz is too low for strapdown navigation (need >= {MIN_IMU_RATE_HZ:g} Hz; "
+            "a telemetry log's IMU stream is often decimated: use the on-board log)"
+        )
     temp = imu.temp
     gyro = imu.gyro
     dbias = None
@@ -464,21 +489,21 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
     mag = flight.mag if cfg.use_mag else None
     llh = np.ascontiguousarray(np.column_stack([np.radians(g.lat), np.radians(g.lon), g.alt]))
     acc = np.ascontiguousarray(np.column_stack([g.h_acc, g.v_acc, g.s_acc]))
-    rate = imu.sample_rate
+    c = np.ascontiguousarray
     out = _core.ins_run(
-        imu.t,
-        np.ascontiguousarray(gyro),
-        imu.accel,
-        g.t,
+        c(imu.t),
+        c(gyro),
+        c(imu.accel),
+        c(g.t),
         llh,
-        g.vel,
+        c(g.vel),
         acc,
         gnss_use=use,
-        baro_t=None if baro is None else baro.t,
-        baro_h=None if baro is None else baro.alt,
-        mag_t=None if mag is None else mag.t,
-        mag=None if mag is None else mag.field,
-        temp=temp if cfg.mode == "tczupt" else None,
+        baro_t=None if baro is None else c(baro.t),
+        baro_h=None if baro is None else c(baro.alt),
+        mag_t=None if mag is None else c(mag.t),
+        mag=None if mag is None else c(mag.field),
+        temp=c(temp) if cfg.mode == "tczupt" and temp is not None else None,
         dbias_dtemp=dbias,
         stationary=stationary,
         levelling_samples=max(1, int(round(min(2.0, imu.duration / 4) * rate))),

@@ -32,7 +32,9 @@ def _radii(lat_rad: FloatArray) -> tuple[FloatArray, FloatArray]:
     return re * (1.0 - earth.WGS84_E2) / d, re
 
 
-def ned_difference(lat: FloatArray, lon: FloatArray, alt: FloatArray, ref: Trajectory, t: FloatArray) -> FloatArray:
+def ned_difference(
+    lat: FloatArray, lon: FloatArray, alt: FloatArray, ref: Trajectory, t: FloatArray
+) -> FloatArray:
     """(n, 3) NED difference (m) of positions (deg, deg, m) at times ``t`` from ``ref``
     interpolated to ``t``."""
     rlat = np.interp(t, ref.t, ref.lat)
@@ -109,7 +111,9 @@ def compare(result: InsResult, ref: Trajectory, *, t_range: tuple[float, float] 
         ang = np.radians(ref.euler_deg)
         re_ = np.column_stack(
             [
-                np.degrees(np.arctan2(np.interp(t, ref.t, np.sin(ang[:, i])), np.interp(t, ref.t, np.cos(ang[:, i]))))
+                np.degrees(
+                    np.arctan2(np.interp(t, ref.t, np.sin(ang[:, i])), np.interp(t, ref.t, np.cos(ang[:, i])))
+                )
                 for i in range(3)
             ]
         )
@@ -237,7 +241,13 @@ def outage_end_error(
     if against == "truth":
         if flight.truth is None:
             raise InputError("outage_end_error: the flight has no truth")
-        d = ned_difference(result.lat[i : i + 1], result.lon[i : i + 1], result.alt[i : i + 1], flight.truth, result.t[i : i + 1])[0]
+        d = ned_difference(
+            result.lat[i : i + 1],
+            result.lon[i : i + 1],
+            result.alt[i : i + 1],
+            flight.truth,
+            result.t[i : i + 1],
+        )[0]
     else:
         g = flight.gnss
         j = int(np.searchsorted(g.t, t_end - 1e-9))
@@ -267,7 +277,9 @@ def outage_end_error(
     )
 
 
-def outage_starts(interval: tuple[float, float], duration: float, count: int, lead_s: float = 30.0) -> list[float]:
+def outage_starts(
+    interval: tuple[float, float], duration: float, count: int, lead_s: float = 30.0
+) -> list[float]:
     """``count`` start times spread evenly over ``interval`` so that each outage ends inside it
     and the filter has ``lead_s`` of GNSS before the first."""
     lo, hi = interval[0] + lead_s, interval[1] - duration - 1.0

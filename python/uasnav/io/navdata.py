@@ -9,8 +9,8 @@ constructors check shapes, finiteness and strictly increasing time and name what
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 import math
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -95,7 +95,9 @@ class GnssData:
 
     def select(self, keep: NDArray[np.bool_]) -> GnssData:
         """The fixes where ``keep`` is true."""
-        return GnssData(*(getattr(self, k)[keep] for k in ("t", "lat", "lon", "alt", "vel", "h_acc", "v_acc", "s_acc")))
+        return GnssData(
+            *(getattr(self, k)[keep] for k in ("t", "lat", "lon", "alt", "vel", "h_acc", "v_acc", "s_acc"))
+        )
 
 
 @dataclass(frozen=True)
@@ -213,7 +215,9 @@ class Flight:
         meta = dict(self.meta)
         if name:
             meta["imu"] = name
-        return Flight(imu, self.gnss, self.baro, self.mag, self.reference, self.truth, self.imus, self.airborne, meta)
+        return Flight(
+            imu, self.gnss, self.baro, self.mag, self.reference, self.truth, self.imus, self.airborne, meta
+        )
 
     def between(self, t0: float, t1: float) -> Flight:
         """The flight cut to ``t0 ≤ t ≤ t1`` (every stream)."""
@@ -276,7 +280,9 @@ ARDUPILOT_SPEED_ACC_M_S = 0.3
 ARDUPILOT_GPS_DELAY_S = 0.22
 
 
-def _pick(tables: dict[str, dict[str, FloatArray]], names: tuple[str, ...]) -> tuple[str, dict[str, FloatArray]] | None:
+def _pick(
+    tables: dict[str, dict[str, FloatArray]], names: tuple[str, ...]
+) -> tuple[str, dict[str, FloatArray]] | None:
     for n in names:
         if n in tables and tables[n]["t"].size >= 2:
             return n, tables[n]
@@ -319,7 +325,9 @@ def read_dataflash_nav(path: str | Any, imu: str | None = None) -> Flight:
     imus = read_dataflash(path)
     tables = read_dataflash_messages(path, ["GPS", "BARO", "MAG", "XKF1", "NKF1", "EKF1", "AHR2", "ATT"])
     if "GPS" not in tables:
-        raise DataFormatError("no GPS message: the GNSS/INS filter needs GNSS fixes", path=str(path), column="GPS")
+        raise DataFormatError(
+            "no GPS message: the GNSS/INS filter needs GNSS fixes", path=str(path), column="GPS"
+        )
     gp = tables["GPS"]
     t_field = "T" if "T" in gp and np.all(np.isfinite(gp["T"])) and gp["T"].max() > 0 else None
     t = gp["T"] * 1e-3 if t_field else gp["t"]
@@ -329,7 +337,9 @@ def read_dataflash_nav(path: str | Any, imu: str | None = None) -> Flight:
     keep = _strictly_increasing(t)
     t, ok = t[keep], ok[keep]
     if t.size < 2:
-        raise DataFormatError("GPS: fewer than 2 fixes with Status >= 3 (3-D fix)", path=str(path), column="GPS.Status")
+        raise DataFormatError(
+            "GPS: fewer than 2 fixes with Status >= 3 (3-D fix)", path=str(path), column="GPS.Status"
+        )
     spd, crs = gp["Spd"][ok], np.radians(gp["GCrs"][ok])
     vz = gp["VZ"][ok] if "VZ" in gp else np.zeros(t.size)
     hdop = gp["HDop"][ok] if "HDop" in gp else np.full(t.size, 1.5)
@@ -381,8 +391,14 @@ def read_dataflash_nav(path: str | Any, imu: str | None = None) -> Flight:
         k = _strictly_increasing(a["t"]) & (np.abs(a["Lat"]) > 1e-6)
         if k.sum() >= 2:
             ref = Trajectory(
-                a["t"][k], a["Lat"][k], a["Lng"][k], a["Alt"][k], None,
-                np.column_stack([a["Roll"], a["Pitch"], a["Yaw"]])[k], name="ArduPilot AHR2", alt_datum="amsl",
+                a["t"][k],
+                a["Lat"][k],
+                a["Lng"][k],
+                a["Alt"][k],
+                None,
+                np.column_stack([a["Roll"], a["Pitch"], a["Yaw"]])[k],
+                name="ArduPilot AHR2",
+                alt_datum="amsl",
             )
     key = imu or next(iter(imus))
     if key not in imus:
@@ -390,6 +406,220 @@ def read_dataflash_nav(path: str | Any, imu: str | None = None) -> Flight:
 
         raise InputError(f"imu: {key!r} not in the log (has {', '.join(imus)})")
     return Flight(
-        imus[key], gnss, baro, mag, reference=ref, imus=imus,
+        imus[key],
+        gnss,
+        baro,
+        mag,
+        reference=ref,
+        imus=imus,
         meta={"source": str(path), "format": "ardupilot-dataflash", "imu": key},
     )
+
+
+def read_ulog_nav(path: str | Any) -> Flight:
+    """Navigation data of a PX4 ULog: the primary IMU (:func:`uasnav.io.px4.read_ulog`:
+    ``sensor_combined`` or ``sensor_gyro``/``sensor_accel``, with temperature),
+    ``vehicle_gps_position`` or ``sensor_gps`` (``alt_ellipsoid``, ``eph``/``epv``/
+    ``s_variance_m_s`` as accuracies, fixes with ``fix_type`` ≥ 3), ``vehicle_air_data``
+    (``baro_alt_meter``), ``vehicle_magnetometer``, and the reference from
+    ``vehicle_global_position`` or ``vehicle_local_position`` (``ref_lat/ref_lon/ref_alt`` +
+    ``x/y/z``, ``vx/vy/vz``) with ``vehicle_attitude``.
+
+    Raises
+    ------
+    DataFormatError
+        No GNSS topic, fewer than 2 3-D fixes, or the IMU reader's errors.
+    """
+    from pathlib import Path
+
+    from uasnav.errors import DataFormatError
+    from uasnav.io.px4 import _dataset, _open, read_ulog
+
+    p = Path(path)
+    imu = read_ulog(p)
+    ulog, _ = _open(p)
+
+    def topic(*names: str) -> dict[str, Any] | None:
+        for n in names:
+            d = _dataset(ulog, n)
+            if d is not None and len(d.data["timestamp"]) >= 2:
+                return {k: np.asarray(v, dtype=np.float64) for k, v in d.data.items()}
+        return None
+
+    g = topic("vehicle_gps_position", "sensor_gps")
+    if g is None:
+        raise DataFormatError(
+            "no vehicle_gps_position / sensor_gps topic: the GNSS/INS filter needs GNSS fixes", path=str(p)
+        )
+    ok = g.get("fix_type", np.full(g["timestamp"].size, 3.0)) >= 3
+    t = g["timestamp"][ok] * 1e-6
+    keep = _strictly_increasing(t)
+    sel = np.flatnonzero(ok)[keep]
+    if sel.size < 2:
+        raise DataFormatError(
+            "vehicle_gps_position: fewer than 2 fixes with fix_type >= 3",
+            path=str(p),
+            column="vehicle_gps_position.fix_type",
+        )
+    alt = g["alt_ellipsoid"] if "alt_ellipsoid" in g and np.any(g["alt_ellipsoid"] != 0) else g["alt"]
+    gnss = GnssData(
+        g["timestamp"][sel] * 1e-6,
+        g["lat"][sel] * 1e-7,
+        g["lon"][sel] * 1e-7,
+        alt[sel] * 1e-3,
+        np.column_stack([g["vel_n_m_s"], g["vel_e_m_s"], g["vel_d_m_s"]])[sel],
+        np.maximum(g.get("eph", np.full(g["timestamp"].size, 2.0))[sel], 0.1),
+        np.maximum(g.get("epv", np.full(g["timestamp"].size, 3.0))[sel], 0.1),
+        np.maximum(g.get("s_variance_m_s", np.full(g["timestamp"].size, 0.3))[sel], 0.05),
+    )
+    baro = None
+    b = topic("vehicle_air_data")
+    if b is not None:
+        k = _strictly_increasing(b["timestamp"])
+        baro = BaroData(b["timestamp"][k] * 1e-6, b["baro_alt_meter"][k])
+    mag = None
+    m = topic("vehicle_magnetometer")
+    if m is not None and "magnetometer_ga[0]" in m:
+        k = _strictly_increasing(m["timestamp"])
+        mag = MagData(
+            m["timestamp"][k] * 1e-6, np.column_stack([m[f"magnetometer_ga[{i}]"] for i in range(3)])[k]
+        )
+    ref = None
+    att = topic("vehicle_attitude")
+    lp = topic("vehicle_local_position")
+    if lp is not None and "ref_lat" in lp:
+        k = _strictly_increasing(lp["timestamp"])
+        tt = lp["timestamp"][k] * 1e-6
+        lat0, lon0, alt0 = (
+            float(lp["ref_lat"][k][-1]),
+            float(lp["ref_lon"][k][-1]),
+            float(lp["ref_alt"][k][-1]),
+        )
+        origin = "ref_lat/ref_lon/ref_alt"
+        if lat0 == 0.0 and lon0 == 0.0:
+            # No global reference in the log (e.g. an excerpt): the EKF origin is taken as the
+            # first 3-D fix, its height as that fix's (ellipsoidal) height.
+            lat0, lon0, alt0 = float(gnss.lat[0]), float(gnss.lon[0]), float(gnss.alt[0])
+            origin = "first 3-D fix"
+            z0 = float(np.interp(gnss.t[0], lp["timestamp"][k] * 1e-6, lp["z"][k]))
+            alt0 += z0
+        s2 = math.sin(math.radians(lat0)) ** 2
+        d = 1.0 - 6.69437999014e-3 * s2
+        re = 6378137.0 / math.sqrt(d)
+        rn = re * (1.0 - 6.69437999014e-3) / d
+        eul = None
+        if att is not None:
+            from scipy.spatial.transform import Rotation
+
+            q = np.column_stack([att[f"q[{i}]"] for i in (1, 2, 3, 0)])
+            e = Rotation.from_quat(q).as_euler("ZYX")[:, ::-1]
+            ta = att["timestamp"] * 1e-6
+            eul = np.column_stack(
+                [
+                    np.degrees(
+                        np.arctan2(np.interp(tt, ta, np.sin(e[:, i])), np.interp(tt, ta, np.cos(e[:, i])))
+                    )
+                    for i in range(3)
+                ]
+            )
+        ref = Trajectory(
+            tt,
+            lat0
+            + np.degrees(
+                (
+                    lp["x"][k]
+                    - (
+                        float(np.interp(gnss.t[0], tt, lp["x"][k]))
+                        if origin != "ref_lat/ref_lon/ref_alt"
+                        else 0.0
+                    )
+                )
+                / rn
+            ),
+            lon0
+            + np.degrees(
+                (
+                    lp["y"][k]
+                    - (
+                        float(np.interp(gnss.t[0], tt, lp["y"][k]))
+                        if origin != "ref_lat/ref_lon/ref_alt"
+                        else 0.0
+                    )
+                )
+                / (re * math.cos(math.radians(lat0)))
+            ),
+            alt0 - lp["z"][k],
+            np.column_stack([lp["vx"], lp["vy"], lp["vz"]])[k],
+            eul,
+            name=f"PX4 EKF2 (vehicle_local_position + vehicle_attitude; origin = {origin})",
+            alt_datum="origin-relative",
+        )
+    return Flight(
+        imu,
+        gnss,
+        baro,
+        mag,
+        reference=ref,
+        imus={"IMU": imu},
+        meta={"source": str(p), "format": "px4-ulog", "imu": "IMU"},
+    )
+
+
+def read_csv_nav(path: str | Any, gnss: GnssData) -> Flight:
+    """A CSV v1 IMU log (``mx my mz`` as magnetometer if present) with a separate GNSS CSV."""
+    from uasnav.io.csv_v1 import read_csv_v1
+
+    imu = read_csv_v1(path)
+    mag = MagData(imu.t, imu.mag) if imu.mag is not None else None
+    return Flight(
+        imu, gnss, None, mag, imus={"IMU": imu}, meta={"source": str(path), "format": "csv-v1", "imu": "IMU"}
+    )
+
+
+def read_nav(path: str | Any, *, gnss_csv: str | None = None) -> Flight:
+    """The navigation data of a log, by extension: ``.bin`` (DataFlash), ``.ulg`` (ULog),
+    ``.tlog`` (MAVLink), ``.csv`` (CSV v1, with ``gnss_csv`` required), or an ALFA ROS-topic CSV
+    folder. ``gnss_csv`` replaces the log's own GNSS when given.
+
+    Raises
+    ------
+    InputError
+        Unknown extension, or a CSV log without ``gnss_csv``.
+    """
+    from pathlib import Path
+
+    from uasnav.errors import InputError
+
+    p = Path(path)
+    gnss = None
+    if gnss_csv is not None:
+        from uasnav.io.gnss_csv import read_gnss_csv
+
+        gnss = read_gnss_csv(gnss_csv)
+    if p.is_dir():
+        from uasnav.io.alfa import read_alfa_folder
+
+        f = read_alfa_folder(p)
+    else:
+        ext = p.suffix.lower()
+        if ext == ".bin":
+            f = read_dataflash_nav(p)
+        elif ext == ".ulg":
+            f = read_ulog_nav(p)
+        elif ext == ".tlog":
+            from uasnav.io.tlog import read_tlog_nav
+
+            f = read_tlog_nav(p)
+        elif ext in (".csv", ".txt"):
+            if gnss is None:
+                raise InputError(
+                    f"{p}: a CSV IMU log needs --gnss GNSS.csv (t,lat,lon,alt,vn,ve,vd,h_acc,v_acc,s_acc)"
+                )
+            return read_csv_nav(p, gnss)
+        else:
+            raise InputError(
+                f"{p}: unknown log type {ext!r} (expected .ulg, .bin, .tlog, .csv or an ALFA folder)"
+            )
+    if gnss is not None:
+        f = Flight(f.imu, gnss, f.baro, f.mag, f.reference, f.truth, f.imus, f.airborne, f.meta)
+    return f

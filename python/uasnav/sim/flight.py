@@ -91,7 +91,9 @@ def _radii(lat: float) -> tuple[float, float]:
     return re * (1.0 - earth.WGS84_E2) / d, re
 
 
-def _path(waypoints: Sequence[tuple[float, float, float]], speed: float, static_s: float, duration_s: float | None) -> CubicSpline:
+def _path(
+    waypoints: Sequence[tuple[float, float, float]], speed: float, static_s: float, duration_s: float | None
+) -> CubicSpline:
     pts = [np.zeros(3)]
     wps = [np.asarray(w, dtype=np.float64) for w in waypoints]
     if not wps:
@@ -241,7 +243,11 @@ def simulate_flight(
     # Sensor errors.
     temp = e.temp_start_c + e.temp_rise_c * (1.0 - np.exp(-t / e.temp_tau_s))
     th = thermal_model(preset, "gyro")
-    b_t = np.zeros((n, 3)) if th is None else th.branch_bias(temp, "heating") - th.branch_bias(temp[:1], "heating")
+    b_t = (
+        np.zeros((n, 3))
+        if th is None
+        else th.branch_bias(temp, "heating") - th.branch_bias(temp[:1], "heating")
+    )
     bg = (
         rng.normal(0.0, e.gyro_turn_on_rad_s, 3)
         + np.cumsum(rng.normal(0.0, e.gyro_rw_rad_s_sqrt_s * math.sqrt(dt), (n, 3)), axis=0)
@@ -264,7 +270,13 @@ def simulate_flight(
         accel,
         temp,
         truth={},
-        meta={"source": "simulated flight", "format": "simulated", "rate_hz": rate_hz, "seed": seed, "preset": preset},
+        meta={
+            "source": "simulated flight",
+            "format": "simulated",
+            "rate_hz": rate_hz,
+            "seed": seed,
+            "preset": preset,
+        },
     )
 
     # GNSS at its own rate, with dropouts.
@@ -299,7 +311,14 @@ def simulate_flight(
     mag = MagData(tm_, mag_field)
     euler = np.degrees(rot.as_euler("ZYX")[:, ::-1])
     truth = Trajectory(
-        t, np.degrees(lat), np.degrees(lon), h, vel, euler, name="truth", extra=truth_extra | {"quat": _quat(rot)}
+        t,
+        np.degrees(lat),
+        np.degrees(lon),
+        h,
+        vel,
+        euler,
+        name="truth",
+        extra=truth_extra | {"quat": _quat(rot)},
     )
     return Flight(
         imu,
