@@ -223,13 +223,13 @@ def test_outputs_track_csv_geojson_kml(tmp_path, flight: ins.Flight) -> None:  #
 
 
 def test_bad_input_is_named(flight: ins.Flight) -> None:
-    with pytest.raises(InputError, match="tczupt.*model"):
+    with pytest.raises(InputError, match=r"tczupt.*model"):
         ins.run(flight, ins.InsConfig(mode="tczupt"))
     with pytest.raises(InputError, match="mode"):
         ins.run(flight, ins.InsConfig(mode="fancy"))  # type: ignore[arg-type]
     with pytest.raises(InputError, match="masked"):
         ins.run(flight, ins.InsConfig(gnss_outages=((-1.0, 1e6),)))
-    with pytest.raises(InputError, match="gnss.t"):
+    with pytest.raises(InputError, match=r"gnss\.t"):
         ins.GnssData(np.array([0.0, 0.0]), *(np.zeros(2),) * 3, np.zeros((2, 3)), *(np.ones(2),) * 3)
     with pytest.raises(InputError, match="h_acc"):
         ins.GnssData(

@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from uasnav.cli._common import POSITIVE, OutputPath, check_outputs, echo_json
+from uasnav.cli._common import FINITE, POSITIVE, OutputPath, check_outputs, echo_json
 
 
 def _outages(values: tuple[str, ...]) -> tuple[tuple[float, float], ...]:
@@ -77,10 +77,10 @@ def _durations(text: str | None) -> list[float]:
     help="GNSS-outage experiment: durations (s) at start times spread over the flight.",
 )
 @click.option(
-    "--start", "t_start", type=float, default=None, help="Use the log from this time (s, log clock)."
+    "--start", "t_start", type=FINITE, default=None, help="Use the log from this time (s, log clock)."
 )
 @click.option(
-    "--end", "t_end", type=float, default=None, help="Use the log up to this time (s), e.g. before a crash."
+    "--end", "t_end", type=FINITE, default=None, help="Use the log up to this time (s), e.g. before a crash."
 )
 @click.option("--hal", "hal", type=POSITIVE, default=None, help="Horizontal alert limit (m).")
 @click.option("--val", "val", type=POSITIVE, default=None, help="Vertical alert limit (m).")
@@ -122,7 +122,7 @@ def command(
     from uasnav.atomicfile import output_set
     from uasnav.errors import InputError
     from uasnav.ins import evaluate as ev
-    from uasnav.io.navdata import read_nav
+    from uasnav.io.navlog import read_nav
 
     outage_list = _outages(outages)
     durations = _durations(sweep)
@@ -194,30 +194,40 @@ def command(
     if as_json:
         echo_json(report)
         return
+    _print_text(log, flight, result, report)
+
+
+def _print_text(log: str, flight: Any, result: Any, report: dict[str, Any]) -> None:
     s = result.summary
     click.echo(
         f"{log}: {flight.imu.n} IMU samples at {flight.imu.sample_rate:.1f} Hz, {flight.gnss.n} GNSS fixes"
     )
     click.echo(
-        f"fixes used {s['fixes_used']}, excluded {s['fixes_excluded']}, masked {s['fixes_masked']}, resets {s['gnss_resets']}; "
-        f"ZUPT {s['static_updates']}, baro {s['baro_updates']}, alerts {s['alerts']}"
+        f"fixes used {s['fixes_used']}, excluded {s['fixes_excluded']}, masked {s['fixes_masked']}, "
+        f"resets {s['gnss_resets']}; ZUPT {s['static_updates']}, baro {s['baro_updates']}, "
+        f"alerts {s['alerts']}"
     )
     ref = report.get("reference")
     if isinstance(ref, dict) and "horizontal_rms_m" in ref:
+        nan = float("nan")
+        vel = ref["velocity_rms_m_s"] if ref["velocity_rms_m_s"] is not None else nan
+        rp = ref["roll_pitch_rms_deg"] if ref["roll_pitch_rms_deg"] is not None else nan
         click.echo(
-            f"vs {ref['reference']}: horizontal RMS {ref['horizontal_rms_m']:.2f} m, vertical RMS {ref['vertical_rms_m']:.2f} m, "
-            f"velocity RMS {ref['velocity_rms_m_s'] if ref['velocity_rms_m_s'] is not None else float('nan'):.2f} m/s, "
-            f"roll/pitch RMS {ref['roll_pitch_rms_deg'] if ref['roll_pitch_rms_deg'] is not None else float('nan'):.2f}°"
+            f"vs {ref['reference']}: horizontal RMS {ref['horizontal_rms_m']:.2f} m, "
+            f"vertical RMS {ref['vertical_rms_m']:.2f} m, velocity RMS {vel:.2f} m/s, "
+            f"roll/pitch RMS {rp:.2f}°"
         )
     for o in report.get("outages", []):
         click.echo(
-            f"outage {o['start']:g}+{o['duration']:g} s: horizontal error {o['horizontal_error_m']:.1f} m, vertical {o['vertical_error_m']:.1f} m"
+            f"outage {o['start']:g}+{o['duration']:g} s: horizontal error {o['horizontal_error_m']:.1f} m, "
+            f"vertical {o['vertical_error_m']:.1f} m"
         )
-    if "outage_sweep" in report:
-        for d, row in report["outage_sweep"]["summary"].items():
-            click.echo(
-                f"outage {d} s: {row['count']} outages, median horizontal error {row['median_horizontal_m']:.1f} m, max {row['max_horizontal_m']:.1f} m"
-            )
+    for d, row in report.get("outage_sweep", {}).get("summary", {}).items():
+        click.echo(
+            f"outage {d} s: {row['count']} outages, "
+            f"median horizontal error {row['median_horizontal_m']:.1f} m, "
+            f"max {row['max_horizontal_m']:.1f} m"
+        )
 
 
 def _select_imu(flight: Any, sel: str) -> Any:

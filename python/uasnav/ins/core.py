@@ -309,7 +309,7 @@ class InsResult:
     def to_geojson(self, max_points: int = 5000) -> dict[str, Any]:
         """A GeoJSON FeatureCollection: the track as a LineString (lon, lat, alt; decimated to at
         most ``max_points``), and a Point per excluded fix and per alert start."""
-        step = max(1, int(math.ceil(self.t.size / max_points)))
+        step = max(1, math.ceil(self.t.size / max_points))
         idx = np.r_[np.arange(0, self.t.size, step), self.t.size - 1]
         coords = [[float(self.lon[i]), float(self.lat[i]), float(self.alt[i])] for i in np.unique(idx)]
         feats: list[dict[str, Any]] = [
@@ -347,7 +347,7 @@ class InsResult:
         """Write the track as a KML LineString (absolute altitude = ellipsoidal height)."""
         from xml.sax.saxutils import escape
 
-        step = max(1, int(math.ceil(self.t.size / max_points)))
+        step = max(1, math.ceil(self.t.size / max_points))
         idx = np.unique(np.r_[np.arange(0, self.t.size, step), self.t.size - 1])
         coords = " ".join(f"{self.lon[i]:.9f},{self.lat[i]:.9f},{self.alt[i]:.3f}" for i in idx)
         with atomic_open(path, "w") as fh:
@@ -396,7 +396,7 @@ def _static_mask(flight: Flight, cfg: InsConfig) -> NDArray[np.bool_] | None:
         return None
     imu = flight.imu
     try:
-        det = detect_static(imu, window_samples=max(3, int(round(0.2 * imu.sample_rate))))
+        det = detect_static(imu, window_samples=max(3, round(0.2 * imu.sample_rate)))
     except InputError:
         return None
     mask = det.mask.copy()
@@ -506,7 +506,7 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         temp=c(temp) if cfg.mode == "tczupt" and temp is not None else None,
         dbias_dtemp=dbias,
         stationary=stationary,
-        levelling_samples=max(1, int(round(min(2.0, imu.duration / 4) * rate))),
+        levelling_samples=max(1, round(min(2.0, imu.duration / 4) * rate)),
         gyro_bias0=list(gyro0),
         mode=cfg.mode,
         discretisation=cfg.discretisation,

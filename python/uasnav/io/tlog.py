@@ -324,6 +324,7 @@ def read_tlog_nav(path: str | os.PathLike[str]) -> Any:
             "format": "mavlink-tlog",
             "imu": key,
             "t0_wall_s": t0,
-            "note": f"telemetry IMU at {imu.sample_rate:.1f} Hz on arrival time stamps: it limits the accuracy",
+            "note": f"telemetry IMU at {imu.sample_rate:.1f} Hz on arrival time stamps: "
+            "it limits the accuracy",
         },
     )

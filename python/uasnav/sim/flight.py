@@ -11,7 +11,8 @@ IMU (the sample at ``t_k`` holds over ``(t_{k−1}, t_k]``, as the filter reads 
 ``ω̃ = rotvec(C_{k−1}ᵀ C_k)/Ts + Cᵀω_in + b_g + b_T(T) + n_g`` and
 ``f̃ = C_midᵀ(Δv/Ts − g + (2ω_ie + ω_en) × v) + b_a + n_a``, with turn-on biases, the
 preset's thermal gyro-bias curve ``b_T`` (heating branch; zero at the start temperature) on a die
-temperature that warms exponentially, white noise (ARW, VRW), rotor vibration while airborne (white) and bias random walks. GNSS:
+temperature that warms exponentially, white noise (ARW, VRW), rotor vibration while airborne
+(white) and bias random walks. GNSS:
 antenna position/velocity with white errors of exactly the reported σ (the filter's model; real
 receivers have time-correlated errors). Barometer: height minus a constant datum offset plus
 white noise. Magnetometer: a fixed NED field (declination 0 plus a per-flight heading error)
@@ -178,7 +179,7 @@ def simulate_flight(
     t_end = float(spline.x[-1]) if duration_s is None else float(duration_s)
     if duration_s is not None and not (math.isfinite(t_end) and t_end > static_s):
         raise InputError(f"duration_s: must exceed static_s ({static_s} s), got {duration_s!r}")
-    n = int(round(t_end * rate_hz)) + 1
+    n = round(t_end * rate_hz) + 1
     check_memory(n * 8 * 60, "simulated flight")
     rng = np.random.default_rng(seed)
     dt = 1.0 / rate_hz
