@@ -14,7 +14,8 @@ Topics read:
 ============================================ ===============================================
 ``mavros-imu-data_raw``                      gyro (rad/s), specific force (m/s²); ~10 Hz
 ``mavros-imu-temperature``                   die temperature (°C)
-``mavros-imu-mag``                           magnetic field (body; unit as logged)
+``mavros-imu-mag``                           magnetic field (body; unit as logged), in
+                                             ``meta["magnetometer"]`` only (see below)
 ``mavros-imu-atm_pressure``                  static pressure (Pa) → ISA pressure altitude
 ``mavros-global_position-raw-fix``           GNSS fix; σ from ``position_covariance`` (ENU m²)
 ``mavros-global_position-raw-gps_vel``       GNSS velocity (ENU, m/s); no accuracy logged:
@@ -227,11 +228,14 @@ def read_alfa_folder(path: str | os.PathLike[str]) -> Flight:
             name="PX4/mavros global_position + imu/data",
             alt_datum="as logged",
         )
+    # The magnetometer is returned in meta only: its unit is undocumented (|B| ≈ 5e5 as logged)
+    # and the site's declination (≈ −9°) is not modelled, so as a heading aid it does more harm
+    # than the GNSS course of a fixed-wing aircraft, which the filter uses instead.
     return Flight(
         imu,
         gnss,
         baro,
-        mag,
+        None,
         reference=ref,
         imus={"imu": imu},
         meta={
@@ -239,6 +243,7 @@ def read_alfa_folder(path: str | os.PathLike[str]) -> Flight:
             "format": "alfa-ros-csv",
             "imu": "imu",
             "t0_unix_s": t0,
+            "magnetometer": mag,
             "note": f"IMU at {imu.sample_rate:.1f} Hz: low for strapdown integration, it limits the accuracy",
         },
     )
