@@ -101,6 +101,55 @@ pub struct InsFilter<T: Real> {
     bias_h: T,
     bias_v: T,
     last_nis: T,
+    earth: EarthCache<T>,
+}
+
+/// Earth quantities at a reference point, refreshed when the position moves by more than
+/// [`EARTH_REFRESH_RAD`] in latitude or [`EARTH_REFRESH_M`] in height: over such a step the
+/// radii change by < 1e-6 relative and gravity by < 3e-6 m/s² (a 60 s outage: < 6 mm).
+#[derive(Debug, Clone, Copy)]
+struct EarthCache<T> {
+    lat: f64,
+    h: f64,
+    cos_lat: f64,
+    tan_lat: f64,
+    /// Meridian and transverse radii (m).
+    rn: f64,
+    re: f64,
+    w_ie: Vector3<T>,
+    gravity: T,
+    grav_grad: T,
+}
+
+/// Latitude change (rad, ≈ 6 m) that refreshes the Earth quantities.
+const EARTH_REFRESH_RAD: f64 = 1e-6;
+/// Height change (m) that refreshes the Earth quantities.
+const EARTH_REFRESH_M: f64 = 1.0;
+
+impl<T: Real> EarthCache<T> {
+    fn at(lat: f64, h: f64) -> Self {
+        let (sl, cl) = (lat.sin(), lat.cos());
+        // Radii of curvature (Groves eqs. 2.105–2.106) from one sin.
+        let d = 1.0 - earth::WGS84_E2 * sl * sl;
+        let re = earth::WGS84_A / d.sqrt();
+        let rn = re * (1.0 - earth::WGS84_E2) / d;
+        let g = earth::normal_gravity(lat, h);
+        Self {
+            lat,
+            h,
+            cos_lat: cl,
+            tan_lat: sl / cl,
+            rn,
+            re,
+            w_ie: Vector3::new(
+                lit::<T>(earth::OMEGA_IE * cl),
+                T::zero(),
+                lit::<T>(-earth::OMEGA_IE * sl),
+            ),
+            gravity: lit(g),
+            grav_grad: lit(2.0 * g / earth::geocentric_radius(lat)),
+        }
+    }
 }
 
 impl<T: Real> InsFilter<T> {
@@ -173,6 +222,7 @@ impl<T: Real> InsFilter<T> {
             bias_h: T::zero(),
             bias_v: T::zero(),
             last_nis: T::zero(),
+            earth: EarthCache::at(lat_rad, height_m),
             cfg: config,
         })
     }
@@ -256,23 +306,14 @@ impl<T: Real> InsFilter<T> {
             });
         }
         let dt = dt_s;
-        let lat_t: T = lit(self.lat);
-        let h_t: T = lit(self.h);
-        let (sl, cl) = (self.lat.sin(), self.lat.cos());
-        // Radii of curvature (Groves eqs. 2.105–2.106) from one sin: f64, then to T.
-        let d = 1.0 - earth::WGS84_E2 * sl * sl;
-        let re = earth::WGS84_A / d.sqrt();
-        let rn = re * (1.0 - earth::WGS84_E2) / d;
-        let (rn_h, re_h) = (rn + self.h, re + self.h);
-        let w_ie = Vector3::new(
-            lit::<T>(earth::OMEGA_IE * cl),
-            T::zero(),
-            lit::<T>(-earth::OMEGA_IE * sl),
-        );
+        self.refresh_earth();
+        let e = self.earth;
+        let (rn_h, re_h) = (e.rn + self.h, e.re + self.h);
+        let w_ie = e.w_ie;
         let w_en = Vector3::new(
             self.vel.y / lit::<T>(re_h),
             -self.vel.x / lit::<T>(rn_h),
-            -self.vel.y * lit::<T>(sl / cl / re_h),
+            -self.vel.y * lit::<T>(e.tan_lat / re_h),
         );
         let w_in = w_ie + w_en;
         let w_hat = Vector3::from(*gyro_rad_s) - self.bg;
@@ -284,7 +325,7 @@ impl<T: Real> InsFilter<T> {
         // with the old one alone a turn leaves a systematic velocity error of |f|·|ω|·Ts/2.
         let c_mid = (c + quat_to_dcm(&self.q)) * lit::<T>(0.5);
         let f_n = c_mid * f_hat;
-        let g = earth::normal_gravity(lat_t, h_t);
+        let g = e.gravity;
         let w_v = w_ie * lit::<T>(2.0) + w_en;
         let acc = f_n + Vector3::new(T::zero(), T::zero(), g) - w_v.cross(&self.vel);
         let v_old = self.vel;
@@ -293,7 +334,7 @@ impl<T: Real> InsFilter<T> {
         let dt64 = to_f64(dt);
         self.h -= to_f64(v_bar.z) * dt64;
         self.lat += to_f64(v_bar.x) * dt64 / rn_h;
-        self.lon += to_f64(v_bar.y) * dt64 / (re_h * cl);
+        self.lon += to_f64(v_bar.y) * dt64 / (re_h * e.cos_lat);
         self.bg += dbias_dt_rad_s2 * dt;
         self.w_hat = w_hat;
         let e = ErrorDynamics {
@@ -302,7 +343,7 @@ impl<T: Real> InsFilter<T> {
             f_n,
             w_v,
             w_psi: w_in,
-            grav_grad: lit::<T>(2.0) * g / lit::<T>(earth::geocentric_radius(self.lat)),
+            grav_grad: e.grav_grad,
         };
         let gamma = [
             self.q_rate[0] * dt,
@@ -313,6 +354,15 @@ impl<T: Real> InsFilter<T> {
         strapdown::propagate_covariance(&mut self.p, &e, self.cfg.discretisation, &gamma);
         self.index += 1;
         self.check_health()
+    }
+
+    #[inline(always)]
+    fn refresh_earth(&mut self) {
+        if (self.lat - self.earth.lat).abs() > EARTH_REFRESH_RAD
+            || (self.h - self.earth.h).abs() > EARTH_REFRESH_M
+        {
+            self.earth = EarthCache::at(self.lat, self.h);
+        }
     }
 
     fn check_health(&self) -> Result<(), NavError> {
