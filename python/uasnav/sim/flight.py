@@ -43,6 +43,7 @@ from uasnav.imu import ImuLog
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.limits import check_memory
 from uasnav.sim.core import thermal_model
+from uasnav.sim.model import SensorModel
 
 FloatArray = NDArray[np.float64]
 
@@ -131,7 +132,7 @@ def simulate_flight(
     latitude_deg: float = 45.0,
     longitude_deg: float = 7.0,
     height_m: float = 300.0,
-    preset: str = "lsm6dsm",
+    preset: str | SensorModel = "lsm6dsm",
     errors: FlightErrors | None = None,
     gnss_dropouts: Sequence[tuple[float, float]] = (),
     seed: int = 0,
@@ -152,8 +153,8 @@ def simulate_flight(
         Time at rest on the ground before take-off (s).
     latitude_deg, longitude_deg, height_m : float
         Start point (deg, deg, m ellipsoidal).
-    preset : str
-        Simulator preset whose thermal gyro-bias curve the IMU carries.
+    preset : str or SensorModel
+        Simulator preset (or model) whose thermal gyro-bias curve the IMU carries.
     errors : FlightErrors, optional
         Sensor errors.
     gnss_dropouts : sequence of (start_s, duration_s)
@@ -175,6 +176,7 @@ def simulate_flight(
         raise InputError(f"static_s: must be ≥ 1 s (levelling), got {static_s!r}")
     if not -80.0 <= latitude_deg <= 80.0:
         raise InputError(f"latitude_deg: must be within ±80°, got {latitude_deg!r}")
+    preset_name = preset if isinstance(preset, str) else preset.name
     spline = _path(waypoints, speed_m_s, static_s, duration_s)
     t_end = float(spline.x[-1]) if duration_s is None else float(duration_s)
     if duration_s is not None and not (math.isfinite(t_end) and t_end > static_s):
@@ -276,7 +278,7 @@ def simulate_flight(
             "format": "simulated",
             "rate_hz": rate_hz,
             "seed": seed,
-            "preset": preset,
+            "preset": preset_name,
         },
     )
 
@@ -330,7 +332,7 @@ def simulate_flight(
         truth=truth,
         imus={"IMU": imu},
         airborne=(static_s, float(spline.x[-1])),
-        meta={"source": "simulated flight", "seed": seed, "preset": preset, "errors": e},
+        meta={"source": "simulated flight", "seed": seed, "preset": preset_name, "errors": e},
     )
 
 
