@@ -148,3 +148,50 @@ impl VelocityReference {
         self.bridge_var = [0.0; 3];
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Constant velocity at a steady rate: the trapezoid integral is exact and the variance
+    /// is the anchor's plus σ_v²·Σwᵢ² with interior weights Δt and end weights Δt/2.
+    #[test]
+    fn trapezoid_integral_and_variance_closed_form() {
+        let (dt, n, var_v) = (0.2, 51, 0.15_f64 * 0.15);
+        let radii = (6.4e6, 5.0e6);
+        let v = Vector3::new(3.0, -4.0, 0.5);
+        let mut r = VelocityReference::default();
+        r.anchor(0.0, &v, var_v, &[0.5, 0.1, 100.0], &[0.04, 0.05, 0.09]);
+        for k in 1..n {
+            let p = [0.0; 3];
+            r.advance(k as f64 * dt, &v, var_v, &r.llh.clone(), &p, radii);
+        }
+        let t = (n - 1) as f64 * dt;
+        assert!((((r.llh[0] - 0.5) * radii.0) - 3.0 * t).abs() < 1e-6);
+        assert!((((r.llh[1] - 0.1) * radii.1) + 4.0 * t).abs() < 1e-6);
+        assert!(((100.0 - r.llh[2]) - 0.5 * t).abs() < 1e-9);
+        let sum_w2 = (n - 2) as f64 * dt * dt + 2.0 * (dt / 2.0) * (dt / 2.0);
+        let var = r.variance();
+        for (i, a) in [0.04, 0.05, 0.09].iter().enumerate() {
+            assert!((var[i] - a - var_v * sum_w2).abs() < 1e-12, "{i}: {}", var[i]);
+        }
+    }
+
+    /// A span longer than [`REF_MAX_GAP_S`] is bridged by the filter's displacement and
+    /// covariance growth, never by the end velocities.
+    #[test]
+    fn long_gap_is_bridged_by_the_filter_displacement() {
+        let radii = (6.4e6, 5.0e6);
+        let v = Vector3::new(10.0, 0.0, 0.0);
+        let mut r = VelocityReference::default();
+        r.anchor(0.0, &v, 0.01, &[0.5, 0.1, 100.0], &[0.04, 0.04, 0.09]);
+        r.last_ant = [0.5, 0.1, 100.0];
+        r.last_p = [0.04, 0.04, 0.09];
+        // 5 s later the filter dead-reckoned 45 m north (not 50) with variance 2.0 m².
+        let ant = [0.5 + 45.0 / radii.0, 0.1, 100.0];
+        r.advance(5.0, &v, 0.01, &ant, &[2.04, 2.04, 0.59], radii);
+        assert!(((r.llh[0] - 0.5) * radii.0 - 45.0).abs() < 1e-6);
+        let var = r.variance();
+        assert!((var[0] - 2.04).abs() < 1e-12 && (var[2] - 0.59).abs() < 1e-12);
+    }
+}
