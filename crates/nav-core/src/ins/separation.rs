@@ -173,7 +173,11 @@ mod tests {
         let sum_w2 = (n - 2) as f64 * dt * dt + 2.0 * (dt / 2.0) * (dt / 2.0);
         let var = r.variance();
         for (i, a) in [0.04, 0.05, 0.09].iter().enumerate() {
-            assert!((var[i] - a - var_v * sum_w2).abs() < 1e-12, "{i}: {}", var[i]);
+            assert!(
+                (var[i] - a - var_v * sum_w2).abs() < 1e-12,
+                "{i}: {}",
+                var[i]
+            );
         }
     }
 
