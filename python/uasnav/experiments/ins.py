@@ -63,6 +63,56 @@ class IntegrityTrace:
 
 
 @dataclass(frozen=True)
+class RampRow:
+    """One GNSS position ramp (velocity untouched) on a simulated flight: when it was first
+    flagged (separation alert, exclusion or reset), the worst true-error/PL ratio over the
+    flight, and the rows where the error exceeded the PL with no flag raised at that epoch."""
+
+    rate_m_s: float
+    direction: str
+    start_s: float
+    first_flag_s: float | None
+    worst_error_over_pl: float
+    unannounced_rows: int
+
+
+def unannounced_rows(r: ins.InsResult, truth: ins.Trajectory) -> tuple[int, float]:
+    """Rows where the true horizontal error exceeds the HPL or the vertical the VPL while no
+    flag is raised at that epoch (no alert, and the latest tested fix was used), and the worst
+    error/PL ratio."""
+    d = ev.ned_difference(r.lat, r.lon, r.alt, truth, r.t)
+    eh, evv = np.hypot(d[:, 0], d[:, 1]), np.abs(d[:, 2])
+    tested = np.isin(r.fix_status, (0, 1, 2, 5, 6))
+    ft, fs = r.fix_t[tested], r.fix_status[tested]
+    i = np.searchsorted(ft, r.t, side="right") - 1
+    flag = r.alert | ((i >= 0) & np.isin(fs[np.maximum(i, 0)], (1, 2, 5, 6)))
+    bad = ((eh > r.hpl) | (evv > r.vpl)) & ~flag
+    return int(bad.sum()), float(max((eh / r.hpl).max(), (evv / r.vpl).max()))
+
+
+RAMP_RATES = (0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 5.0)
+RAMP_DIRECTIONS = {"north": (1.0, 0.0, 0.0), "south-east": (-0.6, 0.8, 0.0), "down": (0.0, 0.0, 1.0)}
+
+
+def ramp_sweep(f: ins.Flight, start_s: float, rates: tuple[float, ...] = RAMP_RATES) -> list[RampRow]:
+    """Every rate × direction of a GNSS position ramp from ``start_s`` on flight ``f``."""
+    rows = []
+    g = f.gnss
+    for rate in rates:
+        for name, u in RAMP_DIRECTIONS.items():
+            a = np.clip(g.t - start_s, 0.0, None) * rate
+            lat = g.lat + np.degrees(a * u[0] / 6_367_000.0)
+            lon = g.lon + np.degrees(a * u[1] / (6_378_000.0 * np.cos(np.radians(g.lat))))
+            gg = dataclasses.replace(g, lat=lat, lon=lon, alt=g.alt - a * u[2])
+            r = ins.run(dataclasses.replace(f, gnss=gg), matched_config(hal_m=40.0, val_m=50.0, decimation=5))
+            flagged = r.fix_t[np.isin(r.fix_status, (1, 2, 5, 6))]
+            bad, worst = unannounced_rows(r, f.truth)  # type: ignore[arg-type]
+            first = float(flagged[0]) if flagged.size else None
+            rows.append(RampRow(rate, name, start_s, first, worst, bad))
+    return rows
+
+
+@dataclass(frozen=True)
 class InsExperiment:
     """Results of :func:`run`."""
 
@@ -73,6 +123,10 @@ class InsExperiment:
     integrity: IntegrityTrace
     classic_vs_tczupt: dict[str, float]
     accuracy: dict[str, float]
+    ramps: list[RampRow]
+    #: Fault-free flights: flagged fixes (separation alerts + exclusions), fixes tested,
+    #: median HPL and VPL (m).
+    fault_free: dict[str, float]
 
 
 def _outage_stats(d: float, items: list[ev.Outage]) -> OutageStats:
@@ -95,6 +149,8 @@ def run(seed: int = 0, quick: bool = False, progress: Callable[[str], None] | No
     ends: dict[float, list[ev.Outage]] = {d: [] for d in DURATIONS}
     nees: dict[str, list[FloatArray]] = {"position": [], "velocity": [], "attitude": []}
     acc: list[ev.Comparison] = []
+    ff = {"flagged": 0.0, "fixes": 0.0}
+    pls: list[tuple[float, float]] = []
     start = 90.0
     for k in range(runs):
         if k % 10 == 0:
@@ -104,6 +160,9 @@ def run(seed: int = 0, quick: bool = False, progress: Callable[[str], None] | No
         )
         base = ins.run(f, matched_config(decimation=20))
         acc.append(ev.compare(base, f.truth))  # type: ignore[arg-type]
+        ff["flagged"] += base.summary["separation_alerts"] + base.summary["fixes_excluded"]
+        ff["fixes"] += base.summary["fixes_used"] + base.summary["fixes_excluded"]
+        pls.append((float(np.median(base.hpl)), float(np.median(base.vpl))))
         n = ev.nees(base, f.truth)  # type: ignore[arg-type]
         for key in nees:
             nees[key].append(n[key][150:])
@@ -112,18 +171,21 @@ def run(seed: int = 0, quick: bool = False, progress: Callable[[str], None] | No
             ends[d].append(ev.outage_end_error(r, f, start, d, against="truth"))
     lo, hi = ev.chi2_bounds(3, runs)
     nees_mean = {k: float(np.mean(np.mean(v, axis=0))) for k, v in nees.items()}
-    # Integrity: a 1 m/s ramp on the GNSS north position from 100 s.
-    f = simulate_flight(duration_s=200.0, seed=seed + 7, errors=NO_THERMAL)
-    fault = np.clip(f.gnss.t - 100.0, 0.0, None) * 1.0
+    # Integrity: a slow (0.1 m/s) ramp on the GNSS north position from 100 s, which the
+    # innovation tests never flag: the solution separation does.
+    f = simulate_flight(duration_s=400.0, seed=seed + 7, errors=NO_THERMAL)
+    fault = np.clip(f.gnss.t - 100.0, 0.0, None) * 0.1
     g = dataclasses.replace(f.gnss, lat=f.gnss.lat + np.degrees(fault / 6_367_000.0))
-    r = ins.run(dataclasses.replace(f, gnss=g), matched_config(hal_m=25.0, val_m=35.0, decimation=5))
+    r = ins.run(dataclasses.replace(f, gnss=g), matched_config(hal_m=40.0, val_m=50.0, decimation=5))
     d = ev.ned_difference(r.lat, r.lon, r.alt, f.truth, r.t)  # type: ignore[arg-type]
     err = np.hypot(d[:, 0], d[:, 1])
-    excl = r.fix_t[np.isin(r.fix_status, (1, 2, 5))]
-    first = float(excl[0]) if excl.size else None
-    detected = r.t >= (first if first is not None else np.inf)
-    violations = int(((err > r.hpl) & ~r.alert & ~detected).sum())
-    trace = IntegrityTrace(r.t, err, r.hpl, 100.0, 1.0, 25.0, first, r.alerts, violations)
+    flagged = r.fix_t[np.isin(r.fix_status, (1, 2, 5, 6))]
+    first = float(flagged[0]) if flagged.size else None
+    violations, _ = unannounced_rows(r, f.truth)  # type: ignore[arg-type]
+    trace = IntegrityTrace(r.t, err, r.hpl, 100.0, 0.1, 40.0, first, r.alerts, violations)
+    say("ins: GNSS ramp sweep")
+    long = simulate_flight(duration_s=300.0 if quick else 600.0, seed=seed + 5, errors=NO_THERMAL)
+    ramps = ramp_sweep(long, 60.0, (0.05, 1.0) if quick else RAMP_RATES)
     # Classic vs TCZUPT on a warming IMU (the lsm6dsm thermal curve, +20 °C).
     temps = np.linspace(15.0, 45.0, 61)
     model = PolynomialBiasModel(order=3).fit(temps, thermal_bias("lsm6dsm", temps))
@@ -158,6 +220,12 @@ def run(seed: int = 0, quick: bool = False, progress: Callable[[str], None] | No
             "classic_gyro_bias_error_deg_h": float(np.median(bias_err["classic"])),
             "tczupt_gyro_bias_error_deg_h": float(np.median(bias_err["tczupt"])),
             "flights": float(len(cmp["classic"])),
+        },
+        ramps=ramps,
+        fault_free={
+            **ff,
+            "median_hpl_m": float(np.median([p[0] for p in pls])),
+            "median_vpl_m": float(np.median([p[1] for p in pls])),
         },
         accuracy={
             "horizontal_rms_m": float(np.median([c.horizontal_rms_m for c in acc])),
