@@ -264,6 +264,9 @@ pub(crate) struct Gain<T: Real, const M: usize> {
     pub chol: nalgebra::Cholesky<T, nalgebra::Const<M>>,
     /// `H·P` (M×15).
     pub hp: SMatrix<T, M, N_STATES>,
+    /// `S = H·P·Hᵀ + diag(r)`, kept so that the update and the integrity tests need not
+    /// recompute it (an M×M×15 product each).
+    pub s: SMatrix<T, M, M>,
 }
 
 /// Factorises `S = H·P·Hᵀ + diag(r)` (no state change).
@@ -282,10 +285,11 @@ pub(crate) fn gain<T: Real, const M: usize>(
         s[(i, i)] += r_diag[i];
     }
     let chol = s.cholesky().ok_or(NavError::NotPositiveDefinite { what })?;
-    Ok(Gain { chol, hp })
+    Ok(Gain { chol, hp, s })
 }
 
-/// The Joseph-form update `P ← (I−KH)P(I−KH)ᵀ + K·R·Kᵀ` (symmetrised) for the innovation
+/// The Joseph-form update `P ← (I−KH)P(I−KH)ᵀ + K·R·Kᵀ` (symmetrised; `H·P` and `S` from
+/// [`gain`]) for the innovation
 /// `z = h(x̂) − y` (predicted minus measured); returns `δx = K·z`. `P` is left
 /// unchanged on error.
 // Indices below M and N_STATES, the matrices' compile-time sizes.
@@ -293,9 +297,7 @@ pub(crate) fn gain<T: Real, const M: usize>(
 #[inline]
 pub(crate) fn joseph_update<T: Real, const M: usize>(
     p: &mut Mat15<T>,
-    h: &SMatrix<T, M, N_STATES>,
     z: &SVector<T, M>,
-    r_diag: &SVector<T, M>,
     g: &Gain<T, M>,
 ) -> Result<SVector<T, N_STATES>, NavError> {
     let kt = g.chol.solve(&g.hp); // Kᵀ = S⁻¹·H·P
@@ -306,11 +308,7 @@ pub(crate) fn joseph_update<T: Real, const M: usize>(
     // but costs M-row products (≈ 3.8k multiply-adds for M = 6) instead of two dense 15×15
     // products (≈ 9.5k).
     let khp = k * g.hp;
-    let mut s = g.hp * h.transpose();
-    for j in 0..M {
-        s[(j, j)] += r_diag[j];
-    }
-    let p_new = *p - khp - khp.transpose() + (k * s) * kt;
+    let p_new = *p - khp - khp.transpose() + (k * g.s) * kt;
     let p_sym = (p_new + p_new.transpose()) * lit::<T>(0.5);
     for i in 0..N_STATES {
         let d = p_sym[(i, i)];
@@ -386,7 +384,7 @@ mod tests {
         let z = SVector::<f64, 2>::new(0.5, -0.2);
         let g = gain(&p, &h, &r, "S").unwrap();
         let mut pj = p;
-        let dx = joseph_update(&mut pj, &h, &z, &r, &g).unwrap();
+        let dx = joseph_update(&mut pj, &z, &g).unwrap();
         let s = h * p * h.transpose() + SMatrix::<f64, 2, 2>::from_diagonal(&r);
         let k = p * h.transpose() * s.try_inverse().unwrap();
         let po = (Mat15::identity() - k * h) * p;

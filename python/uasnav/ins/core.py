@@ -440,8 +440,10 @@ def _static_mask(flight: Flight, cfg: InsConfig) -> NDArray[np.bool_] | None:
     g = flight.gnss
     speed = np.linalg.norm(g.vel, axis=1)
     # The nearest earlier fix must be slow too (a detector alone can fire in smooth cruise).
-    j = np.clip(np.searchsorted(g.t, imu.t, side="right") - 1, 0, g.n - 1)
-    mask &= speed[j] < cfg.static_max_speed_m_s + 3.0 * g.s_acc[j]
+    # (Only at the detector's static samples: a few percent of a flight.)
+    idx = np.flatnonzero(mask)
+    j = np.clip(np.searchsorted(g.t, imu.t[idx], side="right") - 1, 0, g.n - 1)
+    mask[idx] = speed[j] < cfg.static_max_speed_m_s + 3.0 * g.s_acc[j]
     return np.ascontiguousarray(mask)
 
 

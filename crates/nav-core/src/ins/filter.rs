@@ -581,7 +581,7 @@ impl<T: Real> InsFilter<T> {
             return Ok(FixStatus::ExcludedSnapshot);
         }
         // Averaged innovation over the window (the stored fixes and this one).
-        let s = g.hp * hm.transpose() + Mat6::from_diagonal(&r);
+        let s = g.s;
         let (mut zs, mut ss_sum) = (z, s);
         for k in 0..self.win_len {
             zs += self.win_z[k];
@@ -597,7 +597,7 @@ impl<T: Real> InsFilter<T> {
                 }
             }
         }
-        let dx = strapdown::joseph_update(&mut self.p, &hm, &z, &r, &g)?;
+        let dx = strapdown::joseph_update(&mut self.p, &z, &g)?;
         self.feedback(&dx);
         // Window bookkeeping (ring buffer of the accepted fixes).
         let w = cfg.window_fixes.saturating_sub(1);
@@ -643,7 +643,7 @@ impl<T: Real> InsFilter<T> {
                 + num_traits::Float::max(offset_var_m2, T::zero()),
         );
         let g = strapdown::gain(&self.p, &hm, &r, "baro innovation covariance")?;
-        let dx = strapdown::joseph_update(&mut self.p, &hm, &z, &r, &g)?;
+        let dx = strapdown::joseph_update(&mut self.p, &z, &g)?;
         self.feedback(&dx);
         // The offset error is common to every baro sample, so averaging them cannot take the
         // vertical σ below it: floor the height variance there (conservative, keeps P ≥ 0).
@@ -669,7 +669,7 @@ impl<T: Real> InsFilter<T> {
         let (sv, sw) = (self.cfg.zupt_std_velocity_m_s, self.cfg.zaru_std_rad_s);
         let r = Vec6::from([sv * sv, sv * sv, sv * sv, sw * sw, sw * sw, sw * sw]);
         let g = strapdown::gain(&self.p, &hm, &r, "ZUPT innovation covariance")?;
-        let dx = strapdown::joseph_update(&mut self.p, &hm, &z, &r, &g)?;
+        let dx = strapdown::joseph_update(&mut self.p, &z, &g)?;
         self.feedback(&dx);
         self.check_health()
     }
@@ -693,7 +693,7 @@ impl<T: Real> InsFilter<T> {
         let s = self.cfg.mag_heading_std_rad;
         let r = SVector::<T, 1>::new(s * s);
         let g = strapdown::gain(&self.p, &hm, &r, "heading innovation covariance")?;
-        let dx = strapdown::joseph_update(&mut self.p, &hm, &z, &r, &g)?;
+        let dx = strapdown::joseph_update(&mut self.p, &z, &g)?;
         self.feedback(&dx);
         // A magnetic heading error is mostly a bias (declination, iron), common to every
         // sample: averaging cannot take the heading σ below the single-sample σ.
