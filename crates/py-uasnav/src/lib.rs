@@ -8,6 +8,7 @@ mod attitude;
 mod convert;
 mod earth;
 mod errors;
+mod ins;
 mod mlp;
 mod redundancy;
 mod utm;
@@ -26,5 +27,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     zupt::register(m)?;
     redundancy::register(m)?;
     utm::register(m)?;
+    ins::register(m)?;
     Ok(())
 }

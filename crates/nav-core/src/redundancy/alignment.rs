@@ -51,6 +51,16 @@ pub fn wahba<T: Real>(
             got: v_sensor.len().min(weights.len()),
         });
     }
+    // The solution does not depend on the weights' scale: normalise them by the largest so
+    // that weights near f64::MAX do not overflow B (or the SVD's internal squares).
+    let w_max = weights
+        .iter()
+        .fold(T::zero(), |m, w| num_traits::Float::max(m, *w));
+    let w_scale = if w_max > T::zero() && num_traits::Float::is_finite(w_max) {
+        T::one() / w_max
+    } else {
+        T::one()
+    };
     let mut b = Matrix3::zeros();
     for (k, ((r, s), w)) in v_ref.iter().zip(v_sensor).zip(weights).enumerate() {
         if r.iter()
@@ -64,7 +74,13 @@ pub fn wahba<T: Real>(
                 index: k,
             });
         }
-        b += s * r.transpose() * *w;
+        b += s * r.transpose() * (*w * w_scale);
+    }
+    if !b.iter().all(|v| num_traits::Float::is_finite(*v)) {
+        return Err(NavError::NonFinite {
+            what: "wahba attitude profile matrix (vectors too large)",
+            index: 0,
+        });
     }
     let svd = b.svd(true, true);
     let (u, vt) = match (svd.u, svd.v_t) {
@@ -79,7 +95,8 @@ pub fn wahba<T: Real>(
     let hi = num_traits::Float::max(sv[0], num_traits::Float::max(sv[1], sv[2]));
     let lo = num_traits::Float::min(sv[0], num_traits::Float::min(sv[1], sv[2]));
     let mid = sv[0] + sv[1] + sv[2] - hi - lo;
-    if !(hi > T::zero()) || mid <= hi * lit(1e-6) {
+    // `!(mid > …)` also refuses NaN singular values (max/min would hide them in hi/lo).
+    if !(hi > T::zero()) || !(mid > hi * lit(1e-6)) || !num_traits::Float::is_finite(mid) {
         return Err(NavError::InvalidParameter {
             what: "wahba pairs",
             reason: "need at least two non-parallel vector pairs",
@@ -87,7 +104,13 @@ pub fn wahba<T: Real>(
     }
     let d = (u * vt).determinant();
     let m = Matrix3::from_diagonal(&Vector3::new(T::one(), T::one(), d));
-    Ok(u * m * vt)
+    let c = u * m * vt;
+    if !c.iter().all(|v| num_traits::Float::is_finite(*v)) {
+        return Err(NavError::NotPositiveDefinite {
+            what: "wahba attitude profile matrix",
+        });
+    }
+    Ok(c)
 }
 
 /// Small-angle misalignment (rad, rotation vector) of an estimated relative rotation with

@@ -64,12 +64,22 @@ impl<T: Real, const S: usize> BiasKalman<T, S> {
             .iter()
             .chain(sigma.iter())
         {
-            if !num_traits::Float::is_finite(*v) || *v < T::zero() {
+            // The σ are squared into P and R: their squares must be finite too (1e308² = inf).
+            if !num_traits::Float::is_finite(*v * *v) || *v < T::zero() {
                 return Err(NavError::InvalidParameter {
                     what: "kalman noise",
-                    reason: "every noise parameter must be finite and non-negative",
+                    reason:
+                        "every noise parameter must be finite (its square too) and non-negative",
                 });
             }
+        }
+        // A zero measurement σ makes R singular: every other consumer of the per-axis σ
+        // (WLS fusion, FDI, parity residuals) requires σ > 0; so does the filter.
+        if sigma.iter().any(|s| !(*s > T::zero())) {
+            return Err(NavError::InvalidParameter {
+                what: "sigma",
+                reason: "every measurement sigma must be > 0",
+            });
         }
         let mut h = [Vector3::zeros(); S];
         let mut r = [T::one(); S];
@@ -92,12 +102,13 @@ impl<T: Real, const S: usize> BiasKalman<T, S> {
         })
     }
 
-    /// Time update over `dt_s` seconds (random walks: `P += Q·dt`).
+    /// Time update over `dt_s` seconds (random walks: `P += Q·dt`); `dt_s` must be finite
+    /// and > 0 (a zero step is a duplicated timestamp, refused as everywhere in nav-core).
     pub fn predict(&mut self, dt_s: T) -> Result<(), NavError> {
-        if !num_traits::Float::is_finite(dt_s) || dt_s < T::zero() {
+        if !(num_traits::Float::is_finite(dt_s) && dt_s > T::zero()) {
             return Err(NavError::InvalidParameter {
                 what: "dt_s",
-                reason: "must be finite and non-negative",
+                reason: "must be finite and > 0",
             });
         }
         for j in 0..3 {

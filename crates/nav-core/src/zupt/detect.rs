@@ -131,6 +131,19 @@ impl<T: Real> StationarityDetector<T> {
             ax * ax + ay * ay + az * az,
             wx * wx + wy * wy + wz * wz,
         ];
+        // Finite samples whose squared norms (or their window sums) overflow are refused like
+        // non-finite ones (|a| ≈ 1e154 m/s² is no measurement), before the state changes.
+        let sums_finite = self
+            .sums
+            .iter()
+            .zip(rec.iter())
+            .all(|(s, r)| num_traits::Float::is_finite(*s + *r));
+        if !sums_finite {
+            return Err(NavError::NonFinite {
+                what: "stationarity input (squared norm overflows)",
+                index: self.pushes,
+            });
+        }
         let w = self.cfg.window_samples;
         if self.n == w {
             let old = self.buf[self.head];
