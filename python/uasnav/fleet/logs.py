@@ -1,0 +1,128 @@
+"""One log of a fleet, read once through :mod:`uasnav.io`: its format, IMUs and identity.
+
+The fleet never parses a format itself: every reader is :mod:`uasnav.io`'s. This module only
+says which reader a file needs (by extension, and for ``.csv`` by the header: CSV v1, x-io or
+the flight CSV) and gathers what every analysis needs: the IMU instances as
+:class:`~uasnav.imu.ImuLog` (``read_dataflash``/``read_tlog`` give every instance, ``read_ulog``
+the primary one) and the vehicle identity written in the log (CSV v1 ``# vehicle:``,
+``# autopilot:``, ``# start_time:`` comments; the binary readers carry none yet, so their
+vehicle and day are ``unknown``).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from uasnav.errors import DataFormatError, InputError
+from uasnav.imu import ImuLog
+from uasnav.io.flight import FLIGHT_CSV_COLUMNS
+
+#: Format names of the inventory (``format`` column) by reader.
+FORMATS = ("csv-v1", "xio-csv", "flight-csv", "npz", "px4-ulog", "ardupilot-dataflash", "mavlink-tlog")
+_AUTOPILOT = {"px4-ulog": "PX4", "ardupilot-dataflash": "ArduPilot"}
+
+
+@dataclass(frozen=True)
+class FleetLog:
+    """What the fleet knows of one log after reading it once.
+
+    Attributes
+    ----------
+    path : str
+    format : str
+        One of :data:`FORMATS`.
+    imus : dict of str → ImuLog
+        IMU instances by name (empty for a flight CSV).
+    vehicle, autopilot : str or None
+        Identifiers written in the log, if any.
+    start_time : datetime or None
+        Start of the recording (UTC), if the log says.
+    """
+
+    path: str
+    format: str
+    imus: dict[str, ImuLog]
+    vehicle: str | None = None
+    autopilot: str | None = None
+    start_time: dt.datetime | None = None
+
+    @property
+    def day(self) -> str | None:
+        """``YYYY-MM-DD`` of the start (UTC), or None."""
+        return None if self.start_time is None else self.start_time.date().isoformat()
+
+
+def csv_kind(path: str) -> str:
+    """``csv-v1``, ``xio-csv`` or ``flight-csv`` from the first non-comment line of a CSV file."""
+    from uasnav.io import is_xio_csv
+
+    with open(path, "rb") as fh:
+        for _ in range(1000):
+            raw = fh.readline(4096)
+            if not raw:
+                break
+            line = raw.decode("utf-8", errors="replace").lstrip("\ufeff").strip()
+            if not line or line.startswith("#"):
+                continue
+            if is_xio_csv(line):
+                return "xio-csv"
+            cols = [c.strip() for c in line.split(",")]
+            if cols[: len(FLIGHT_CSV_COLUMNS)] == list(FLIGHT_CSV_COLUMNS) or {"lat", "lon"} <= set(cols):
+                return "flight-csv"
+            return "csv-v1"
+    return "csv-v1"
+
+
+def format_of(path: str) -> str:
+    """The format of ``path`` (see :data:`FORMATS`); InputError for an unknown extension."""
+    ext = Path(path).suffix.lower()
+    if ext in (".csv", ".txt"):
+        return csv_kind(path)
+    known = {".npz": "npz", ".ulg": "px4-ulog", ".bin": "ardupilot-dataflash", ".tlog": "mavlink-tlog"}
+    if ext not in known:
+        raise InputError(f"{path}: unknown log format {ext!r}")
+    return known[ext]
+
+
+def _start_time(meta: dict[str, Any]) -> dt.datetime | None:
+    text = meta.get("start_time")
+    if not text:
+        return None
+    try:
+        t = dt.datetime.fromisoformat(str(text).replace("Z", "+00:00"))
+    except ValueError:
+        raise DataFormatError(f"start_time: not an ISO 8601 time: {text!r}", path=meta.get("source")) from None
+    return t.replace(tzinfo=dt.timezone.utc) if t.tzinfo is None else t.astimezone(dt.timezone.utc)
+
+
+def read_fleet_log(path: str) -> FleetLog:
+    """Read ``path`` once with the reader its format needs (module docs)."""
+    from uasnav import io
+
+    fmt = format_of(path)
+    imus: dict[str, ImuLog]
+    if fmt in ("csv-v1", "xio-csv", "npz", "px4-ulog"):
+        log = io.read_log(path)
+        imus = {str(log.meta.get("topic", "imu0")) if fmt == "px4-ulog" else "imu0": log}
+    elif fmt == "ardupilot-dataflash":
+        imus = io.read_dataflash(path)
+    elif fmt == "mavlink-tlog":
+        imus = io.read_tlog(path)
+    else:  # flight CSV: telemetry only
+        io.read_flight(path)
+        imus = {}
+    meta = next(iter(imus.values())).meta if imus else {}
+    return FleetLog(
+        path=path,
+        format=fmt,
+        imus=imus,
+        vehicle=meta.get("vehicle"),
+        autopilot=meta.get("autopilot") or _AUTOPILOT.get(fmt),
+        start_time=_start_time(dict(meta)),
+    )
+
+
+__all__ = ["FORMATS", "FleetLog", "csv_kind", "format_of", "read_fleet_log"]
