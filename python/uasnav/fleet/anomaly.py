@@ -130,7 +130,8 @@ def write_scores(out: str | Path) -> dict[str, Any]:
         "n_imus": table.num_rows,
         "n_outliers": outl.num_rows,
         "outliers": [
-            {"path": r["path"], "imu": r["imu"], "score": r["score"], "driver": r["driver"]} for r in outl.to_pylist()
+            {"path": r["path"], "imu": r["imu"], "score": r["score"], "driver": r["driver"]}
+            for r in outl.to_pylist()
         ],
     }
 

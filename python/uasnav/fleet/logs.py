@@ -94,7 +94,9 @@ def _start_time(meta: dict[str, Any]) -> dt.datetime | None:
     try:
         t = dt.datetime.fromisoformat(str(text).replace("Z", "+00:00"))
     except ValueError:
-        raise DataFormatError(f"start_time: not an ISO 8601 time: {text!r}", path=meta.get("source")) from None
+        raise DataFormatError(
+            f"start_time: not an ISO 8601 time: {text!r}", path=meta.get("source")
+        ) from None
     return t.replace(tzinfo=dt.timezone.utc) if t.tzinfo is None else t.astimezone(dt.timezone.utc)
 
 

@@ -40,6 +40,7 @@ import pyarrow as pa
 
 from uasnav.errors import InputError
 from uasnav.fleet.output import (
+    ERRORS_SCHEMA,
     Manifest,
     ManifestEntry,
     content_hash,
@@ -48,7 +49,6 @@ from uasnav.fleet.output import (
     stat_key,
     table_file,
     write_table,
-    ERRORS_SCHEMA,
 )
 from uasnav.fleet.sources import discover
 
@@ -108,7 +108,7 @@ class TaskResult:
     size: int
     mtime_ns: int
     log_hash: str | None
-    status: str  # "ok", "empty", "error", "done-before"
+    status: str  # "ok", "empty", "error" (a bad log), "lost" (the cluster gave up on the task)
     n_rows: int = 0
     cpu_s: float = 0.0
     error: str | None = None
@@ -157,7 +157,9 @@ def process_log(path: str, analysis: Analysis, out: str) -> TaskResult:
         row = error_row(path, log_hash, analysis.name, e)
         key = f"{analysis.name}-{log_hash or _path_key(path)}"
         write_table(pa.Table.from_pylist([row], schema=ERRORS_SCHEMA), error_file(out_p, key))
-        return TaskResult(path, size, mtime_ns, log_hash, "error", cpu_s=time.process_time() - cpu0, error=row["error"])
+        return TaskResult(
+            path, size, mtime_ns, log_hash, "error", cpu_s=time.process_time() - cpu0, error=row["error"]
+        )
 
 
 def _path_key(path: str) -> str:
@@ -275,9 +277,19 @@ def run(
         progress(0, len(todo))
 
     def record(res: TaskResult) -> None:
-        manifest.commit(
-            [ManifestEntry(os.path.abspath(res.path), res.size, res.mtime_ns, res.log_hash, analysis.name, res.status)]
-        )
+        if res.status != "lost":
+            manifest.commit(
+                [
+                    ManifestEntry(
+                        os.path.abspath(res.path),
+                        res.size,
+                        res.mtime_ns,
+                        res.log_hash,
+                        analysis.name,
+                        res.status,
+                    )
+                ]
+            )
         summary.cpu_s += res.cpu_s
         if res.status == "ok":
             summary.n_ok += 1
@@ -337,12 +349,15 @@ def _run_distributed(
             except Exception as e:  # infrastructure failure (e.g. KilledWorker after retries)
                 path = by_key[fut.key]
                 row = error_row(path, None, analysis.name, e)
-                write_table(pa.Table.from_pylist([row], schema=ERRORS_SCHEMA), error_file(out, _path_key(path)))
+                write_table(
+                    pa.Table.from_pylist([row], schema=ERRORS_SCHEMA), error_file(out, _path_key(path))
+                )
                 try:
                     size, mtime = stat_key(path)[1:]
                 except OSError:
                     size, mtime = -1, -1
-                res = TaskResult(path, size, mtime, None, "error", error=row["error"])
+                # "lost": in the errors table, but not committed, so --resume tries it again
+                res = TaskResult(path, size, mtime, None, "lost", error=row["error"])
             record(res)
             fut.release()
     finally:
@@ -352,4 +367,13 @@ def _run_distributed(
                 cluster.close()
 
 
-__all__ = ["KEY_FIELDS", "Analysis", "LogRows", "RunSummary", "TaskResult", "local_cluster", "process_log", "run"]
+__all__ = [
+    "KEY_FIELDS",
+    "Analysis",
+    "LogRows",
+    "RunSummary",
+    "TaskResult",
+    "local_cluster",
+    "process_log",
+    "run",
+]

@@ -187,7 +187,12 @@ def simulate_fleet(
 
                 atomic_write_bytes(out_p / name, junk)
             files.append(FleetFile(name, "unknown", "unknown", -1, 1.0, False, True))
-        truth = {"seed": seed, "vehicles": vehicles, "flights": flights, "files": [dataclasses.asdict(f) for f in files]}
+        truth = {
+            "seed": seed,
+            "vehicles": vehicles,
+            "flights": flights,
+            "files": [dataclasses.asdict(f) for f in files],
+        }
         atomic_write_text(out_p / TRUTH_FILE, json.dumps(truth, indent=1) + "\n")
     return SimulatedFleet(str(out_p), tuple(files))
 

@@ -1,0 +1,279 @@
+"""uasnav.fleet on a real Dask LocalCluster (2 worker processes, one per module): the cluster's
+output equals the single-process path's, bit for bit; resume does only what is missing; corrupt
+logs become rows of the errors table; killing a worker that runs a task does not change the
+output (each log exactly once)."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from uasnav import fleet
+from uasnav.cli import main
+from uasnav.errors import InputError
+from uasnav.fleet.anomaly import robust_z
+from uasnav.fleet.output import MANIFEST, read_dataset, read_errors
+from uasnav.fleet.simulate import load_truth
+
+
+@pytest.fixture(scope="module")
+def client():
+    from distributed import Client
+
+    cluster = fleet.local_cluster(2)
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def fleet_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("fleet")
+    fleet.simulate_fleet(d, vehicles=3, flights=2, seed=3, duration_s=40.0)
+    return d
+
+
+@pytest.fixture(scope="module")
+def reference(fleet_dir, tmp_path_factory):
+    """The single-process outputs (workers=0) of both analyses."""
+    out = tmp_path_factory.mktemp("ref")
+    res = {}
+    for a in (fleet.IMU_HEALTH, fleet.SCAN):
+        s = fleet.run(a, [fleet_dir], out / f"{a.name}.parquet", workers=0)
+        res[a.name] = (s, read_dataset(s.out), read_errors(s.out))
+    return res
+
+
+def _same(out, ref):
+    _, rows, errors = ref
+    got = read_dataset(out)
+    assert got.num_rows == rows.num_rows > 0
+    assert got.equals(rows), "cluster output differs from the single-process output"
+    assert read_errors(out).equals(errors)
+    assert len(set(got.column("log_hash").to_pylist())) == len(
+        {(h) for h in rows.column("log_hash").to_pylist()}
+    )
+
+
+def test_simulated_fleet_truth(fleet_dir, reference):
+    truth = load_truth(fleet_dir)
+    assert len(truth.files) == 3 * 2 + 1 and len(truth.corrupt) == 1 and len(truth.faulty) == 1
+    s, rows, errors = reference["imu_health"]
+    assert (s.n_logs, s.n_ok, s.n_errors, s.n_rows) == (7, 6, 1, 6)
+    # the corrupt file is in the errors table with the reader's message, the rest complete
+    assert errors.column("path").to_pylist() == [str(fleet_dir / truth.corrupt[0])]
+    assert "line" in errors.column("error")[0].as_py()
+    # the white noise read from the static part is the simulated one: the faulty IMU's is ×8
+    faulty = str(fleet_dir / truth.faulty[0])
+    paths = rows.column("path").to_pylist()
+    arw = np.array(rows.column("gyro_random_walk_x").to_pylist())
+    models = rows.column("imu_model").to_pylist()
+    i = paths.index(faulty)
+    peers = [k for k in range(len(paths)) if models[k] == models[i] and k != i]
+    assert arw[i] > 4 * max(arw[peers])
+    # partitions: vehicle and day from the logs' own metadata
+    assert set(rows.column("vehicle").to_pylist()) == {"V01", "V02", "V03"}
+    assert all(d.startswith("2026-11-0") for d in rows.column("day").to_pylist())
+
+
+def test_health_numbers_match_the_simulated_sensor(tmp_path):
+    """The noise terms are uasnav.allan/noise's on the static part: the simulator's white noise."""
+    from uasnav.fleet.imu_health import imu_health_of
+    from uasnav.sim import load_preset, simulate
+
+    log = simulate("lsm6dsm", duration=60.0, rate=100.0, seed=5)
+    row = imu_health_of(log)
+    white = load_preset("lsm6dsm").gyro.white  # rad/s/√Hz = rad/√s
+    for a in "xyz":
+        assert row[f"gyro_random_walk_{a}"] == pytest.approx(white, rel=0.15)
+    assert row["static_s"] == pytest.approx(60.0, abs=0.5)
+    # the long-τ terms of a one-minute static log are null with a reason, never a guess
+    assert row["gyro_rate_ramp"] is None and row["gyro_rate_ramp_reason"]
+    bias = log.truth["gyro_bias"].mean(axis=0)
+    for i, a in enumerate("xyz"):
+        assert row[f"gyro_bias_{a}"] == pytest.approx(bias[i], abs=2e-3)  # plus noise, Earth rate
+
+
+def test_robust_z_is_the_modified_z_score():
+    x = np.array([1.0, 2.0, 3.0, 4.0, 100.0, 5.0])
+    g = np.array(["a"] * 6)
+    z, ok = robust_z(x, g)
+    med, mad = 3.5, 1.5  # median of the six; median |x − 3.5| = 1.5
+    assert np.allclose(z, 0.6745 * (x - med) / mad) and ok.all()
+    z2, ok2 = robust_z(x[:4], g[:4])  # fewer than 5: no score
+    assert np.isnan(z2).all() and not ok2.any()
+
+
+def test_cluster_equals_single_process(client, fleet_dir, reference, tmp_path):
+    for a in (fleet.IMU_HEALTH, fleet.SCAN):
+        s = fleet.run(a, [fleet_dir], tmp_path / f"{a.name}.parquet", client=client)
+        assert s.workers == 2 and s.scheduler.startswith("tcp://")
+        _same(s.out, reference[a.name])
+    assert fleet.read_scores(tmp_path / "imu_health.parquet").equals(
+        fleet.read_scores(Path(reference["imu_health"][0].out))
+    )
+
+
+def test_resume_does_only_what_is_missing(client, fleet_dir, reference, tmp_path):
+    src = tmp_path / "src"
+    shutil.copytree(fleet_dir, src)
+    late = sorted(src.glob("V03/*.csv"))
+    held = tmp_path / "held"
+    held.mkdir()
+    for f in late:
+        f.rename(held / f.name)
+    out = tmp_path / "h.parquet"
+    first = fleet.run(fleet.IMU_HEALTH, [src], out, client=client)
+    assert first.n_logs == 5
+    with pytest.raises(InputError, match="--resume"):
+        fleet.run(fleet.IMU_HEALTH, [src], out, client=client)
+    for f in late:
+        (held / f.name).rename(src / "V03" / f.name)
+    again = fleet.run(fleet.IMU_HEALTH, [src], out, client=client, resume=True)
+    assert (again.n_logs, again.n_skipped, again.n_ok + again.n_errors) == (7, 5, 2)
+    # the same rows as one run over everything (paths differ: compare without them)
+    ref = reference["imu_health"][1].drop_columns(["path"])
+    assert read_dataset(out).drop_columns(["path"]).equals(ref)
+    nothing = fleet.run(fleet.IMU_HEALTH, [src], out, client=client, resume=True)
+    assert (nothing.n_skipped, nothing.n_ok, nothing.n_errors) == (7, 0, 0)
+    lines = (out / MANIFEST).read_text().splitlines()
+    assert len(lines) == 7 and len({json.loads(x)["path"] for x in lines}) == 7
+
+
+def test_torn_manifest_line_is_ignored(fleet_dir, tmp_path):
+    out = tmp_path / "s.parquet"
+    fleet.run(fleet.SCAN, [fleet_dir], out, workers=0)
+    with open(out / MANIFEST, "a") as fh:
+        fh.write('{"path": "/x", "si')  # a client killed while appending
+    s = fleet.run(fleet.SCAN, [fleet_dir], out, workers=0, resume=True)
+    assert (s.n_skipped, s.n_ok) == (7, 0)
+
+
+def test_scan_inventory_of_real_logs(shared_data, tmp_path):
+    logs = [
+        shared_data / "logs" / "px4_sample_log_small.ulg",
+        shared_data / "logs" / "ardupilot_log171.bin",
+        shared_data / "flights" / "phoenix_mission1_arducopter.tlog",
+    ]
+    s = fleet.run(fleet.SCAN, logs, tmp_path / "scan.parquet", workers=0)
+    assert s.n_errors == 0, s.errors
+    rows = {Path(r["path"]).name: r for r in read_dataset(s.out).to_pylist()}
+    bin_ = rows["ardupilot_log171.bin"]
+    assert bin_["format"] == "ardupilot-dataflash" and bin_["n_imus"] == 3
+    imu3 = next(i for i in bin_["imus"] if i["name"] == "IMU3")
+    assert imu3["temp_min_c"] == pytest.approx(25.5, abs=0.6) and imu3["temp_max_c"] == pytest.approx(
+        42.0, abs=0.6
+    )
+    tlog = rows["phoenix_mission1_arducopter.tlog"]
+    assert tlog["gnss"] and tlog["mission"] and tlog["n_waypoints"] >= 2
+    ulg = rows["px4_sample_log_small.ulg"]
+    assert ulg["autopilot"] == "PX4" and ulg["gnss"] and not ulg["mission"]
+    assert all(len(r["log_hash"]) == 64 for r in rows.values())
+
+
+def test_cli_scheduler_file_and_address(client, fleet_dir, reference, tmp_path):
+    sched = tmp_path / "scheduler.json"
+    client.write_scheduler_file(str(sched))
+    out = tmp_path / "scan.parquet"
+    r = CliRunner().invoke(
+        main, ["fleet", "scan", str(fleet_dir), "--out", str(out), "--scheduler-file", str(sched), "--json"]
+    )
+    assert r.exit_code == 0, r.output
+    info = json.loads(r.stdout)
+    assert (info["logs"], info["ok"], info["errors"], info["workers"]) == (7, 6, 1, 2)
+    _same(out, reference["scan"])
+    out2 = tmp_path / "h.parquet"
+    html = tmp_path / "fleet.html"
+    r = CliRunner().invoke(
+        main,
+        ["fleet", "imu-health", str(fleet_dir), "--out", str(out2), "--scheduler", client.scheduler.address,
+         "--report", str(html)],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert "1 error(s)" in r.stdout
+    _same(out2, reference["imu_health"])
+    page = html.read_text()
+    assert "Outliers" in page and "broken_001.csv" in page and "data:image/png;base64," in page
+
+
+def test_cli_errors(fleet_dir, tmp_path):
+    run = CliRunner().invoke
+    r = run(main, ["fleet", "scan", str(fleet_dir), "--out", str(tmp_path / "x.csv"), "--workers", "0"])
+    assert r.exit_code == 1 and "expected a name ending in .parquet" in r.stderr
+    r = run(
+        main,
+        ["fleet", "scan", str(tmp_path / "nope"), "--out", str(tmp_path / "x.parquet"), "--workers", "0"],
+    )
+    assert r.exit_code == 1 and "no such file" in r.stderr and not (tmp_path / "x.parquet").exists()
+    r = run(
+        main, ["fleet", "scan", str(fleet_dir), "--out", str(tmp_path / "x.parquet"), "--scheduler", "nohost"]
+    )
+    assert r.exit_code == 2 and "--scheduler" in r.stderr
+    r = run(main, ["fleet", "simulate", "--vehicles", "1", "--flights", "1", "--out", str(fleet_dir)])
+    assert r.exit_code == 1 and "not empty" in r.stderr
+
+
+def test_cli_simulate_then_scan_in_process(tmp_path):
+    d = tmp_path / "f"
+    r = CliRunner().invoke(main, ["fleet", "simulate", "--vehicles", "2", "--flights", "1", "--out", str(d),
+                                  "--duration", "5", "--json"])  # fmt: skip
+    assert r.exit_code == 0, r.output
+    info = json.loads(r.stdout)
+    assert info["files"] == 3 and len(info["faulty"]) == 1 and len(info["corrupt"]) == 1
+    r = CliRunner().invoke(
+        main, ["fleet", "scan", str(d), "--out", str(tmp_path / "s.parquet"), "--workers", "0"]
+    )
+    assert r.exit_code == 0, r.output
+    rows = read_dataset(tmp_path / "s.parquet")
+    assert sorted(rows.column("duration_s").to_pylist()) == pytest.approx([4.99, 4.99])
+
+
+def _executing(dask_worker):  # runs on each worker
+    return len(dask_worker.state.executing)
+
+
+def test_killed_worker_mid_run(client, fleet_dir, reference, tmp_path):
+    """SIGKILL the worker process that runs a task: Dask re-runs the task elsewhere, the output
+    equals the single-process output and each log is there exactly once."""
+    out = tmp_path / "h.parquet"
+    result: dict[str, object] = {}
+
+    def go():
+        try:
+            result["summary"] = fleet.run(fleet.IMU_HEALTH, [fleet_dir], out, client=client)
+        except BaseException as e:  # pragma: no cover - reported below
+            result["error"] = e
+
+    pids = client.run(os.getpid)
+    th = threading.Thread(target=go)
+    th.start()
+    killed = None
+    deadline = time.monotonic() + 60
+    while killed is None and time.monotonic() < deadline and th.is_alive():
+        busy = client.run(_executing)
+        for addr, n in busy.items():
+            if n > 0 and addr in pids:
+                os.kill(pids[addr], signal.SIGKILL)
+                killed = addr
+                break
+        time.sleep(0.05)
+    th.join(180)
+    assert killed is not None, "no worker was seen running a task"
+    assert "error" not in result, result.get("error")
+    s = result["summary"]
+    assert (s.n_logs, s.n_ok, s.n_errors) == (7, 6, 1)
+    _same(out, reference["imu_health"])
+    lines = (out / MANIFEST).read_text().splitlines()
+    assert sorted(json.loads(x)["path"] for x in lines) == sorted({json.loads(x)["path"] for x in lines})
+    client.wait_for_workers(2, timeout=60)
+    assert set(client.run(os.getpid).values()) != set(pids.values())  # a new process took over
