@@ -277,3 +277,33 @@ def test_killed_worker_mid_run(client, fleet_dir, reference, tmp_path):
     assert sorted(json.loads(x)["path"] for x in lines) == sorted({json.loads(x)["path"] for x in lines})
     client.wait_for_workers(2, timeout=60)
     assert set(client.run(os.getpid).values()) != set(pids.values())  # a new process took over
+
+
+def test_elements_dataset_trains_the_same_model(client, shared_data, fleet_dir, tmp_path):
+    """`fleet elements` on the cluster = the single-process rows = flight_samples' elements; and
+    `uasnav trajectory train ELEMENTS.parquet` trains the model training on the log gives."""
+    from uasnav.fleet.elements import ELEMENTS
+    from uasnav.trajectory.element_table import read_element_dataset
+    from uasnav.trajectory.flights import flight_samples
+
+    tlog = shared_data / "flights" / "phoenix_mission1_arducopter.tlog"
+    one = fleet.run(ELEMENTS, [tlog, fleet_dir], tmp_path / "e1.parquet", workers=0)
+    two = fleet.run(ELEMENTS, [tlog, fleet_dir], tmp_path / "e2.parquet", client=client)
+    assert (one.n_ok, one.n_empty, one.n_errors) == (1, 7, 0)  # IMU-only logs: no mission
+    assert read_dataset(two.out).equals(read_dataset(one.out))
+    samples, seg, runs = read_element_dataset(one.out)
+    ref = flight_samples([tlog])
+    assert (seg, runs, len(samples)) == (10.0, len(ref), ref.n_elements)
+    r = ref.concat()
+    for name in ("t_real_s", "dv_ms", "v_init_ms", "length_m", "flight", "element"):
+        assert np.array_equal(getattr(samples, name), getattr(r, name)), name
+    assert np.array_equal(samples.features.theta_deg, r.features.theta_deg)
+    m1, m2 = tmp_path / "m1.json", tmp_path / "m2.json"
+    for src, m in ((str(tlog), m1), (one.out, m2)):
+        res = CliRunner().invoke(main, ["trajectory", "train", src, "--out", str(m), "--json"])
+        assert res.exit_code == 0, res.output
+        assert json.loads(res.stdout)["n_runs"] == len(ref)
+    a, b = json.loads(m1.read_text()), json.loads(m2.read_text())
+    assert a == b and a["count_table"] and a["lvq"]
+    res = CliRunner().invoke(main, ["trajectory", "train", one.out, "--out", str(m2), "--segment", "5"])
+    assert res.exit_code == 1 and "10 m segments" in res.stderr

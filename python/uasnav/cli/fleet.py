@@ -155,6 +155,15 @@ def imu_health(sources, out, scheduler, scheduler_file, workers, resume, as_json
     _print(summary, as_json)
 
 
+@command.command("elements")
+@_run_options
+def elements(sources, out, scheduler, scheduler_file, workers, resume, as_json):  # type: ignore[no-untyped-def]
+    """Trajectory elements (features, measured times) of every log that flew a mission."""
+    from uasnav.fleet.elements import ELEMENTS
+
+    _print(_execute(ELEMENTS, sources, out, scheduler, scheduler_file, workers, resume), as_json)
+
+
 @command.command("simulate")
 @click.option("--vehicles", type=click.IntRange(1, 1000), required=True, help="Number of vehicles N.")
 @click.option("--flights", type=click.IntRange(1, 1000), required=True, help="Flights per vehicle M.")
@@ -178,6 +187,6 @@ def simulate(vehicles, flights, out, seed, duration, rate, as_json):  # type: ig
         echo_json({"out": fl.out, "files": len(fl.files), "faulty": fl.faulty, "corrupt": fl.corrupt})
     else:
         click.echo(
-            f"{len(fl.files)} file(s) in {out}: {len(fl.faulty)} with a faulty IMU, {len(fl.corrupt)} corrupt "
-            "(truth in fleet.json)"
+            f"{len(fl.files)} file(s) in {out}: {len(fl.faulty)} with a faulty IMU, "
+            f"{len(fl.corrupt)} corrupt (truth in fleet.json)"
         )
