@@ -117,12 +117,10 @@ def scores(health: pa.Table) -> pa.Table:
     return pa.Table.from_pylist(rows, schema=SCORES_SCHEMA)
 
 
-def write_scores(out: str | Path) -> dict[str, Any]:
-    """Score the health dataset ``out`` and write ``out/_scores.parquet`` (atomically)."""
-    from uasnav.fleet.imu_health import HEALTH_SCHEMA
-    from uasnav.fleet.runner import KEY_FIELDS
-
-    health = read_dataset(out, pa.schema([*KEY_FIELDS, *HEALTH_SCHEMA]))
+def write_scores(out: str | Path, schema: pa.Schema | None = None) -> dict[str, Any]:
+    """Score the health dataset ``out`` and write ``out/_scores.parquet`` (atomically);
+    ``schema``: the health files' schema (for a dataset without rows)."""
+    health = read_dataset(out, schema)
     table = scores(health)
     write_table(table, Path(out) / SCORES_FILE)
     outl = table.filter(pc.equal(table.column("outlier"), True)) if table.num_rows else table

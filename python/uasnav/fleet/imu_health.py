@@ -189,7 +189,7 @@ def imu_health_log(path: str) -> LogRows:
 def _finish(out: Any) -> dict[str, Any]:
     from uasnav.fleet.anomaly import write_scores
 
-    return write_scores(out)
+    return write_scores(out, IMU_HEALTH.full_schema)
 
 
 IMU_HEALTH = Analysis("imu_health", HEALTH_SCHEMA, imu_health_log, finish=_finish)
