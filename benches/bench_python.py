@@ -337,6 +337,98 @@ def bench_mission(n_uas: int, n_cam: int, repeat: int) -> None:
     )
 
 
+# --- issue 19: fleet-scale processing on Dask -------------------------------------------------
+
+_FLEET_PER_LOG = """
+import json, resource, sys, time, warnings
+warnings.simplefilter("ignore")
+from uasnav.fleet.runner import process_log
+from uasnav.fleet import IMU_HEALTH, SCAN
+import uasnav.stationary, uasnav.allan, uasnav.noise, uasnav.io, scipy.ndimage, uasnav.thermal
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+analysis = {"scan": SCAN, "imu_health": IMU_HEALTH}[sys.argv[2]]
+c0 = time.process_time()
+r = process_log(sys.argv[1], analysis, sys.argv[3])
+print(json.dumps({"status": r.status, "cpu_s": time.process_time() - c0, "base_mb": base / 1024,
+                  "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+
+def bench_fleet(vehicles: int, flights: int, duration_s: float, repeat: int) -> None:
+    """Fleet throughput (logs/s, MB/s) of ``imu-health`` and ``scan`` on LocalClusters of 1 and 2
+    worker processes (cluster started before timing), and per-log CPU-seconds and peak memory
+    (RSS above the imported baseline, one fresh process per log) by format."""
+    import json
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    from distributed import Client
+
+    from uasnav import fleet
+
+    with tempfile.TemporaryDirectory(prefix="bench-fleet-") as tmp:
+        src = Path(tmp) / "fleet"
+        fleet.simulate_fleet(src, vehicles, flights, seed=1, duration_s=duration_s, corrupt=False)
+        mb = sum(f.stat().st_size for f in src.rglob("*.csv")) / 1e6
+        n = vehicles * flights
+        for analysis in (fleet.IMU_HEALTH, fleet.SCAN):
+            rates = {}
+            for workers in (1, 2):
+                cluster = fleet.local_cluster(workers)
+                client = Client(cluster)
+                # warm-up (imports on every worker), not timed
+                warm = [str(p) for p in sorted(src.rglob("*.csv"))[:workers]]
+                fleet.run(analysis, warm, Path(tmp) / f"warm-{analysis.name}-{workers}", client=client)
+                times = []
+                for k in range(repeat):
+                    out = Path(tmp) / f"{analysis.name}-{workers}-{k}.parquet"
+                    t0 = time.perf_counter()
+                    fleet.run(analysis, [src], out, client=client)
+                    times.append(time.perf_counter() - t0)
+                client.close()
+                cluster.close()
+                rates[workers] = statistics.median(times)
+            print(
+                f"fleet {analysis.name} {n} CSV v1 logs ({mb:.0f} MB, {duration_s:g} s at 100 Hz): "
+                + " | ".join(
+                    f"{w} worker(s) {n / t:5.2f} logs/s {mb / t:5.1f} MB/s" for w, t in rates.items()
+                )
+                + f" | speed-up 2 vs 1: {rates[1] / rates[2]:.2f}x"
+            )
+        shared = Path(__file__).resolve().parents[2] / "shared" / "data"
+        samples = {f"csv-v1 (simulated, {duration_s:g} s 100 Hz)": str(next(src.rglob("*.csv")))}
+        for label, rel in (
+            ("px4-ulog (px4_sample.ulg, 69 s)", "logs/px4_sample.ulg"),
+            ("ardupilot-dataflash (log171.bin, 3 IMUs)", "logs/ardupilot_log171.bin"),
+            ("mavlink-tlog (phoenix mission1)", "flights/phoenix_mission1_arducopter.tlog"),
+        ):
+            if (shared / rel).exists():
+                samples[label] = str(shared / rel)
+        for label, path in samples.items():
+            size = os.path.getsize(path) / 1e6
+            parts = []
+            for name in ("scan", "imu_health"):
+                cpu, peak, base = [], [], []
+                for k in range(repeat):
+                    out = Path(tmp) / f"one-{name}-{k}-{abs(hash(path))}"
+                    r = subprocess.run(
+                        [sys.executable, "-c", _FLEET_PER_LOG, path, name, str(out)],
+                        capture_output=True, text=True, check=True,
+                    )  # fmt: skip
+                    d = json.loads(r.stdout.strip().splitlines()[-1])
+                    cpu.append(d["cpu_s"])
+                    peak.append(d["peak_mb"])
+                    base.append(d["base_mb"])
+                parts.append(
+                    f"{name} {statistics.median(cpu):5.2f} CPU-s, peak RSS {statistics.median(peak):4.0f} MB "
+                    f"(+{statistics.median(peak) - statistics.median(base):3.0f}) [{d['status']}]"
+                )
+            print(f"fleet per log {label} {size:.1f} MB: " + " | ".join(parts))
+
+
 CASES: dict[str, Callable[[bool], None]] = {
     "trajectory": lambda quick: bench_trajectory(10**5 if quick else 10**6, 10**4 if quick else 10**5, 3),
     "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
@@ -350,6 +442,9 @@ CASES: dict[str, Callable[[bool], None]] = {
     "noise": lambda quick: bench_noise(0.5 if quick else 2.0, 3 if quick else 5),
     "io": lambda quick: bench_io(10**4 if quick else 10**5, 1 if quick else 3),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
+    "fleet": lambda quick: bench_fleet(
+        3 if quick else 5, 2 if quick else 8, 40.0 if quick else 120.0, 1 if quick else 3
+    ),
 }
 
 
