@@ -152,7 +152,9 @@ def test_resume_does_only_what_is_missing(client, fleet_dir, reference, tmp_path
 
 def test_torn_manifest_line_is_ignored(fleet_dir, tmp_path):
     out = tmp_path / "s.parquet"
-    fleet.run(fleet.SCAN, [fleet_dir], out, workers=0)
+    calls = []
+    fleet.run(fleet.SCAN, [fleet_dir], out, workers=0, progress=lambda d, n: calls.append((d, n)))
+    assert calls[0] == (0, 7) and calls[-1] == (7, 7) and len(calls) == 8
     with open(out / MANIFEST, "a") as fh:
         fh.write('{"path": "/x", "si')  # a client killed while appending
     s = fleet.run(fleet.SCAN, [fleet_dir], out, workers=0, resume=True)
@@ -204,6 +206,16 @@ def test_cli_scheduler_file_and_address(client, fleet_dir, reference, tmp_path):
     _same(out2, reference["imu_health"])
     page = html.read_text()
     assert "Outliers" in page and "broken_001.csv" in page and "data:image/png;base64," in page
+
+
+def test_health_report_of_a_fleet_without_a_readable_log(fleet_dir, tmp_path):
+    from uasnav.fleet.html import render_health_report
+
+    out = tmp_path / "h.parquet"
+    s = fleet.run(fleet.IMU_HEALTH, [fleet_dir / "corrupt"], out, workers=0)
+    assert (s.n_ok, s.n_errors, s.extra["n_imus"]) == (0, 1, 0)
+    page = render_health_report(out)
+    assert "0 IMU(s)" in page and "1 unreadable" in page
 
 
 def test_cli_errors(fleet_dir, tmp_path):

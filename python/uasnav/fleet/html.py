@@ -79,7 +79,9 @@ def render_health_report(out: str | Path) -> str:
     from uasnav.fleet.anomaly import OUTLIER_Z, read_scores
     from uasnav.fleet.output import read_dataset, read_errors
 
-    health = read_dataset(out)
+    from uasnav.fleet.imu_health import IMU_HEALTH
+
+    health = read_dataset(out, IMU_HEALTH.full_schema)
     scores = read_scores(out)
     errors = read_errors(out)
     png = _figure_png(health, scores) if health.num_rows else ""
