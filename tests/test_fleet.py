@@ -183,6 +183,24 @@ def test_scan_inventory_of_real_logs(shared_data, tmp_path):
     assert all(len(r["log_hash"]) == 64 for r in rows.values())
 
 
+def test_imu_health_of_real_logs(shared_data, tmp_path):
+    logs = [shared_data / "logs" / "ardupilot_log171.bin", shared_data / "logs" / "px4_sample.ulg"]
+    s = fleet.run(fleet.IMU_HEALTH, logs, tmp_path / "h.parquet", workers=0)
+    assert (s.n_ok, s.n_errors, s.n_rows) == (2, 0, 4)
+    rows = {r["imu"]: r for r in read_dataset(s.out).to_pylist()}
+    assert set(rows) == {"IMU", "IMU2", "IMU3", "sensor_combined"}
+    for r in rows.values():
+        assert r["static_s"] >= 10.0 and r["noise_reason"] is None
+        assert all(r[f"gyro_random_walk_{a}"] > 0 for a in "xyz")
+        # a static minute shows white noise only: the longest-τ term is null with the reason
+        assert r["gyro_rate_ramp"] is None and r["gyro_rate_ramp_reason"]
+        assert all(r[f"vibration_{a}"] > 0 for a in "xyz")
+    # IMU3 warms by 16 °C: its slope is measured; the others warm < 2 °C while static
+    assert rows["IMU3"]["gyro_temp_slope_x"] is not None and rows["IMU3"]["temp_slope_reason"] is None
+    assert rows["IMU"]["gyro_temp_slope_x"] is None and "°C" in rows["IMU"]["temp_slope_reason"]
+    assert rows["sensor_combined"]["temp_slope_reason"] == "no temperature channel"
+
+
 def test_cli_scheduler_file_and_address(client, fleet_dir, reference, tmp_path):
     sched = tmp_path / "scheduler.json"
     client.write_scheduler_file(str(sched))

@@ -25,7 +25,8 @@ Columns (SI; besides the runner's key and partition columns):
 - ``temp_min_c``, ``temp_max_c``; ``gyro_temp_slope_{x,y,z}`` (rad/s/°C): slope of the static
   gyro output against temperature when the static samples span at least
   :data:`MIN_TEMP_SPAN_C`, else null with ``temp_slope_reason``;
-- ``vibration_{x,y,z}`` (m/s²): RMS of the specific force minus its 1 s moving mean;
+- ``vibration_{x,y,z}`` (m/s²): RMS of the specific force minus its 1 s moving mean (null for
+  streams slower than :data:`MIN_VIBRATION_RATE_HZ`);
   ``gyro_clip_samples``/``accel_clip_samples``: samples pinned at an axis' extreme value
   (a rail reached at least :data:`CLIP_MIN_REPEATS` times: saturation).
 
@@ -49,6 +50,9 @@ from uasnav.imu import ImuLog
 MIN_STATIC_S = 10.0
 #: Smallest temperature span over static samples for a temperature slope (°C).
 MIN_TEMP_SPAN_C = 2.0
+#: Slowest IMU stream whose vibration is computed (Hz): telemetry-rate streams (a .tlog's 1–4 Hz
+#: RAW_IMU) cannot show airframe vibration.
+MIN_VIBRATION_RATE_HZ = 20.0
 #: A value at an axis' extreme at least this often is a saturated (clipped) output.
 CLIP_MIN_REPEATS = 3
 TERMS_LONG = ("quantization", "bias_instability", "rate_random_walk", "rate_ramp")
@@ -166,11 +170,11 @@ def imu_health_of(log: ImuLog, name: str = "imu0", model: str | None = None) -> 
         row["temp_slope_reason"] = "no temperature channel"
     from scipy.ndimage import uniform_filter1d
 
-    w = max(1, round(rate))
-    hp = log.accel - uniform_filter1d(log.accel, size=w, axis=0, mode="nearest")
-    vib = np.sqrt(np.mean(hp * hp, axis=0))
-    for i, a in enumerate(AXES):
-        row[f"vibration_{a}"] = float(vib[i])
+    if rate >= MIN_VIBRATION_RATE_HZ:
+        hp = log.accel - uniform_filter1d(log.accel, size=round(rate), axis=0, mode="nearest")
+        vib = np.sqrt(np.mean(hp * hp, axis=0))
+        for i, a in enumerate(AXES):
+            row[f"vibration_{a}"] = float(vib[i])
     row["gyro_clip_samples"] = _clipped(log.gyro)
     row["accel_clip_samples"] = _clipped(log.accel)
     return row
