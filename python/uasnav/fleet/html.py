@@ -77,9 +77,8 @@ def _table(headers: list[str], rows: list[list[object]]) -> str:
 def render_health_report(out: str | Path) -> str:
     """The HTML page of the health dataset ``out`` (module docs)."""
     from uasnav.fleet.anomaly import OUTLIER_Z, read_scores
-    from uasnav.fleet.output import read_dataset, read_errors
-
     from uasnav.fleet.imu_health import IMU_HEALTH
+    from uasnav.fleet.output import read_dataset, read_errors
 
     health = read_dataset(out, IMU_HEALTH.full_schema)
     scores = read_scores(out)
