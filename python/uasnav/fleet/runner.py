@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import logging
 import os
+import shutil
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -41,6 +42,7 @@ import pyarrow as pa
 from uasnav.errors import InputError
 from uasnav.fleet.output import (
     ERRORS_SCHEMA,
+    MANIFEST,
     Manifest,
     ManifestEntry,
     content_hash,
@@ -270,9 +272,34 @@ def run(
             skipped += 1
         else:
             todo.append(p)
+    created = not out_p.exists()
     out_p.mkdir(parents=True, exist_ok=True)
-    manifest = manifest or Manifest(out_p)
-    summary = RunSummary(analysis.name, str(out_p), len(paths), n_skipped=skipped)
+    try:
+        return _run(analysis, out_p, todo, len(paths), skipped, manifest or Manifest(out_p), t0,
+                    client, scheduler, scheduler_file, workers, progress)  # fmt: skip
+    except BaseException:
+        # a run that failed before committing anything (e.g. no scheduler at that address)
+        # leaves nothing behind
+        if created and not (out_p / MANIFEST).exists():
+            shutil.rmtree(out_p, ignore_errors=True)
+        raise
+
+
+def _run(
+    analysis: Analysis,
+    out_p: Path,
+    todo: list[str],
+    n_logs: int,
+    skipped: int,
+    manifest: Manifest,
+    t0: float,
+    client: Any,
+    scheduler: str | None,
+    scheduler_file: str | None,
+    workers: int | None,
+    progress: Progress,
+) -> RunSummary:
+    summary = RunSummary(analysis.name, str(out_p), n_logs, n_skipped=skipped)
     if progress is not None:
         progress(0, len(todo))
 
