@@ -1,12 +1,13 @@
 """Fleet-scale processing of flight logs on Dask: inventory, IMU health, trajectory elements.
 
 The same per-log code runs in this process (``workers=0``), on a ``distributed.LocalCluster``
-(the default) or on an existing Dask cluster (``scheduler=``/``scheduler_file=``):
+(the default) or on an existing Dask cluster (``scheduler=``/``scheduler_file=``)::
 
->>> from uasnav import fleet                                      # doctest: +SKIP
->>> fleet.simulate_fleet("fleet", vehicles=5, flights=4)           # doctest: +SKIP
->>> s = fleet.run(fleet.IMU_HEALTH, ["fleet"], "health.parquet")   # doctest: +SKIP
->>> fleet.read_dataset("health.parquet"), fleet.read_errors("health.parquet")  # doctest: +SKIP
+    from uasnav import fleet
+    fleet.simulate_fleet("fleet", vehicles=5, flights=4)
+    s = fleet.run(fleet.IMU_HEALTH, ["fleet"], "health.parquet")      # a LocalCluster
+    rows, errors = fleet.read_dataset(s.out), fleet.read_errors(s.out)
+    scores = fleet.read_scores(s.out)                                 # anomaly scores
 
 Modules: :mod:`~uasnav.fleet.runner` (the runner, :class:`Analysis`), :mod:`~uasnav.fleet.output`
 (layout, manifest, errors table), :mod:`~uasnav.fleet.sources` (finding logs),
