@@ -180,6 +180,8 @@ def test_scan_inventory_of_real_logs(shared_data, tmp_path):
     assert tlog["gnss"] and tlog["mission"] and tlog["n_waypoints"] >= 2
     ulg = rows["px4_sample_log_small.ulg"]
     assert ulg["autopilot"] == "PX4" and ulg["gnss"] and not ulg["mission"]
+    # the flight controller's UUID is the vehicle (and the partition)
+    assert ulg["vehicle_id"] == ulg["vehicle"] == "000600000000383638393239510d0035002d"
     assert all(len(r["log_hash"]) == 64 for r in rows.values())
 
 

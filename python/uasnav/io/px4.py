@@ -135,6 +135,11 @@ def read_ulog(path: str | os.PathLike[str]) -> ImuLog:
     ulog, decoder = _open(p)
     sp = str(p)
     meta: dict[str, Any] = {"source": sp, "format": "px4-ulog", "frame": "FRD"}
+    # the flight controller's identity when the log records it (uasnav.fleet partitions by it)
+    info = getattr(ulog, "msg_info_dict", None) or {}
+    meta.update(
+        {k: str(info[i]) for k, i in (("vehicle", "sys_uuid"), ("hardware", "ver_hw")) if info.get(i)}
+    )
     sc = _dataset(ulog, "sensor_combined")
     mag = None
     if sc is not None:
