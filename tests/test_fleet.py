@@ -178,6 +178,7 @@ def test_scan_inventory_of_real_logs(shared_data, tmp_path):
     )
     tlog = rows["phoenix_mission1_arducopter.tlog"]
     assert tlog["gnss"] and tlog["mission"] and tlog["n_waypoints"] >= 2
+    assert tlog["day"] == "2018-09-17"  # the ground station's clock (the file is named 2018-09-17 16-44-06)
     ulg = rows["px4_sample_log_small.ulg"]
     assert ulg["autopilot"] == "PX4" and ulg["gnss"] and not ulg["mission"]
     # the flight controller's UUID is the vehicle (and the partition)

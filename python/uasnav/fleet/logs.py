@@ -5,8 +5,8 @@ says which reader a file needs (by extension, and for ``.csv`` by the header: CS
 the flight CSV) and gathers what every analysis needs: the IMU instances as
 :class:`~uasnav.imu.ImuLog` (``read_dataflash``/``read_tlog`` give every instance, ``read_ulog``
 the primary one) and the vehicle identity written in the log (CSV v1 ``# vehicle:``,
-``# autopilot:``, ``# start_time:`` comments; the binary readers carry none yet, so their
-vehicle and day are ``unknown``).
+``# autopilot:``, ``# start_time:`` comments; a ULog's flight-controller UUID; a ``.tlog``'s
+wall-clock time stamps; other logs' vehicle and day are ``unknown``).
 """
 
 from __future__ import annotations
@@ -100,6 +100,21 @@ def _start_time(meta: dict[str, Any]) -> dt.datetime | None:
     return t.replace(tzinfo=dt.timezone.utc) if t.tzinfo is None else t.astimezone(dt.timezone.utc)
 
 
+def _tlog_start(path: str) -> dt.datetime | None:
+    """A .tlog's telemetry is stamped with the ground station's wall clock (UTC, s): its first
+    GNSS sample dates the log. None without one (or before 2000: not a wall clock)."""
+    from uasnav.errors import UasnavError
+    from uasnav.io import read_flight
+
+    try:
+        t0 = float(read_flight(path).t[0])
+    except (UasnavError, IndexError):
+        return None
+    if t0 < 946_684_800:  # 2000-01-01
+        return None
+    return dt.datetime.fromtimestamp(t0, tz=dt.timezone.utc)
+
+
 def read_fleet_log(path: str) -> FleetLog:
     """Read ``path`` once with the reader its format needs (module docs)."""
     from uasnav import io
@@ -117,13 +132,16 @@ def read_fleet_log(path: str) -> FleetLog:
         io.read_flight(path)
         imus = {}
     meta = next(iter(imus.values())).meta if imus else {}
+    start = _start_time(dict(meta))
+    if start is None and fmt == "mavlink-tlog":
+        start = _tlog_start(path)
     return FleetLog(
         path=path,
         format=fmt,
         imus=imus,
         vehicle=meta.get("vehicle"),
         autopilot=meta.get("autopilot") or _AUTOPILOT.get(fmt),
-        start_time=_start_time(dict(meta)),
+        start_time=start,
     )
 
 
