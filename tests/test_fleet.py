@@ -104,6 +104,18 @@ def test_health_numbers_match_the_simulated_sensor(tmp_path):
         assert row[f"gyro_bias_{a}"] == pytest.approx(bias[i], abs=2e-3)  # plus noise, Earth rate
 
 
+def test_anomaly_score_finds_the_faulty_imus(client, tmp_path):
+    """5 vehicles × 4 flights: the outliers are exactly the generator's faulty IMUs."""
+    src = tmp_path / "fleet"
+    fleet.simulate_fleet(src, vehicles=5, flights=4, seed=11, duration_s=30.0, corrupt=False)
+    s = fleet.run(fleet.IMU_HEALTH, [src], tmp_path / "h.parquet", client=client)
+    truth = load_truth(src)
+    found = sorted(Path(o["path"]).relative_to(src).as_posix() for o in s.extra["outliers"])
+    assert found == sorted(truth.faulty) and len(found) == 2
+    scores = fleet.read_scores(s.out)
+    assert scores.num_rows == 20 and all(v is not None for v in scores.column("score").to_pylist())
+
+
 def test_robust_z_is_the_modified_z_score():
     x = np.array([1.0, 2.0, 3.0, 4.0, 100.0, 5.0])
     g = np.array(["a"] * 6)
