@@ -39,6 +39,7 @@ def _figure_png(health: pa.Table, scores: pa.Table) -> str:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
 
     models = sorted(set(health.column("imu_model").to_pylist()))
     outlier = np.array(scores.column("outlier").to_pylist(), dtype=bool)
@@ -55,6 +56,7 @@ def _figure_png(health: pa.Table, scores: pa.Table) -> str:
                 ax.hist(v[ok & ~outlier], bins=bins, color="tab:blue", label="normal")
                 ax.hist(v[ok & outlier], bins=bins, color="tab:red", label="outlier")
                 ax.set_xscale("log")
+                ax.xaxis.set_minor_formatter(NullFormatter())  # no overlapping 2×10⁻³ … labels
             ax.set_title(f"{m}: {label}", fontsize=9)
             if i == 0 and j == 0:
                 ax.legend(fontsize=8)
