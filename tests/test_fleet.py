@@ -160,6 +160,11 @@ def test_resume_does_only_what_is_missing(client, fleet_dir, reference, tmp_path
     assert (nothing.n_skipped, nothing.n_ok, nothing.n_errors) == (7, 0, 0)
     lines = (out / MANIFEST).read_text().splitlines()
     assert len(lines) == 7 and len({json.loads(x)["path"] for x in lines}) == 7
+    # a copy of a finished log under a new name: recognised by its content, stored once
+    shutil.copy(src / "V01" / "flight_001.csv", src / "V01" / "copy.csv")
+    copy = fleet.run(fleet.IMU_HEALTH, [src], out, client=client, resume=True)
+    assert (copy.n_skipped, copy.n_ok, copy.n_rows) == (7, 1, 1)
+    assert read_dataset(out).drop_columns(["path"]).equals(ref)
 
 
 def test_torn_manifest_line_is_ignored(fleet_dir, tmp_path):

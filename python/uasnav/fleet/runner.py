@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
+import pyarrow.parquet as pq
 
 from uasnav.errors import InputError
 from uasnav.fleet.output import (
@@ -131,7 +132,9 @@ def process_log(path: str, analysis: Analysis, out: str) -> TaskResult:
     """Run ``analysis`` on one log and write its rows (or its error row); idempotent.
 
     Runs on a worker (or in this process). Never raises for a bad log: any exception of the
-    reading or the analysis becomes an errors-table row.
+    reading or the analysis becomes an errors-table row. A log whose content hash already has
+    its file in ``out`` is not computed again: logs are identified by content, so two copies of
+    one log are stored once (under the path of the copy processed first).
     """
     cpu0 = time.process_time()
     out_p = Path(out)
@@ -144,6 +147,14 @@ def process_log(path: str, analysis: Analysis, out: str) -> TaskResult:
     log_hash: str | None = None
     try:
         log_hash = content_hash(path)
+        done = sorted(out_p.glob(f"vehicle=*/day=*/{log_hash}.parquet"))
+        if done:
+            # the same content was finished before (a resumed run, a renamed or copied log, or
+            # Dask re-running a task whose result was lost): nothing to compute
+            n = pq.read_metadata(done[0]).num_rows
+            return TaskResult(
+                path, size, mtime_ns, log_hash, "ok", n_rows=n, cpu_s=time.process_time() - cpu0
+            )
         with warnings.catch_warnings():
             # corrupt-record warnings of the readers: the log is salvaged; the run stays quiet
             warnings.simplefilter("ignore")

@@ -129,10 +129,22 @@ def read_element_dataset(path: str | os.PathLike[str]) -> tuple[ElementSamples, 
     p = Path(path)
     if not p.exists():
         raise InputError(f"{p}: no such element dataset")
+    if p.is_dir():
+        files = sorted(
+            str(f)
+            for f in p.rglob("*.parquet")
+            if not any(part.startswith((".", "_")) for part in f.relative_to(p).parts)
+        )
+        if not files:
+            raise InputError(f"{p}: no Parquet file in this directory (not an element dataset)")
+    else:
+        files = [str(p)]
     try:
-        table = pads.dataset(str(p), format="parquet", partitioning="hive").to_table()
-    except (pa.ArrowInvalid, OSError) as e:
-        raise InputError(f"{p}: not a Parquet element dataset ({e})") from None
+        ds = pads.dataset(files, format="parquet", partitioning="hive", partition_base_dir=str(p))
+        table = ds.to_table()
+    except (pa.ArrowInvalid, OSError):
+        # Arrow's message repeats the path; one line naming the input is what the user needs
+        raise InputError(f"{p}: not a Parquet element dataset (unreadable or not Parquet)") from None
     key = ("log_hash", "run") if "log_hash" in table.column_names else ("run",)
     table = table.sort_by([(k, "ascending") for k in (*key, "element")])
     samples, seg = from_table(table, key)
