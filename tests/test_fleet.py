@@ -357,3 +357,10 @@ def test_elements_dataset_trains_the_same_model(client, shared_data, fleet_dir, 
     assert a == b and a["count_table"] and a["lvq"]
     res = CliRunner().invoke(main, ["trajectory", "train", one.out, "--out", str(m2), "--segment", "5"])
     assert res.exit_code == 1 and "10 m segments" in res.stderr
+    # other measuring options go to the workers with the analysis
+    e5 = tmp_path / "e5.parquet"
+    res = CliRunner().invoke(main, ["fleet", "elements", str(tlog), "--out", str(e5), "--segment", "5",
+                                    "--scheduler", client.scheduler.address])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    s5, seg5, _ = read_element_dataset(e5)
+    assert seg5 == 5.0 and len(s5) == flight_samples([tlog], segment_m=5.0).n_elements

@@ -157,11 +157,21 @@ def imu_health(sources, out, scheduler, scheduler_file, workers, resume, as_json
 
 @command.command("elements")
 @_run_options
-def elements(sources, out, scheduler, scheduler_file, workers, resume, as_json):  # type: ignore[no-untyped-def]
+@click.option("--segment", type=POSITIVE, default=10.0, show_default=True, help="Segment length L (m).")
+@click.option("--speed", type=POSITIVE, help="Commanded speed (m/s); default each log's waypoint speed.")
+@click.option(
+    "--max-gap",
+    type=POSITIVE,
+    default=5.0,
+    show_default=True,
+    help="Largest telemetry gap in an element (s).",
+)
+def elements(sources, out, scheduler, scheduler_file, workers, resume, as_json, segment, speed, max_gap):  # type: ignore[no-untyped-def]
     """Trajectory elements (features, measured times) of every log that flew a mission."""
-    from uasnav.fleet.elements import ELEMENTS
+    from uasnav.fleet.elements import elements_analysis
 
-    _print(_execute(ELEMENTS, sources, out, scheduler, scheduler_file, workers, resume), as_json)
+    analysis = elements_analysis(segment, speed, max_gap)
+    _print(_execute(analysis, sources, out, scheduler, scheduler_file, workers, resume), as_json)
 
 
 @command.command("simulate")

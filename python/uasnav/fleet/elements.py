@@ -19,8 +19,12 @@ from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M
 _TELEMETRY = ("px4-ulog", "ardupilot-dataflash", "mavlink-tlog")
 
 
-def elements_log(path: str, segment_m: float = DEFAULT_SEGMENT_M) -> LogRows:
-    """Element rows of every mission run of one log (empty without a mission)."""
+def elements_log(
+    path: str, segment_m: float = DEFAULT_SEGMENT_M, cruise_ms: float | None = None, max_gap_s: float = 5.0
+) -> LogRows:
+    """Element rows of every mission run of one log (empty without a mission); ``cruise_ms``
+    overrides the log's waypoint speed (m/s), ``max_gap_s`` is the largest telemetry gap in a
+    measured element (s)."""
     from uasnav.io import read_flight
     from uasnav.trajectory.flights import flight_samples
 
@@ -28,7 +32,7 @@ def elements_log(path: str, segment_m: float = DEFAULT_SEGMENT_M) -> LogRows:
         return LogRows([])
     if not read_flight(path).waypoints:
         return LogRows([])
-    fs = flight_samples([path], segment_m=segment_m)
+    fs = flight_samples([path], cruise_ms=cruise_ms, segment_m=segment_m, max_gap_s=max_gap_s)
     rows = []
     for run, s in enumerate(fs.samples):
         s.flight[:] = run
@@ -38,4 +42,19 @@ def elements_log(path: str, segment_m: float = DEFAULT_SEGMENT_M) -> LogRows:
 
 ELEMENTS = Analysis("elements", ELEMENT_SCHEMA, elements_log)
 
-__all__ = ["ELEMENTS", "elements_log"]
+
+def elements_analysis(
+    segment_m: float = DEFAULT_SEGMENT_M, cruise_ms: float | None = None, max_gap_s: float = 5.0
+) -> Analysis:
+    """:data:`ELEMENTS` with other measuring options (a partial of :func:`elements_log`, which
+    pickles by reference to the workers)."""
+    from functools import partial
+
+    return Analysis(
+        "elements",
+        ELEMENT_SCHEMA,
+        partial(elements_log, segment_m=segment_m, cruise_ms=cruise_ms, max_gap_s=max_gap_s),
+    )
+
+
+__all__ = ["ELEMENTS", "elements_analysis", "elements_log"]
