@@ -65,6 +65,9 @@ KEY_FIELDS = (
 )
 
 Progress = Callable[[int, int], None] | None
+#: Errors listed in a :class:`RunSummary` (and the ``--json`` summary); the errors table in the
+#: output holds every one.
+MAX_LISTED_ERRORS = 1000
 
 
 @dataclass(frozen=True)
@@ -336,7 +339,8 @@ def _run(
             summary.n_empty += 1
         else:
             summary.n_errors += 1
-            summary.errors.append({"path": res.path, "error": res.error})
+            if len(summary.errors) < MAX_LISTED_ERRORS:  # the errors table has them all
+                summary.errors.append({"path": res.path, "error": res.error})
         summary.bytes_read += max(res.size, 0)
         if progress is not None:
             progress(summary.n_ok + summary.n_empty + summary.n_errors, len(todo))
@@ -376,7 +380,7 @@ def _run_distributed(
             client = Client(cluster)
     try:
         summary.scheduler = str(client.scheduler.address)
-        summary.workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
+        summary.workers = len(client.nthreads())
         # Keys name the analysis and the log: a task is identified by what it computes, so a
         # resubmission (after a lost worker) is the same task.
         futures = client.map(process_log, todo, analysis=analysis, out=str(out), pure=False)
