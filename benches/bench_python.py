@@ -11,6 +11,7 @@ import argparse
 import statistics
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
@@ -435,6 +436,68 @@ def bench_fleet(vehicles: int, flights: int, duration_s: float, repeat: int) -> 
             print(f"fleet per log {label} {size:.1f} MB: " + " | ".join(parts))
 
 
+def bench_ins(n: int, n_peer: int, repeat: int) -> None:
+    """Whole simulated flight through uasnav.ins.run (one FFI call, GIL released; 100 Hz IMU,
+    5 Hz GNSS, 10 Hz baro) against a filterpy loop of the same 15-state error model (fixed Φ at
+    100 Hz, a 6-row GNSS update every 20th step: only the Kalman algebra, no mechanisation —
+    a lower bound on a Python implementation's cost). The flight is simulated once, outside
+    the timing."""
+    from filterpy.kalman import KalmanFilter
+
+    from uasnav import ins
+    from uasnav.sim.flight import simulate_flight
+
+    flight = simulate_flight(duration_s=n / 100.0, seed=0)
+    cfg = ins.InsConfig(decimation=100)
+    t_ours = median_time(lambda: ins.run(flight, cfg), repeat)
+    n_imu = flight.imu.n
+
+    def skew(v: np.ndarray) -> np.ndarray:
+        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+    w = 7.292115e-5 * np.array([np.cos(0.8), 0.0, -np.sin(0.8)])
+    F = np.zeros((15, 15))
+    F[0:3, 3:6] = np.eye(3)
+    F[3:6, 3:6] = -2 * skew(w)
+    F[3:6, 6:9] = -skew(np.array([0.3, -0.2, -9.8]))
+    F[3:6, 9:12] = -np.eye(3)
+    F[6:9, 6:9] = -skew(w)
+    F[6:9, 12:15] = -np.eye(3)
+
+    def peer() -> None:
+        kf = KalmanFilter(dim_x=15, dim_z=6)
+        kf.F = np.eye(15) + F * 0.01
+        kf.Q = np.diag(np.r_[np.zeros(3), np.full(12, 1e-6)]) * 0.01
+        kf.H = np.hstack([np.eye(6), np.zeros((6, 9))])
+        kf.R = np.diag([2.25, 2.25, 6.25, 0.0225, 0.0225, 0.0225])
+        kf.P = np.eye(15)
+        z = np.zeros(6)
+        for k in range(n_peer):
+            kf.predict()
+            if (k + 1) % 20 == 0:
+                kf.update(z)
+
+    t_peer = median_time(peer, max(1, repeat // 2))
+    ours_rate, peer_rate = n_imu / t_ours, n_peer / t_peer
+    print(
+        f"ins whole flight n={n_imu:.2e}: uasnav {t_ours * 1e3:8.1f} ms ({ours_rate / 1e6:.2f} M samples/s)"
+        f" | filterpy loop n={n_peer:.0e} {t_peer * 1e3:8.1f} ms ({peer_rate / 1e3:.1f} k samples/s)"
+        f" | speed-up {ours_rate / peer_rate:5.1f}x"
+    )
+
+
+def bench_ins_log171(repeat: int) -> None:
+    """Real data: read ArduPilot log171 and replay it (IMU, 5 Hz GNSS, baro, mag)."""
+    from uasnav import ins
+    from uasnav.io.navdata import read_dataflash_nav
+
+    path = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "logs" / "ardupilot_log171.bin"
+    t_read = median_time(lambda: read_dataflash_nav(path), repeat)
+    f = read_dataflash_nav(path).between(0.0, 238.0)
+    t_run = median_time(lambda: ins.run(f, ins.InsConfig.for_logged_imu()), repeat)
+    print(f"ins log171: read {t_read * 1e3:8.1f} ms | replay {f.imu.n} samples {t_run * 1e3:8.1f} ms")
+
+
 CASES: dict[str, Callable[[bool], None]] = {
     "trajectory": lambda quick: bench_trajectory(10**5 if quick else 10**6, 10**4 if quick else 10**5, 3),
     "allan": lambda quick: bench_allan(10**6 if quick else 10**7, 3 if quick else 5),
@@ -451,6 +514,10 @@ CASES: dict[str, Callable[[bool], None]] = {
     "fleet": lambda quick: bench_fleet(
         3 if quick else 5, 2 if quick else 8, 40.0 if quick else 120.0, 1 if quick else 3
     ),
+    "ins": lambda quick: bench_ins(
+        10**5 if quick else 10**6, 10**4 if quick else 5 * 10**4, 3 if quick else 5
+    ),
+    "ins_log171": lambda quick: bench_ins_log171(1 if quick else 3),
 }
 
 

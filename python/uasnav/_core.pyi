@@ -32,6 +32,7 @@ __all__ = [
     "earth_normal_gravity",
     "earth_radii",
     "earth_rate_ned",
+    "ins_run",
     "mlp_evaluate_model",
     "noise_fit_ieee952",
     "noise_read_points",
@@ -251,3 +252,42 @@ def redundancy_wahba(
     v_ref: NDArray[np.float64], v_sensor: NDArray[np.float64], weights: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """Rotation C (3, 3), reference → sensor, with v_sensor ≈ C·v_ref."""
+
+# ---- GNSS/INS (issue 15) ----------------------------------------------------------------
+
+def ins_run(
+    imu_t: NDArray[np.float64],
+    gyro: NDArray[np.float64],
+    accel: NDArray[np.float64],
+    gnss_t: NDArray[np.float64],
+    gnss_llh: NDArray[np.float64],
+    gnss_vel: NDArray[np.float64],
+    gnss_acc: NDArray[np.float64],
+    *,
+    gnss_use: NDArray[np.bool_] | None = None,
+    baro_t: NDArray[np.float64] | None = None,
+    baro_h: NDArray[np.float64] | None = None,
+    mag_t: NDArray[np.float64] | None = None,
+    mag: NDArray[np.float64] | None = None,
+    temp: NDArray[np.float64] | None = None,
+    dbias_dtemp: NDArray[np.float64] | None = None,
+    stationary: NDArray[np.bool_] | None = None,
+    initial_attitude: Sequence[float] | None = None,
+    levelling_samples: int = 100,
+    gyro_bias0: Sequence[float] = ...,
+    mode: str = "classic",
+    discretisation: str = "first_order",
+    config: dict[str, float] | None = None,
+    lever_arm: Sequence[float] = ...,
+    window_fixes: int = 10,
+    reset_after_exclusions: int = 50,
+    decimation: int = 1,
+) -> dict[str, Any]:
+    """Run the GNSS/INS filter over a whole flight (one call, GIL released).
+
+    IMU times (s), gyro (n, 3) rad/s, accel (n, 3) m/s²; GNSS times (s), llh (m, 3) rad/rad/m,
+    NED velocity (m, 3) m/s, accuracies (m, 3) = horizontal m, vertical m, speed m/s. Returns
+    decimated ``llh``, ``vel``, ``attitude``, ``gyro_bias``, ``accel_bias``, ``cov_diag``,
+    ``protection`` (HPL, VPL m), ``gnss_used``; per fix ``fix_status`` (0 used, 1/2 excluded,
+    3 masked, 4 unused, 5 reset) and ``fix_nis``; and the update counts.
+    """

@@ -26,10 +26,12 @@ pub mod allan;
 pub mod attitude;
 pub mod earth;
 pub mod error;
+pub mod ins;
 pub mod mlp;
 pub mod noise;
 pub mod redundancy;
 pub(crate) mod scalar;
+pub mod strapdown;
 pub mod zupt;
 
 pub use error::NavError;

@@ -8,6 +8,7 @@ mod attitude;
 mod convert;
 mod earth;
 mod errors;
+mod ins;
 mod mlp;
 mod redundancy;
 mod zupt;
@@ -24,5 +25,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     earth::register(m)?;
     zupt::register(m)?;
     redundancy::register(m)?;
+    ins::register(m)?;
     Ok(())
 }

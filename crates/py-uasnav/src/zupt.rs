@@ -216,7 +216,8 @@ fn zupt_run<'py>(
     Ok(dict)
 }
 
-fn to2<const K: usize>(v: &[[f64; K]]) -> Array2<f64> {
+/// `(n, K)` array from rows (shared with `ins`).
+pub(crate) fn to2<const K: usize>(v: &[[f64; K]]) -> Array2<f64> {
     let mut out = Array2::zeros((v.len(), K));
     for (mut row, r) in out.rows_mut().into_iter().zip(v) {
         row.iter_mut().zip(r).for_each(|(s, x)| *s = *x);

@@ -34,10 +34,12 @@ def _outputs(out: Path, count: int) -> list[Path]:
 )
 @click.option(
     "--profile",
-    type=click.Choice(["static", "soak", "ramp", "cycles", "warmup"]),
+    type=click.Choice(["static", "soak", "ramp", "cycles", "warmup", "flight"]),
     default="static",
     show_default=True,
-    help="Temperature profile (thesis §4.2.4: soak = Fig. 29, ramp = Fig. 30; cycles = repeated ramps).",
+    help="Temperature profile (thesis §4.2.4: soak = Fig. 29, ramp = Fig. 30; cycles = repeated ramps); "
+    "flight: a simulated multirotor flight (uasnav.sim.flight) with the preset's thermal gyro bias, "
+    "written as OUT (IMU, magnetometer, truth) and OUT_gnss.csv.",
 )
 @click.option(
     "--duration", type=POSITIVE, default=None, help="Seconds; default: the profile's natural length."
@@ -97,6 +99,11 @@ def command(
     out_path = Path(out)
     if out_path.suffix.lower() not in WRITE_EXTENSIONS:
         raise click.UsageError(f"--out: extension must be one of {', '.join(WRITE_EXTENSIONS)}")
+    if profile == "flight":
+        if sensors != "single" or table_rate_dps != 0.0:
+            raise click.UsageError("--profile flight: one sensor, no --table-rate")
+        _simulate_flight(preset, duration, rate, seed, latitude_deg, height_m, out_path, as_json)
+        return
     # one file per sensor: the count ends each multi-sensor name (cube6 → 6)
     n_files = 1 if _SENSORS[sensors] is None else int(sensors.lstrip("abcdefghijklmnopqrstuvwxyz"))
     check_outputs([preset], {"--out": _outputs(out_path, n_files)})
@@ -149,6 +156,78 @@ def command(
         click.echo(
             f"wrote {len(paths)} file(s) ({logs[0].n} samples, {logs[0].duration:.1f} s, preset "
             f"{model.name}, profile {profile}): {', '.join(str(p) for p in paths)}"
+        )
+
+
+def _simulate_flight(
+    preset: str,
+    duration: float | None,
+    rate: float,
+    seed: int,
+    latitude_deg: float,
+    height_m: float,
+    out_path: Path,
+    as_json: bool,
+) -> None:
+    """``--profile flight``: OUT holds gyro, accel, temp, mx/my/mz and truth_* (lat, lon deg;
+    alt m; vel m/s NED; euler deg; gyro/accel bias); OUT_gnss.csv the GNSS fixes."""
+    import dataclasses
+
+    import numpy as np
+
+    from uasnav.atomicfile import output_set
+    from uasnav.io import write_log
+    from uasnav.io.gnss_csv import write_gnss_csv
+    from uasnav.sim import load_preset
+    from uasnav.sim.flight import simulate_flight
+
+    gnss_path = out_path.with_name(f"{out_path.stem}_gnss.csv")
+    check_outputs([preset], {"--out": [out_path, gnss_path]})
+    model = load_preset(preset)
+    if not -80.0 <= latitude_deg <= 80.0:
+        raise click.BadParameter(
+            f"--profile flight needs |latitude| <= 80, got {latitude_deg}", param_hint="--latitude"
+        )
+    f = simulate_flight(
+        duration_s=duration,
+        rate_hz=rate,
+        seed=seed,
+        latitude_deg=latitude_deg,
+        height_m=height_m,
+        preset=model,
+    )
+    tr = f.truth
+    assert tr is not None and tr.vel is not None and tr.euler_deg is not None and f.mag is not None
+    t = f.imu.t
+    mag = np.column_stack([np.interp(t, f.mag.t, f.mag.field[:, i]) for i in range(3)])
+    truth = {
+        "lat": tr.lat,
+        "lon": tr.lon,
+        "alt": tr.alt,
+        "vel": tr.vel,
+        "euler_deg": tr.euler_deg,
+        "gyro_bias": tr.extra["gyro_bias"],
+        "accel_bias": tr.extra["accel_bias"],
+    }
+    log = dataclasses.replace(f.imu, mag=mag, truth=truth)
+    with output_set():  # the IMU log and the GNSS file, or neither
+        write_log(log, out_path)
+        write_gnss_csv(gnss_path, f.gnss)
+    summary = {
+        "preset": model.name,
+        "profile": "flight",
+        "rate_hz": rate,
+        "seed": seed,
+        "samples": log.n,
+        "duration_s": log.duration,
+        "gnss_fixes": f.gnss.n,
+        "files": [str(out_path), str(gnss_path)],
+    }
+    if as_json:
+        echo_json(summary)
+    else:
+        click.echo(
+            f"wrote a simulated flight ({log.n} samples, {log.duration:.1f} s): {out_path}, {gnss_path}"
         )
 
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -175,3 +176,155 @@ def read_tlog_flight(path: str | os.PathLike[str]) -> FlightLog:
 
 
 __all__ = ["IMU_TYPES", "read_tlog", "read_tlog_flight"]
+
+
+def read_tlog_nav(path: str | os.PathLike[str]) -> Any:
+    """Navigation data of a MAVLink log as a :class:`~uasnav.io.navdata.Flight`: the IMU from
+    ``SCALED_IMU`` (else ``RAW_IMU``, ArduPilot scaling: mg, mrad/s), ``GPS_RAW_INT`` (fixes
+    with ``fix_type`` ≥ 3; ``h_acc``/``v_acc``/``vel_acc`` when sent, else σ from ``eph``),
+    ``SCALED_PRESSURE`` (ISA pressure altitude), the IMU's magnetometer, and the reference from
+    ``GLOBAL_POSITION_INT`` and ``ATTITUDE``. All on the log's wall clock (the time stamp the
+    ground station wrote on arrival: telemetry jitter of tens of ms is part of the data).
+    Telemetry IMU streams are typically 10–50 Hz: say so where it limits accuracy.
+
+    Raises
+    ------
+    DataFormatError
+        No IMU message, no GPS_RAW_INT, or fewer than 2 3-D fixes.
+    """
+    from uasnav.io.alfa import isa_pressure_altitude
+    from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
+
+    p = Path(path)
+    imu_rows: dict[str, list[tuple[float, ...]]] = {"SCALED_IMU": [], "RAW_IMU": []}
+    gps: list[tuple[float, ...]] = []
+    baro: list[tuple[float, float]] = []
+    ref: list[tuple[float, ...]] = []
+    att: list[tuple[float, ...]] = []
+    types = ("SCALED_IMU", "RAW_IMU", "GPS_RAW_INT", "SCALED_PRESSURE", "GLOBAL_POSITION_INT", "ATTITUDE")
+    with reading(p, dialect="ardupilotmega") as (conn, decoder):
+        for m in messages(conn, types, p, "MAVLink"):
+            kind = m.get_type()
+            ts = float(m._timestamp)
+            if kind in imu_rows:
+                imu_rows[kind].append(
+                    (
+                        ts,
+                        m.xgyro * 1e-3,
+                        m.ygyro * 1e-3,
+                        m.zgyro * 1e-3,
+                        m.xacc * 1e-3 * STANDARD_GRAVITY,
+                        m.yacc * 1e-3 * STANDARD_GRAVITY,
+                        m.zacc * 1e-3 * STANDARD_GRAVITY,
+                        m.xmag * 1e-1,
+                        m.ymag * 1e-1,
+                        m.zmag * 1e-1,
+                    )
+                )
+            elif kind == "GPS_RAW_INT" and m.fix_type >= 3:
+                h_acc = getattr(m, "h_acc", 0) * 1e-3 or max(m.eph * 1e-2, 0.5) * 1.5
+                v_acc = getattr(m, "v_acc", 0) * 1e-3 or 1.5 * h_acc
+                s_acc = getattr(m, "vel_acc", 0) * 1e-3 or 0.3
+                alt = getattr(m, "alt_ellipsoid", 0) or m.alt
+                cog = np.radians(m.cog * 1e-2)
+                gps.append(
+                    (
+                        ts,
+                        m.lat * 1e-7,
+                        m.lon * 1e-7,
+                        alt * 1e-3,
+                        m.vel * 1e-2 * np.cos(cog),
+                        m.vel * 1e-2 * np.sin(cog),
+                        0.0,
+                        h_acc,
+                        v_acc,
+                        s_acc,
+                    )
+                )
+            elif kind == "SCALED_PRESSURE":
+                baro.append((ts, float(m.press_abs) * 100.0))
+            elif kind == "GLOBAL_POSITION_INT":
+                ref.append(
+                    (ts, m.lat * 1e-7, m.lon * 1e-7, m.alt * 1e-3, m.vx * 0.01, m.vy * 0.01, m.vz * 0.01)
+                )
+            elif kind == "ATTITUDE":
+                att.append((ts, np.degrees(m.roll), np.degrees(m.pitch), np.degrees(m.yaw)))
+    key = "SCALED_IMU" if len(imu_rows["SCALED_IMU"]) >= 2 else "RAW_IMU"
+    if len(imu_rows[key]) < 2:
+        raise DataFormatError(
+            f"no SCALED_IMU/RAW_IMU messages{because(decoder)}", path=str(p), column="SCALED_IMU"
+        )
+    if len(gps) < 2:
+        raise DataFormatError(
+            f"fewer than 2 GPS_RAW_INT fixes with fix_type >= 3{because(decoder)}",
+            path=str(p),
+            column="GPS_RAW_INT",
+        )
+
+    def increasing(a: np.ndarray) -> np.ndarray:
+        keep = np.zeros(a.shape[0], dtype=bool)
+        last = -np.inf
+        for i, x in enumerate(a[:, 0]):
+            if x > last:
+                keep[i], last = True, x
+        return a[keep]
+
+    a = increasing(np.asarray(imu_rows[key], dtype=np.float64))
+    g = increasing(np.asarray(gps, dtype=np.float64))
+    t0 = float(a[0, 0])
+    imu = ImuLog(
+        a[:, 0] - t0,
+        a[:, 1:4],
+        a[:, 4:7],
+        meta={"source": str(p), "format": "mavlink-tlog", "message": key, "frame": "FRD"},
+    )
+    mag_ok = np.linalg.norm(a[:, 7:10], axis=1) > 0
+    mag = MagData(a[mag_ok, 0] - t0, a[mag_ok, 7:10]) if mag_ok.sum() >= 2 else None
+    # GPS_RAW_INT has no vertical velocity: derive it from the fixes' height.
+    g[:, 6] = -np.gradient(g[:, 3], g[:, 0]) if g.shape[0] >= 2 else 0.0
+    gnss = GnssData(g[:, 0] - t0, g[:, 1], g[:, 2], g[:, 3], g[:, 4:7], g[:, 7], g[:, 8], g[:, 9])
+    b = increasing(np.asarray(baro, dtype=np.float64)) if len(baro) >= 2 else None
+    baro_d = BaroData(b[:, 0] - t0, isa_pressure_altitude(b[:, 1])) if b is not None else None
+    reference = None
+    if len(ref) >= 2:
+        r = increasing(np.asarray(ref, dtype=np.float64))
+        eul = None
+        if len(att) >= 2:
+            at = increasing(np.asarray(att, dtype=np.float64))
+            eul = np.column_stack(
+                [np.interp(r[:, 0], at[:, 0], at[:, i]) for i in (1, 2)]
+                + [
+                    np.degrees(
+                        np.arctan2(
+                            np.interp(r[:, 0], at[:, 0], np.sin(np.radians(at[:, 3]))),
+                            np.interp(r[:, 0], at[:, 0], np.cos(np.radians(at[:, 3]))),
+                        )
+                    )
+                ]
+            )
+        reference = Trajectory(
+            r[:, 0] - t0,
+            r[:, 1],
+            r[:, 2],
+            r[:, 3],
+            r[:, 4:7],
+            eul,
+            name="ArduPilot GLOBAL_POSITION_INT + ATTITUDE",
+            alt_datum="amsl",
+        )
+    return Flight(
+        imu,
+        gnss,
+        baro_d,
+        mag,
+        reference=reference,
+        imus={key: imu},
+        meta={
+            "source": str(p),
+            "format": "mavlink-tlog",
+            "imu": key,
+            "t0_wall_s": t0,
+            "note": f"telemetry IMU at {imu.sample_rate:.1f} Hz on arrival time stamps: "
+            "it limits the accuracy",
+        },
+    )

@@ -1,35 +1,19 @@
 //! The filter kernel: strapdown mechanisation, block-structured covariance propagation, the
 //! nine-measurement ZUPT update in Joseph form, feedback and reset; and the batch runner.
-use nalgebra::{Matrix3, Quaternion, SMatrix, SVector, UnitQuaternion, Vector3};
+use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
 use super::slope::SlopeEstimator;
 use super::{
-    BiasTemperatureDerivative, Discretisation, HeadingSource, Levelling, Mode, ZuptConfig, N_MEAS,
-    N_STATES,
+    BiasTemperatureDerivative, HeadingSource, Levelling, Mode, ZuptConfig, N_MEAS, N_STATES,
 };
 use crate::attitude::{quat_from_rotation_vector, quat_to_array, quat_to_dcm};
 use crate::earth;
 use crate::scalar::lit;
+use crate::strapdown::{self, ErrorDynamics};
 use crate::{NavError, Real};
 
 type Mat15<T> = SMatrix<T, N_STATES, N_STATES>;
 type Vec9<T> = SVector<T, N_MEAS>;
-
-/// `[v×]`, the cross-product matrix.
-#[inline(always)]
-pub(super) fn skew<T: Real>(v: &Vector3<T>) -> Matrix3<T> {
-    Matrix3::new(
-        T::zero(),
-        -v.z,
-        v.y,
-        v.z,
-        T::zero(),
-        -v.x,
-        -v.y,
-        v.x,
-        T::zero(),
-    )
-}
 
 #[inline(always)]
 fn finite3<T: Real>(what: &'static str, index: usize, v: &[T; 3]) -> Result<(), NavError> {
@@ -37,57 +21,6 @@ fn finite3<T: Real>(what: &'static str, index: usize, v: &[T; 3]) -> Result<(), 
         Ok(())
     } else {
         Err(NavError::NonFinite { what, index })
-    }
-}
-
-/// The non-identity block rows of `Φ = I + F·Ts` (δv and ψ rows; δr rows are `I, Ts·I`),
-/// stored column-major as nalgebra converts them (`[column][row]`).
-struct PhiBlocks<T> {
-    dt: T,
-    /// `(2g/r)·Ts` on the δv_D ← δr_D entry.
-    dd: T,
-    vv: [[T; 3]; 3],
-    vp: [[T; 3]; 3],
-    vb: [[T; 3]; 3],
-    pp: [[T; 3]; 3],
-}
-
-impl<T: Real> PhiBlocks<T> {
-    /// `(Φ·S)[0..9, :]` for a 15×L matrix `S` given by its rows `src[k]` (the bias rows of
-    /// `Φ·S` equal those of `S`). Each output row is a few AXPYs over contiguous length-L
-    /// rows, which the compiler vectorises.
-    #[inline(always)]
-    fn rows<const L: usize>(&self, src: &[[T; L]; N_STATES]) -> [[T; L]; 9] {
-        let mut out = [[T::zero(); L]; 9];
-        for i in 0..3 {
-            for l in 0..L {
-                out[i][l] = src[i][l] + self.dt * src[3 + i][l];
-            }
-            let mut v = src[3 + i];
-            let mut p = src[6 + i];
-            for k in 0..3 {
-                // [k][i] is row i, column k of the block (column-major storage).
-                let c = self.vb[k][i];
-                for l in 0..L {
-                    v[l] += c * src[9 + k][l];
-                    p[l] += c * src[12 + k][l];
-                }
-                // vv, vp and pp are skew-symmetric: their diagonal is zero.
-                if k != i {
-                    let (a, b, d) = (self.vv[k][i], self.vp[k][i], self.pp[k][i]);
-                    for l in 0..L {
-                        v[l] += a * src[3 + k][l] + b * src[6 + k][l];
-                        p[l] += d * src[6 + k][l];
-                    }
-                }
-            }
-            out[3 + i] = v;
-            out[6 + i] = p;
-        }
-        for l in 0..L {
-            out[5][l] += self.dd * src[2][l];
-        }
-        out
     }
 }
 
@@ -287,25 +220,7 @@ impl<T: Real> ZuptFilter<T> {
         let f_hat = Vector3::from(*accel_m_s2) - self.ba;
         let c = quat_to_dcm(&self.q);
         // Attitude: body rotation on the right, Earth rotation of the NED frame on the left.
-        let phi = w_hat * dt;
-        let n2 = phi.norm_squared();
-        let q_body = if n2 < lit(1e-8) {
-            // exp(φ/2) to 4th order: the truncation (|φ|⁶/46080 < 3e-29) is below f64
-            // resolution, and the product is renormalised below.
-            let k = lit::<T>(0.5) - n2 / lit(48.0);
-            Quaternion::new(
-                T::one() - n2 / lit(8.0) + n2 * n2 / lit(384.0),
-                phi.x * k,
-                phi.y * k,
-                phi.z * k,
-            )
-        } else {
-            quat_from_rotation_vector(&phi).into_inner()
-        };
-        let q = self.q_earth.into_inner() * self.q.into_inner() * q_body;
-        // One Newton step towards |q| = 1 (|q|² − 1 is O(1e-16) here): no sqrt, no division.
-        let s = (lit::<T>(3.0) - q.norm_squared()) * lit::<T>(0.5);
-        self.q = UnitQuaternion::new_unchecked(q * s);
+        self.q = strapdown::attitude_step(&self.q, &w_hat, dt, self.q_earth.quaternion());
         let f_n = c * f_hat;
         let g = self.g0 + self.grav_grad * self.pos.z;
         let acc = f_n + Vector3::new(T::zero(), T::zero(), g)
@@ -316,7 +231,21 @@ impl<T: Real> ZuptFilter<T> {
         // Eq. 31 (F_g = 0): deterministic thermal drift of the bias.
         self.bg += dbias_dt_rad_s2 * dt;
 
-        self.propagate_covariance(&c, &f_n);
+        let dynamics = ErrorDynamics {
+            dt,
+            c,
+            f_n,
+            // At rest: no transport rate, so ω_v = 2ω_ie and ω_ψ = ω_ie.
+            w_v: self.w_ie * lit::<T>(2.0),
+            w_psi: self.w_ie,
+            grav_grad: self.grav_grad,
+        };
+        strapdown::propagate_covariance(
+            &mut self.p,
+            &dynamics,
+            self.cfg.discretisation,
+            &self.gamma,
+        );
         self.index += 1;
         self.check_health()
     }
@@ -334,89 +263,12 @@ impl<T: Real> ZuptFilter<T> {
                 index: self.index,
             });
         }
-        let (mut trace, mut negative) = (T::zero(), false);
-        for i in 0..N_STATES {
-            let d = self.p[(i, i)];
-            trace += d;
-            negative |= d < T::zero();
-        }
-        if negative || !num_traits::Float::is_finite(trace) {
+        if !strapdown::covariance_healthy(&self.p) {
             return Err(NavError::NotPositiveDefinite {
                 what: "state covariance P",
             });
         }
         Ok(())
-    }
-
-    /// `P ← Φ·P·Φᵀ + Γ`.
-    // Index loops mirror the block algebra (row i, column j) and unroll fully.
-    #[allow(clippy::needless_range_loop)]
-    fn propagate_covariance(&mut self, c: &Matrix3<T>, f_n: &Vector3<T>) {
-        let dt = self.dt;
-        let w = skew(&self.w_ie);
-        let a_vv = w * (lit::<T>(-2.0) * dt);
-        let a_vp = skew(f_n) * (-dt);
-        let a_vb = c * (-dt);
-        let a_pp = w * (-dt);
-        let a_dd = self.grav_grad * dt;
-        match self.cfg.discretisation {
-            Discretisation::FirstOrder => {
-                // Only the δr, δv and ψ block rows of Φ differ from I, so P⁻ = Φ·P·Φᵀ needs
-                // only (Φ·x)[0..9] of 15-vectors x: first for the 15 columns of P (giving
-                // M = (Φ·P)[0..9, :]), then for the 9 rows of M (giving P⁻[0..9, 0..9]); the
-                // bias blocks are P⁻[0..9, 9..] = M[:, 9..] and P⁻[9.., 9..] = P[9.., 9..].
-                // Plain scalar loops over fixed arrays: the compiler unrolls them fully.
-                let blocks = PhiBlocks {
-                    dt,
-                    dd: a_dd,
-                    vv: a_vv.into(),
-                    vp: a_vp.into(),
-                    vb: a_vb.into(),
-                    pp: a_pp.into(),
-                };
-                // P is symmetric, so its column-major columns are also its rows.
-                let m = blocks.rows(&self.p.data.0); // M = (Φ·P)[0..9, :], row-major
-                let mut mt = [[T::zero(); 9]; N_STATES]; // Mᵀ
-                for (i, row) in m.iter().enumerate() {
-                    for (j, v) in row.iter().enumerate() {
-                        mt[j][i] = *v;
-                    }
-                }
-                // (Φ·Mᵀ)[0..9, :] = (M·Φᵀ)ᵀ[0..9, 0..9] = P⁻[0..9, 0..9] (symmetric).
-                let n = blocks.rows(&mt);
-                let cols = &mut self.p.data.0;
-                for (a, row) in n.iter().enumerate() {
-                    cols[a][..9].copy_from_slice(row);
-                }
-                for j in 9..N_STATES {
-                    cols[j][..9].copy_from_slice(&mt[j]);
-                    for i in 0..9 {
-                        cols[i][j] = mt[j][i];
-                    }
-                }
-            }
-            Discretisation::SecondOrder => {
-                let mut f = Mat15::<T>::zeros();
-                let eye3 = Matrix3::<T>::identity();
-                f.fixed_view_mut::<3, 3>(0, 3).copy_from(&eye3);
-                f[(5, 2)] = self.grav_grad;
-                f.fixed_view_mut::<3, 3>(3, 3)
-                    .copy_from(&(w * lit::<T>(-2.0)));
-                f.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(f_n)));
-                f.fixed_view_mut::<3, 3>(3, 9).copy_from(&(-c));
-                f.fixed_view_mut::<3, 3>(6, 6).copy_from(&(-w));
-                f.fixed_view_mut::<3, 3>(6, 12).copy_from(&(-c));
-                let ft = f * dt;
-                let phi = Mat15::<T>::identity() + ft + ft * ft * lit::<T>(0.5);
-                self.p = phi * self.p * phi.transpose();
-            }
-        }
-        for (grp, var) in self.gamma.iter().enumerate() {
-            for i in 0..3 {
-                let k = 3 * (grp + 1) + i;
-                self.p[(k, k)] += *var;
-            }
-        }
     }
 
     /// The ZUPT measurement update (eqs. 19–21): frozen position, zero velocity, frozen
@@ -470,9 +322,7 @@ impl<T: Real> ZuptFilter<T> {
         self.pos -= dx.fixed_rows::<3>(0);
         self.vel -= dx.fixed_rows::<3>(3);
         let dpsi: Vector3<T> = dx.fixed_rows::<3>(6).into_owned();
-        self.q = UnitQuaternion::new_normalize(
-            quat_from_rotation_vector(&(-dpsi)).into_inner() * self.q.into_inner(),
-        );
+        self.q = strapdown::correct_attitude(&self.q, &dpsi);
         self.ba -= dx.fixed_rows::<3>(9);
         self.bg -= dx.fixed_rows::<3>(12);
         self.n_updates += 1;

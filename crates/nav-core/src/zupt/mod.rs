@@ -2,6 +2,9 @@
 //! filter of the thesis (§4.2.2.2, eqs. 8–25; §4.2.3.2, eqs. 29–31).
 //!
 //! # Model
+//! The mechanisation and the error-state kernel are shared with the GNSS/INS filter
+//! ([`crate::strapdown`]); here the unit is at rest, so the transport rate is zero.
+//!
 //! An error-state (closed-loop) Kalman filter runs beside a strapdown navigation solution in
 //! the local-level NED frame (Earth rate and WGS-84 normal gravity, [`crate::earth`]). The
 //! error state (eq. 8) is
@@ -58,9 +61,9 @@ mod filter;
 mod init;
 mod slope;
 
-pub use detect::{detect_static, StationarityConfig, StationarityDetector, DETECT_CAPACITY};
 #[cfg(test)]
-use filter::skew as filter_test_skew;
+use crate::strapdown::skew as filter_test_skew;
+pub use detect::{detect_static, StationarityConfig, StationarityDetector, DETECT_CAPACITY};
 pub use filter::{BatchInput, BatchOutput, BatchSummary, ZuptFilter};
 pub use init::{HeadingSource, Levelling};
 pub use slope::{SlopeEstimator, SLOPE_CAPACITY};
@@ -70,7 +73,7 @@ use crate::{NavError, Real};
 use nalgebra::Vector3;
 
 /// Number of error states (eq. 8).
-pub const N_STATES: usize = 15;
+pub const N_STATES: usize = crate::strapdown::N_STATES;
 /// Number of ZUPT measurements (position, velocity, attitude).
 pub const N_MEAS: usize = 9;
 
@@ -85,15 +88,7 @@ pub enum Mode {
     Tczupt,
 }
 
-/// Discretisation of the transition matrix.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Discretisation {
-    /// `Φ = I + F·Ts` (eq. 16), propagated with block-sparse products (fast path).
-    #[default]
-    FirstOrder,
-    /// `Φ = I + F·Ts + (F·Ts)²/2`, propagated with dense 15×15 products (reference path).
-    SecondOrder,
-}
+pub use crate::strapdown::Discretisation;
 
 /// The four process-noise parameters of eqs. (22)–(25), SI units in the field names (same
 /// fields as the Python `uasnav.noise.FilterNoise`).

@@ -1,0 +1,274 @@
+"""``uasnav nav``: replay a flight log through the GNSS/INS filter."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import click
+
+from uasnav.cli._common import FINITE, POSITIVE, OutputPath, check_outputs, echo_json
+
+
+def _outages(values: tuple[str, ...]) -> tuple[tuple[float, float], ...]:
+    out = []
+    for v in values:
+        try:
+            a, b = v.split("+")
+            start, dur = float(a), float(b)
+        except ValueError:
+            raise click.BadParameter(
+                f"expected START+DURATION in seconds (e.g. 120+30), got {v!r}", param_hint="--gnss-outage"
+            ) from None
+        if not (math.isfinite(start) and math.isfinite(dur) and dur > 0):
+            raise click.BadParameter(
+                f"expected finite START and DURATION > 0, got {v!r}", param_hint="--gnss-outage"
+            )
+        out.append((start, dur))
+    return tuple(out)
+
+
+def _durations(text: str | None) -> list[float]:
+    if text is None:
+        return []
+    try:
+        vals = [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise click.BadParameter(
+            f"expected comma-separated seconds, got {text!r}", param_hint="--outage-sweep"
+        ) from None
+    if not vals or not all(math.isfinite(v) and v > 0 for v in vals):
+        raise click.BadParameter(f"expected durations > 0, got {text!r}", param_hint="--outage-sweep")
+    return vals
+
+
+@click.command("nav")
+@click.argument("log", type=click.Path(exists=False))
+@click.option(
+    "--gnss",
+    "gnss_path",
+    type=click.Path(dir_okay=False),
+    help="GNSS CSV (t,lat,lon,alt,vn,ve,vd,h_acc,v_acc,s_acc); required for a CSV log.",
+)
+@click.option(
+    "--imu",
+    "imu_sel",
+    default=None,
+    help="Which IMU: its index N (0-based, in the log's order) or 'fused' (redundant-IMU fusion).",
+)
+@click.option(
+    "--model",
+    "model_path",
+    type=click.Path(dir_okay=False),
+    help="Thermal model JSON (`uasnav calibrate`): TCZUPT in flight.",
+)
+@click.option(
+    "--gnss-outage",
+    "outages",
+    multiple=True,
+    metavar="START+DURATION",
+    help="Mask GNSS from START for DURATION seconds (log time); repeatable.",
+)
+@click.option(
+    "--outage-sweep",
+    "sweep",
+    default=None,
+    metavar="D1,D2,…",
+    help="GNSS-outage experiment: durations (s) at start times spread over the flight.",
+)
+@click.option(
+    "--start", "t_start", type=FINITE, default=None, help="Use the log from this time (s, log clock)."
+)
+@click.option(
+    "--end", "t_end", type=FINITE, default=None, help="Use the log up to this time (s), e.g. before a crash."
+)
+@click.option("--hal", "hal", type=POSITIVE, default=None, help="Horizontal alert limit (m).")
+@click.option("--val", "val", type=POSITIVE, default=None, help="Vertical alert limit (m).")
+@click.option("--out", "out_path", type=OutputPath(), help="Write TRACK.csv.")
+@click.option("--geojson", "geojson_path", type=OutputPath(), help="Write the track as GeoJSON.")
+@click.option("--kml", "kml_path", type=OutputPath(), help="Write the track as KML.")
+@click.option(
+    "--json",
+    "as_json",
+    is_flag=True,
+    help="Print the comparison with the autopilot's estimate and the outage table as JSON.",
+)
+@click.option("--plot", "plot_path", type=OutputPath(), help="Write a PNG of the track.")
+def command(
+    log: str,
+    gnss_path: str | None,
+    imu_sel: str | None,
+    model_path: str | None,
+    outages: tuple[str, ...],
+    sweep: str | None,
+    t_start: float | None,
+    t_end: float | None,
+    hal: float | None,
+    val: float | None,
+    out_path: str | None,
+    geojson_path: str | None,
+    kml_path: str | None,
+    as_json: bool,
+    plot_path: str | None,
+) -> None:
+    """Replay LOG (.ulg, .bin, .tlog, .csv with --gnss, or an ALFA ROS-topic CSV folder) through
+    the loosely coupled GNSS/INS filter, compare it with the autopilot's own estimate, and
+    optionally mask GNSS to measure dead-reckoning drift.
+
+    Logged IMU streams (DataFlash, ULog, ROS) use the logged-IMU noise preset; a CSV log uses
+    the consumer-MEMS defaults.
+    """
+    from uasnav import ins
+    from uasnav.atomicfile import output_set
+    from uasnav.errors import InputError
+    from uasnav.ins import evaluate as ev
+    from uasnav.io.navlog import read_nav
+
+    outage_list = _outages(outages)
+    durations = _durations(sweep)
+    check_outputs(
+        [log, gnss_path, model_path],
+        {"--out": out_path, "--geojson": geojson_path, "--kml": kml_path, "--plot": plot_path},
+    )
+    flight = read_nav(log, gnss_csv=gnss_path)
+    if t_start is not None or t_end is not None:
+        lo = float(flight.imu.t[0]) if t_start is None else t_start
+        hi = float(flight.imu.t[-1]) if t_end is None else t_end
+        if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
+            raise click.BadParameter(
+                f"expected finite --start < --end, got {lo!r} and {hi!r}", param_hint="--start/--end"
+            )
+        flight = flight.between(lo, hi)
+    if imu_sel is not None:
+        flight = _select_imu(flight, imu_sel)
+    model = None
+    if model_path is not None:
+        from uasnav.thermal import load_model
+
+        model = load_model(model_path)
+    logged = flight.meta.get("format") in ("ardupilot-dataflash", "px4-ulog", "alfa-ros-csv", "mavlink-tlog")
+    base: dict[str, Any] = {
+        "mode": "tczupt" if model is not None else "classic",
+        "model": model,
+        "hal_m": hal,
+        "val_m": val,
+    }
+    cfg = ins.InsConfig.for_logged_imu(**base) if logged else ins.InsConfig(**base)
+    result = ins.run(flight, cfg.replace(gnss_outages=outage_list))
+    report: dict[str, Any] = {
+        "log": str(log),
+        "imu": flight.meta.get("imu"),
+        "imu_rate_hz": flight.imu.sample_rate,
+        "summary": result.summary,
+        "excluded_fixes": result.excluded_fixes,
+        "alerts": result.alerts,
+        "gnss_outages": [{"start_s": s, "duration_s": d} for s, d in outage_list],
+    }
+    if "note" in flight.meta:
+        report["note"] = flight.meta["note"]
+    if flight.reference is not None:
+        try:
+            report["reference"] = ev.compare(result, flight.reference).as_dict()
+        except InputError as e:
+            report["reference"] = {"error": str(e)}
+    if outage_list:
+        report["outages"] = [
+            ev.outage_end_error(result, flight, s, d, imu=str(flight.meta.get("imu", ""))).__dict__
+            for s, d in outage_list
+            if s + d < flight.gnss.t[-1]
+        ]
+    if durations:
+        table = ev.outage_experiment(
+            flight, durations, config=cfg, per_duration=5, imu_name=str(flight.meta.get("imu", ""))
+        )
+        report["outage_sweep"] = {"outages": [o.__dict__ for o in table.outages], "summary": table.summary()}
+    with output_set():  # every output of the run, or none
+        if out_path:
+            result.to_csv(out_path)
+        if geojson_path:
+            result.write_geojson(geojson_path)
+        if kml_path:
+            result.to_kml(kml_path)
+        if plot_path:
+            _plot(result, flight, plot_path)
+    if as_json:
+        echo_json(report)
+        return
+    _print_text(log, flight, result, report)
+
+
+def _print_text(log: str, flight: Any, result: Any, report: dict[str, Any]) -> None:
+    s = result.summary
+    click.echo(
+        f"{log}: {flight.imu.n} IMU samples at {flight.imu.sample_rate:.1f} Hz, {flight.gnss.n} GNSS fixes"
+    )
+    click.echo(
+        f"fixes used {s['fixes_used']}, excluded {s['fixes_excluded']}, masked {s['fixes_masked']}, "
+        f"resets {s['gnss_resets']}; ZUPT {s['static_updates']}, baro {s['baro_updates']}, "
+        f"alerts {s['alerts']}"
+    )
+    ref = report.get("reference")
+    if isinstance(ref, dict) and "horizontal_rms_m" in ref:
+        nan = float("nan")
+        vel = ref["velocity_rms_m_s"] if ref["velocity_rms_m_s"] is not None else nan
+        rp = ref["roll_pitch_rms_deg"] if ref["roll_pitch_rms_deg"] is not None else nan
+        click.echo(
+            f"vs {ref['reference']}: horizontal RMS {ref['horizontal_rms_m']:.2f} m, "
+            f"vertical RMS {ref['vertical_rms_m']:.2f} m, velocity RMS {vel:.2f} m/s, "
+            f"roll/pitch RMS {rp:.2f}°"
+        )
+    for o in report.get("outages", []):
+        click.echo(
+            f"outage {o['start']:g}+{o['duration']:g} s: horizontal error {o['horizontal_error_m']:.1f} m, "
+            f"vertical {o['vertical_error_m']:.1f} m"
+        )
+    for d, row in report.get("outage_sweep", {}).get("summary", {}).items():
+        click.echo(
+            f"outage {d} s: {row['count']} outages, "
+            f"median horizontal error {row['median_horizontal_m']:.1f} m, "
+            f"max {row['max_horizontal_m']:.1f} m"
+        )
+
+
+def _select_imu(flight: Any, sel: str) -> Any:
+    from uasnav.errors import InputError
+
+    names = list(flight.imus)
+    if sel == "fused":
+        if len(names) < 2:
+            raise InputError(
+                f"--imu fused: the log has {len(names)} IMU ({', '.join(names)}); fusion needs at least 2"
+            )
+        from uasnav import redundancy
+
+        logs = [flight.imus[n] for n in names]
+        fused = redundancy.fuse(logs, redundancy.array_for_logs("aligned", logs)).to_log()
+        return flight.with_imu(fused, "fused(" + "+".join(names) + ")")
+    try:
+        k = int(sel)
+    except ValueError:
+        if sel in flight.imus:
+            return flight.with_imu(flight.imus[sel], sel)
+        raise InputError(
+            f"--imu: expected an index, an IMU name ({', '.join(names)}) or 'fused', got {sel!r}"
+        ) from None
+    if not 0 <= k < len(names):
+        raise InputError(
+            f"--imu {k}: the log has {len(names)} IMU(s) ({', '.join(names)}), indices 0..{len(names) - 1}"
+        )
+    return flight.with_imu(flight.imus[names[k]], names[k])
+
+
+def _plot(result: Any, flight: Any, path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from uasnav.atomicfile import atomic_open
+
+    fig, ax = plt.subplots(figsize=(6, 6))
+    result.plot(ax, reference=flight.reference)
+    with atomic_open(path, "wb") as fh:
+        fig.savefig(fh, format="png", dpi=100)
+    plt.close(fig)

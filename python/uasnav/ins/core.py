@@ -1,0 +1,571 @@
+"""Run the GNSS/INS filter over a :class:`~uasnav.io.navdata.Flight` (one FFI call, GIL released).
+
+The filter (``nav_core::ins``) is a loosely coupled 15-state error-state Kalman filter on the
+same strapdown mechanisation and error-state kernel as the ZUPT filter: WGS-84 latitude,
+longitude, height (f64), NED velocity, Earth rate and transport rate; GNSS position and
+velocity updates with their reported accuracies and the lever arm, barometric height, ZUPT/ZARU
+when static (on the ground), magnetometer or GNSS-course heading at start-up; χ² fault
+detection and exclusion of whole GNSS fixes (a loosely coupled filter cannot exclude single
+satellites), protection levels and HAL/VAL alerts (thesis §4.1.4).
+
+Integrity parameters are probabilities here and turned into the filter's thresholds with
+scipy: the per-fix and window tests use ``gate = χ²₆⁻¹(1 − p_fa)``; the non-centrality ``λ``
+solves ``F_ncχ²₆(gate; λ) = p_md`` (the largest fault missed with probability ``p_md``); the
+fault-free multipliers are ``k_H = √(−2 ln p_ir)`` (Rayleigh tail on the major-axis σ, exact
+for a circular error, conservative otherwise) and ``k_V = Φ⁻¹(1 − p_ir/2)``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from uasnav import _core
+from uasnav.atomicfile import atomic_open
+from uasnav.attitude import quat_to_euler
+from uasnav.errors import InputError
+from uasnav.io.navdata import Flight
+from uasnav.stationary import detect_static
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from uasnav.thermal.base import BiasModel
+
+FloatArray = NDArray[np.float64]
+Mode = Literal["classic", "tczupt"]
+
+#: TRACK.csv columns (SI; degrees only for lat/lon/roll/pitch/yaw).
+TRACK_COLUMNS = "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw,bgx,bgy,bgz,bax,bay,baz,hpl,vpl,gnss_used".split(",")
+#: Below this IMU rate (Hz) strapdown integration is refused: a turn of 30 °/s would rotate
+#: the body by more than 6° between samples.
+MIN_IMU_RATE_HZ = 5.0
+#: Fix status codes of the Rust filter.
+FIX_STATUS = {0: "used", 1: "excluded", 2: "excluded_window", 3: "masked", 4: "unused", 5: "reset"}
+
+
+@lru_cache(maxsize=32)
+def integrity_thresholds(p_fa: float, p_md: float, p_ir: float) -> dict[str, float]:
+    """χ² gate, non-centrality λ and fault-free multipliers (see the module docs).
+
+    Examples
+    --------
+    >>> th = integrity_thresholds(1e-5, 1e-3, 1e-7)
+    >>> round(th["gate_chi2"], 2), round(th["k_vertical"], 2)
+    (33.11, 5.33)
+    """
+    from scipy import optimize, stats
+
+    for name, p in (("p_fa", p_fa), ("p_md", p_md), ("p_ir", p_ir)):
+        if not (0.0 < p < 0.5):
+            raise InputError(f"{name}: expected a probability in (0, 0.5), got {p!r}")
+    gate = float(stats.chi2.isf(p_fa, 6))
+    lam = float(optimize.brentq(lambda lam: stats.ncx2.cdf(gate, 6, lam) - p_md, 1e-6, 1e4, xtol=1e-10))
+    return {
+        "gate_chi2": gate,
+        "lambda_undetected": lam,
+        "k_horizontal": math.sqrt(-2.0 * math.log(p_ir)),
+        "k_vertical": float(stats.norm.isf(p_ir / 2.0)),
+    }
+
+
+#: Process noise for logged IMU streams: a 50 Hz DataFlash ``IMU`` record (or a 10 Hz ROS
+#: ``imu/data_raw``) is a snapshot of the filtered rate, not an integrated increment, so
+#: integrating it leaves errors far above the sensor's noise (log171: gyro-only integration
+#: drifts 5–15° in 15 s of flight against the autopilot's EKF). The filter is told so: σ_VRW
+#: 0.5 m/s/√s, σ_ARW 0.02 rad/√s, bias random walks 1e-3 m/s²/√s and 1e-4 rad/s/√s, and an
+#: initial accelerometer-bias σ of 0.5 m/s² (the logs' static |f| is 9.1–9.6 m/s²).
+LOGGED_IMU_NOISE: dict[str, Any] = {
+    "sigma_vrw_m_s_sqrt_s": 0.5,
+    "sigma_arw_rad_sqrt_s": 0.02,
+    "sigma_abi_m_s2": 1e-3,
+    "sigma_gbi_rad_s": 1e-4,
+    "extra": {"init_std_accel_bias_m_s2": 0.5},
+}
+
+
+@dataclass(frozen=True)
+class InsConfig:
+    """Settings of :func:`run` (SI units in every name; keyword arguments stored unchanged).
+
+    Attributes
+    ----------
+    mode : {"classic", "tczupt"}
+        ``"classic"``: the gyro is calibrated with ``model`` (if given) and its bias is a random
+        walk; ``"tczupt"``: raw gyro, the bias follows ``model``'s ∂b/∂T·dT/dt (eqs. 29–31).
+    model : BiasModel or None
+        Thermal gyro-bias model (a ``uasnav calibrate`` file); required for ``"tczupt"``.
+    sigma_vrw_m_s_sqrt_s, sigma_arw_rad_sqrt_s, sigma_abi_m_s2, sigma_gbi_rad_s : float
+        IMU process noise (velocity/angle random walk, bias instabilities as random-walk PSD).
+        Defaults: a consumer MEMS IMU in flight, rotor vibration included (0.012 m/s/√s,
+        2.5e-4 rad/√s ≈ 0.86 deg/√h; bias random walks 1e-4 m/s²/√s, 1e-5 rad/s/√s), which is
+        what :func:`uasnav.sim.flight.simulate_flight` simulates.
+    lever_arm_m : tuple of 3 floats
+        GNSS antenna relative to the IMU, body frame (m).
+    gnss_outages : tuple of (start_s, duration_s)
+        GNSS masked in these intervals (log time, s): the filter dead-reckons.
+    p_fa, p_md, p_ir : float
+        False-alarm and missed-detection probabilities of the χ² tests, and the fault-free
+        integrity risk of the protection levels.
+    hal_m, val_m : float or None
+        Horizontal/vertical alert limits (m): an alert when a protection level exceeds them.
+    window_fixes : int
+        Fixes in the averaged-innovation test (1–32).
+    reset_after_exclusions : int
+        Consecutive excluded fixes after which the filter re-initialises on GNSS (0: never).
+    static_updates : bool
+        ZUPT/ZARU when the static detector fires and GNSS speed is below ``static_max_speed_m_s``
+        (on the ground: hovering is not static, and the GLRT rejects its vibration).
+    decimation : int
+        Keep one output row every ``decimation`` IMU samples.
+    extra : dict
+        Further nav-core fields by name (e.g. ``{"baro_std_m": 2.0}``).
+    """
+
+    mode: Mode = "classic"
+    model: BiasModel | None = None
+    sigma_vrw_m_s_sqrt_s: float = 0.012
+    sigma_arw_rad_sqrt_s: float = 2.5e-4
+    sigma_abi_m_s2: float = 1e-4
+    sigma_gbi_rad_s: float = 1e-5
+    lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gnss_outages: tuple[tuple[float, float], ...] = ()
+    p_fa: float = 1e-5
+    p_md: float = 1e-3
+    p_ir: float = 1e-7
+    hal_m: float | None = None
+    val_m: float | None = None
+    window_fixes: int = 10
+    reset_after_exclusions: int = 50
+    static_updates: bool = True
+    static_max_speed_m_s: float = 0.3
+    use_baro: bool = True
+    use_mag: bool = True
+    decimation: int = 1
+    discretisation: Literal["first_order", "second_order"] = "first_order"
+    extra: dict[str, float] = field(default_factory=dict)
+
+    def replace(self, **changes: Any) -> InsConfig:
+        """A copy with some fields changed."""
+        return replace(self, **changes)
+
+    @classmethod
+    def for_logged_imu(cls, **changes: Any) -> InsConfig:
+        """The configuration for real logs whose IMU stream is a low-rate snapshot
+        (:data:`LOGGED_IMU_NOISE`), with ``changes`` on top (``extra`` entries merged)."""
+        base = dict(LOGGED_IMU_NOISE)
+        extra = dict(base.pop("extra"))
+        extra.update(changes.pop("extra", {}) or {})
+        base.update(changes)
+        return cls(**base, extra=extra)
+
+    def core_dict(self) -> dict[str, float]:
+        """The nav-core configuration keys (noise, integrity thresholds, extras)."""
+        d = {
+            "sigma_vrw_m_s_sqrt_s": self.sigma_vrw_m_s_sqrt_s,
+            "sigma_arw_rad_sqrt_s": self.sigma_arw_rad_sqrt_s,
+            "sigma_abi_m_s2": self.sigma_abi_m_s2,
+            "sigma_gbi_rad_s": self.sigma_gbi_rad_s,
+        }
+        d.update(integrity_thresholds(self.p_fa, self.p_md, self.p_ir))
+        d.update({k: float(v) for k, v in self.extra.items()})
+        return d
+
+
+@dataclass
+class InsResult:
+    """Per-sample output of :func:`run` (rows every ``decimation`` IMU samples).
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Time, s.
+    lat, lon, alt : ndarray, shape (n,)
+        Degrees, degrees, ellipsoidal height m.
+    vel : ndarray, shape (n, 3)
+        NED velocity, m/s.
+    quat : ndarray, shape (n, 4)
+        Attitude body → NED, scalar first.
+    euler_deg : ndarray, shape (n, 3)
+        Roll, pitch, yaw (3-2-1), degrees.
+    gyro_bias, accel_bias : ndarray, shape (n, 3)
+        rad/s, m/s² (body).
+    std : ndarray, shape (n, 15)
+        1σ of the error states (δr m NED, δv m/s, ψ rad, δb_a, δb_g).
+    hpl, vpl : ndarray, shape (n,)
+        Protection levels, m.
+    gnss_used : ndarray of bool, shape (n,)
+        A GNSS fix was used since the previous row.
+    fix_t, fix_status, fix_nis : ndarray, shape (m,)
+        Per GNSS fix: time (s), status code (see :data:`FIX_STATUS`), NIS.
+    summary : dict
+        Counts of updates, exclusions, alerts; the thresholds used.
+    """
+
+    t: FloatArray
+    lat: FloatArray
+    lon: FloatArray
+    alt: FloatArray
+    vel: FloatArray
+    quat: FloatArray
+    euler_deg: FloatArray
+    gyro_bias: FloatArray
+    accel_bias: FloatArray
+    std: FloatArray
+    hpl: FloatArray
+    vpl: FloatArray
+    gnss_used: NDArray[np.bool_]
+    fix_t: FloatArray
+    fix_status: NDArray[np.uint8]
+    fix_nis: FloatArray
+    hal_m: float | None = None
+    val_m: float | None = None
+    summary: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def excluded_fixes(self) -> list[dict[str, Any]]:
+        """Every excluded GNSS fix: time (s), test, NIS."""
+        out = []
+        for i in np.flatnonzero((self.fix_status == 1) | (self.fix_status == 2) | (self.fix_status == 5)):
+            out.append(
+                {
+                    "t": float(self.fix_t[i]),
+                    "test": FIX_STATUS[int(self.fix_status[i])],
+                    "nis": float(self.fix_nis[i]),
+                }
+            )
+        return out
+
+    @property
+    def alert(self) -> NDArray[np.bool_]:
+        """Per row: a protection level exceeds its alert limit (HAL/VAL)."""
+        a = np.zeros(self.t.size, dtype=bool)
+        if self.hal_m is not None:
+            a |= self.hpl > self.hal_m
+        if self.val_m is not None:
+            a |= self.vpl > self.val_m
+        return a
+
+    @property
+    def alerts(self) -> list[dict[str, Any]]:
+        """Every alert interval: start and end time (s), which limits, the largest PLs."""
+        out: list[dict[str, Any]] = []
+        a = self.alert
+        if not a.any():
+            return out
+        edges = np.flatnonzero(np.diff(np.r_[0, a.astype(np.int8), 0]))
+        for i0, i1 in zip(edges[::2], edges[1::2], strict=True):
+            h = float(self.hpl[i0:i1].max())
+            v = float(self.vpl[i0:i1].max())
+            kinds = []
+            if self.hal_m is not None and h > self.hal_m:
+                kinds.append("HAL")
+            if self.val_m is not None and v > self.val_m:
+                kinds.append("VAL")
+            out.append(
+                {
+                    "t_start": float(self.t[i0]),
+                    "t_end": float(self.t[i1 - 1]),
+                    "limits": kinds,
+                    "max_hpl": h,
+                    "max_vpl": v,
+                }
+            )
+        return out
+
+    def track_table(self) -> FloatArray:
+        """The TRACK.csv rows, shape (n, 19), in :data:`TRACK_COLUMNS` order."""
+        return np.column_stack(
+            [
+                self.t,
+                self.lat,
+                self.lon,
+                self.alt,
+                self.vel,
+                self.euler_deg,
+                self.gyro_bias,
+                self.accel_bias,
+                self.hpl,
+                self.vpl,
+                self.gnss_used.astype(np.float64),
+            ]
+        )
+
+    def to_csv(self, path: str | os.PathLike[str]) -> None:
+        """Write TRACK.csv (columns :data:`TRACK_COLUMNS`, 17 significant digits), atomically."""
+        table = self.track_table()
+        with atomic_open(path, "w") as fh:
+            fh.write(",".join(TRACK_COLUMNS) + "\n")
+            for row in table:
+                fh.write(",".join(f"{x:.17g}" for x in row[:-1]) + f",{int(row[-1])}\n")
+
+    def to_geojson(self, max_points: int = 5000) -> dict[str, Any]:
+        """A GeoJSON FeatureCollection: the track as a LineString (lon, lat, alt; decimated to at
+        most ``max_points``), and a Point per excluded fix and per alert start."""
+        step = max(1, math.ceil(self.t.size / max_points))
+        idx = np.r_[np.arange(0, self.t.size, step), self.t.size - 1]
+        coords = [[float(self.lon[i]), float(self.lat[i]), float(self.alt[i])] for i in np.unique(idx)]
+        feats: list[dict[str, Any]] = [
+            {
+                "type": "Feature",
+                "geometry": {"type": "LineString", "coordinates": coords},
+                "properties": {
+                    "name": "uasnav INS track",
+                    "t_start": float(self.t[0]),
+                    "t_end": float(self.t[-1]),
+                },
+            }
+        ]
+        for ev in self.excluded_fixes:
+            i = min(int(np.searchsorted(self.t, ev["t"])), self.t.size - 1)
+            feats.append(
+                {
+                    "type": "Feature",
+                    "geometry": {"type": "Point", "coordinates": [float(self.lon[i]), float(self.lat[i])]},
+                    "properties": {"event": "excluded_fix", **ev},
+                }
+            )
+        for al in self.alerts:
+            i = int(np.searchsorted(self.t, al["t_start"]))
+            feats.append(
+                {
+                    "type": "Feature",
+                    "geometry": {"type": "Point", "coordinates": [float(self.lon[i]), float(self.lat[i])]},
+                    "properties": {"event": "alert", **al},
+                }
+            )
+        return {"type": "FeatureCollection", "features": feats}
+
+    def to_kml(self, path: str | os.PathLike[str], max_points: int = 5000) -> None:
+        """Write the track as a KML LineString (absolute altitude = ellipsoidal height)."""
+        from xml.sax.saxutils import escape
+
+        step = max(1, math.ceil(self.t.size / max_points))
+        idx = np.unique(np.r_[np.arange(0, self.t.size, step), self.t.size - 1])
+        coords = " ".join(f"{self.lon[i]:.9f},{self.lat[i]:.9f},{self.alt[i]:.3f}" for i in idx)
+        with atomic_open(path, "w") as fh:
+            fh.write(
+                '<?xml version="1.0" encoding="UTF-8"?>\n<kml xmlns="http://www.opengis.net/kml/2.2">'
+                f"<Document><name>{escape('uasnav INS track')}</name><Placemark><name>track</name>"
+                f"<LineString><altitudeMode>absolute</altitudeMode><coordinates>{coords}</coordinates>"
+                "</LineString></Placemark></Document></kml>\n"
+            )
+
+    def write_geojson(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`to_geojson` atomically."""
+        with atomic_open(path, "w") as fh:
+            json.dump(self.to_geojson(), fh)
+
+    def plot(self, ax: Axes | None = None, *, reference: Any = None) -> Axes:
+        """Plot the horizontal track (east vs north, m from the first point) with excluded
+        fixes; ``reference`` (a :class:`~uasnav.io.navdata.Trajectory`) is drawn beside it."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6, 6))
+        lat0, lon0 = math.radians(self.lat[0]), math.radians(self.lon[0])
+
+        def ne(lat: FloatArray, lon: FloatArray) -> tuple[FloatArray, FloatArray]:
+            r = 6_371_000.0
+            return (np.radians(lat) - lat0) * r, (np.radians(lon) - lon0) * r * math.cos(lat0)
+
+        n, e = ne(self.lat, self.lon)
+        ax.plot(e, n, lw=1.2, label="uasnav INS")
+        if reference is not None:
+            rn, re = ne(reference.lat, reference.lon)
+            ax.plot(re, rn, lw=0.8, ls="--", label=reference.name)
+        for ev in self.excluded_fixes:
+            i = min(int(np.searchsorted(self.t, ev["t"])), self.t.size - 1)
+            ax.plot(e[i], n[i], "rx")
+        ax.set_xlabel("east (m)")
+        ax.set_ylabel("north (m)")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.legend(loc="best")
+        return ax
+
+
+def _static_mask(flight: Flight, cfg: InsConfig) -> NDArray[np.bool_] | None:
+    if not cfg.static_updates:
+        return None
+    imu = flight.imu
+    rate = imu.sample_rate
+    # The GLRT with the noise, gyro bias and |g| of the first two seconds — the levelling
+    # window, which the filter assumes static anyway — instead of a noise-estimation pass over
+    # the whole log (0.13 s per 10⁵ samples).
+    k = min(imu.n, max(10, round(2.0 * rate)))
+    a0, g0 = imu.accel[:k], imu.gyro[:k]
+    try:
+        det = detect_static(
+            imu,
+            window_samples=max(3, round(0.2 * rate)),
+            sigma_a=max(float(np.mean(np.std(a0, axis=0))), 1e-3),
+            sigma_g=max(float(np.mean(np.std(g0, axis=0))), 1e-5),
+            gyro_bias=g0.mean(axis=0),
+            gravity=float(np.linalg.norm(a0.mean(axis=0))),
+        )
+    except InputError:
+        return None
+    mask = det.mask.copy()
+    g = flight.gnss
+    speed = np.linalg.norm(g.vel, axis=1)
+    # The nearest earlier fix must be slow too (a detector alone can fire in smooth cruise).
+    j = np.clip(np.searchsorted(g.t, imu.t, side="right") - 1, 0, g.n - 1)
+    mask &= speed[j] < cfg.static_max_speed_m_s + 3.0 * g.s_acc[j]
+    return np.ascontiguousarray(mask)
+
+
+def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
+    """Run the GNSS/INS filter over a whole flight.
+
+    The IMU is cut to start at the first GNSS fix (the filter initialises its position and
+    velocity there); GNSS fixes inside ``config.gnss_outages`` are masked.
+
+    Parameters
+    ----------
+    flight : Flight
+        IMU (gyro rad/s, accel m/s², optional temp °C), GNSS, optional baro and magnetometer.
+    config : InsConfig, optional
+        Filter settings (defaults: classic filter, consumer MEMS noise).
+
+    Returns
+    -------
+    InsResult
+
+    Raises
+    ------
+    InputError
+        Bad input (no GNSS fix inside the IMU span, TCZUPT without a model or a temperature,
+        non-monotonic time …), naming what.
+    NumericalError
+        The covariance stopped being positive definite.
+    """
+    cfg = InsConfig() if config is None else config
+    if not isinstance(flight, Flight):
+        raise InputError(f"flight: expected a uasnav.ins.Flight, got {type(flight).__name__}")
+    if cfg.mode not in ("classic", "tczupt"):
+        raise InputError(f"mode: expected 'classic' or 'tczupt', got {cfg.mode!r}")
+    g = flight.gnss
+    imu = flight.imu
+    t_start = max(float(g.t[0]), float(imu.t[0]))
+    if t_start > imu.t[-1]:
+        raise InputError(
+            f"gnss: the first fix ({g.t[0]:.3f} s) is after the IMU's last sample ({imu.t[-1]:.3f} s)"
+        )
+    use = np.ones(g.n, dtype=bool)
+    for start, dur in cfg.gnss_outages:
+        if not (math.isfinite(start) and math.isfinite(dur) and dur > 0):
+            raise InputError(f"gnss_outages: expected (start_s, duration_s > 0), got ({start!r}, {dur!r})")
+        use &= ~((g.t >= start) & (g.t < start + dur))
+    # Start at the first usable fix.
+    usable_t = g.t[use]
+    if usable_t.size == 0:
+        raise InputError("gnss: every fix is masked by the outages")
+    t_start = max(t_start, float(usable_t[0]))
+    if t_start > imu.t[0]:
+        imu = imu.between(t_start, float(imu.t[-1]))
+        flight = flight.with_imu(imu, flight.meta.get("imu"))
+    rate = imu.sample_rate
+    if rate < MIN_IMU_RATE_HZ:
+        raise InputError(
+            f"IMU rate {rate:.2f} Hz is too low for strapdown navigation (need >= {MIN_IMU_RATE_HZ:g} Hz; "
+            "a telemetry log's IMU stream is often decimated: use the on-board log)"
+        )
+    temp = imu.temp
+    gyro = imu.gyro
+    dbias = None
+    model = cfg.model
+    if cfg.mode == "tczupt":
+        if model is None:
+            raise InputError("mode 'tczupt' needs a thermal model (model=…, a `uasnav calibrate` file)")
+        if temp is None:
+            raise InputError("mode 'tczupt' needs the IMU die temperature (the log has no temp)")
+        dbias = np.ascontiguousarray(np.asarray(model.derivative(temp), dtype=np.float64))
+        if dbias.shape != (imu.n, 3) or not np.isfinite(dbias).all():
+            raise InputError(f"model.derivative(temp): expected finite shape ({imu.n}, 3), got {dbias.shape}")
+        gyro0 = np.asarray(model.predict(temp[:1]), dtype=np.float64).reshape(3)
+    elif model is not None:
+        if temp is None:
+            raise InputError("a thermal model needs the IMU die temperature (the log has no temp)")
+        gyro = gyro - np.asarray(model.predict(temp), dtype=np.float64)
+        gyro0 = np.zeros(3)
+    else:
+        gyro0 = np.zeros(3)
+    stationary = _static_mask(flight, cfg)
+    baro = flight.baro if cfg.use_baro else None
+    mag = flight.mag if cfg.use_mag else None
+    llh = np.ascontiguousarray(np.column_stack([np.radians(g.lat), np.radians(g.lon), g.alt]))
+    acc = np.ascontiguousarray(np.column_stack([g.h_acc, g.v_acc, g.s_acc]))
+    c = np.ascontiguousarray
+    out = _core.ins_run(
+        c(imu.t),
+        c(gyro),
+        c(imu.accel),
+        c(g.t),
+        llh,
+        c(g.vel),
+        acc,
+        gnss_use=use,
+        baro_t=None if baro is None else c(baro.t),
+        baro_h=None if baro is None else c(baro.alt),
+        mag_t=None if mag is None else c(mag.t),
+        mag=None if mag is None else c(mag.field),
+        temp=c(temp) if cfg.mode == "tczupt" and temp is not None else None,
+        dbias_dtemp=dbias,
+        stationary=stationary,
+        levelling_samples=max(1, round(min(2.0, imu.duration / 4) * rate)),
+        gyro_bias0=list(gyro0),
+        mode=cfg.mode,
+        discretisation=cfg.discretisation,
+        config=cfg.core_dict(),
+        lever_arm=list(cfg.lever_arm_m),
+        window_fixes=cfg.window_fixes,
+        reset_after_exclusions=cfg.reset_after_exclusions,
+        decimation=cfg.decimation,
+    )
+    t = imu.t[:: cfg.decimation]
+    quat = out["attitude"]
+    euler = np.degrees(quat_to_euler(quat))
+    status = out["fix_status"]
+    res = InsResult(
+        t=t,
+        lat=np.degrees(out["llh"][:, 0]),
+        lon=np.degrees(out["llh"][:, 1]),
+        alt=out["llh"][:, 2].copy(),
+        vel=out["vel"],
+        quat=quat,
+        euler_deg=euler,
+        gyro_bias=out["gyro_bias"],
+        accel_bias=out["accel_bias"],
+        std=np.sqrt(np.maximum(out["cov_diag"], 0.0)),
+        hpl=out["protection"][:, 0].copy(),
+        vpl=out["protection"][:, 1].copy(),
+        gnss_used=out["gnss_used"],
+        fix_t=g.t,
+        fix_status=status,
+        fix_nis=out["fix_nis"],
+        hal_m=cfg.hal_m,
+        val_m=cfg.val_m,
+    )
+    res.summary = {
+        "mode": cfg.mode,
+        "imu_rate_hz": rate,
+        "fixes_used": int(out["fixes_used"]),
+        "fixes_excluded": int(out["fixes_excluded"]),
+        "fixes_masked": int((status == 3).sum()),
+        "static_updates": int(out["static_updates"]),
+        "baro_updates": int(out["baro_updates"]),
+        "mag_updates": int(out["mag_updates"]),
+        "course_reset": bool(out["course_reset"]),
+        "imu_gaps": int(out["imu_gaps"]),
+        "gnss_resets": int(out["gnss_resets"]),
+        "alerts": len(res.alerts),
+        "thresholds": integrity_thresholds(cfg.p_fa, cfg.p_md, cfg.p_ir),
+    }
+    return res
