@@ -183,16 +183,26 @@ def elements(sources, out, scheduler, scheduler_file, workers, resume, as_json, 
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--duration", type=POSITIVE, default=120.0, show_default=True, help="Length of each log (s).")
 @click.option("--rate", type=POSITIVE, default=100.0, show_default=True, help="IMU sample rate (Hz).")
+@click.option(
+    "--nav-flights",
+    type=click.IntRange(0, 100),
+    default=0,
+    show_default=True,
+    help="GNSS/INS flights per vehicle (IMU CSV v1 + GNSS CSV + .tlog with the mission).",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the fleet's truth as JSON.")
-def simulate(vehicles, flights, out, seed, duration, rate, as_json):  # type: ignore[no-untyped-def]
-    """Write a synthetic fleet: N vehicles × M flights (CSV v1), a few faulty IMUs and corrupt files."""
+def simulate(vehicles, flights, out, seed, duration, rate, nav_flights, as_json):  # type: ignore[no-untyped-def]
+    """Write a synthetic fleet: N vehicles × M flights (CSV v1), a few faulty IMUs and corrupt files;
+    with --nav-flights, missions flown in the GNSS/INS flight format."""
     from uasnav.fleet.simulate import simulate_fleet
 
     if Path(out).exists() and any(Path(out).iterdir()):
         raise InputError(f"--out {out}: exists and is not empty")
     if rate > 10_000:
         raise InputError(f"--rate {rate:g}: at most 10000 Hz")
-    fl = simulate_fleet(out, vehicles, flights, seed=seed, duration_s=duration, rate_hz=rate)
+    fl = simulate_fleet(
+        out, vehicles, flights, seed=seed, duration_s=duration, rate_hz=rate, nav_flights=nav_flights
+    )
     if as_json:
         echo_json({"out": fl.out, "files": len(fl.files), "faulty": fl.faulty, "corrupt": fl.corrupt})
     else:

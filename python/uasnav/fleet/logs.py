@@ -6,7 +6,9 @@ the flight CSV) and gathers what every analysis needs: the IMU instances as
 :class:`~uasnav.imu.ImuLog` (``read_dataflash``/``read_tlog`` give every instance, ``read_ulog``
 the primary one) and the vehicle identity written in the log (CSV v1 ``# vehicle:``,
 ``# autopilot:``, ``# start_time:`` comments; a ULog's flight-controller UUID; a ``.tlog``'s
-wall-clock time stamps; other logs' vehicle and day are ``unknown``).
+wall-clock time stamps; other logs' vehicle and day are ``unknown``). A CSV v1 log ``X.csv``
+with ``X_gnss.csv`` beside it is one log of the GNSS/INS flight format (:func:`gnss_companion`);
+a ``.tlog`` without IMU streams is telemetry only.
 """
 
 from __future__ import annotations
@@ -76,6 +78,28 @@ def csv_kind(path: str) -> str:
     return "csv-v1"
 
 
+#: Suffix of the GNSS CSV that goes with a CSV v1 IMU log (``X.csv`` + ``X_gnss.csv``, the
+#: flight format of ``uasnav simulate --profile flight`` and ``uasnav nav --gnss``).
+GNSS_SUFFIX = "_gnss.csv"
+
+
+def gnss_companion(path: str) -> str | None:
+    """The GNSS CSV of the CSV IMU log ``path`` (``X_gnss.csv`` beside ``X.csv``), if it exists."""
+    p = Path(path)
+    if p.suffix.lower() != ".csv" or p.name.endswith(GNSS_SUFFIX):
+        return None
+    g = p.with_name(p.stem + GNSS_SUFFIX)
+    return str(g) if g.is_file() else None
+
+
+def is_gnss_companion(path: str) -> bool:
+    """``path`` is ``X_gnss.csv`` with an ``X.csv`` beside it (part of that log)."""
+    p = Path(path)
+    if not p.name.endswith(GNSS_SUFFIX):
+        return False
+    return p.with_name(p.name[: -len(GNSS_SUFFIX)] + ".csv").is_file()
+
+
 def format_of(path: str) -> str:
     """The format of ``path`` (see :data:`FORMATS`); InputError for an unknown extension."""
     ext = Path(path).suffix.lower()
@@ -127,7 +151,16 @@ def read_fleet_log(path: str) -> FleetLog:
     elif fmt == "ardupilot-dataflash":
         imus = io.read_dataflash(path)
     elif fmt == "mavlink-tlog":
-        imus = io.read_tlog(path)
+        try:
+            imus = io.read_tlog(path)
+        except DataFormatError as imu_error:
+            # a ground station's telemetry often streams no IMU: then it is telemetry only
+            # (like a flight CSV) if it has position fixes, else the reader's error stands
+            try:
+                io.read_flight(path)
+            except DataFormatError:
+                raise imu_error from None
+            imus = {}
     else:  # flight CSV: telemetry only
         io.read_flight(path)
         imus = {}

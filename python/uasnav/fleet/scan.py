@@ -15,7 +15,8 @@ n_imus          int32                      IMU instances
 imus            list<struct>               per IMU: ``name``, ``n_samples``, ``rate_hz``
                                            (median), ``temp_min_c``/``temp_max_c`` (null
                                            without a temperature channel)
-gnss            bool                       the log has GNSS fixes
+gnss            bool                       the log has GNSS fixes (CSV v1: its
+                                           ``X_gnss.csv``)
 mission         bool                       the log has mission waypoints
 n_waypoints     int32                      mission navigation waypoints
 =============== ========================== ====================================================
@@ -26,7 +27,7 @@ from __future__ import annotations
 import pyarrow as pa
 
 from uasnav.errors import UasnavError
-from uasnav.fleet.logs import read_fleet_log
+from uasnav.fleet.logs import gnss_companion, read_fleet_log
 from uasnav.fleet.runner import Analysis, LogRows
 
 IMU_TYPE = pa.struct(
@@ -85,6 +86,10 @@ def scan_log(path: str) -> LogRows:
             gnss = fl.t.size > 0
             waypoints = len(fl.waypoints)
             duration = max(duration, float(fl.t[-1] - fl.t[0]) if fl.t.size else 0.0)
+    elif log.format == "csv-v1" and (companion := gnss_companion(path)) is not None:
+        from uasnav.io.gnss_csv import read_gnss_csv
+
+        gnss = read_gnss_csv(companion).n > 0
     row = {
         "format": log.format,
         "vehicle_id": log.vehicle,

@@ -14,7 +14,15 @@ with :func:`uasnav.sim.simulate`:
   what the health numbers (static noise, bias, vibration, clipping) look at;
 - about 10 % of the flights (at least one) have a faulty IMU: white noise ×8 from power-on;
 - about 5 % of the files (at least one) are corrupt: a CSV cut mid-line with a stray cell, or a
-  ``.ulg`` of random bytes.
+  ``.ulg`` of random bytes;
+- with ``nav_flights`` > 0, each vehicle also flies that many missions in the GNSS/INS flight
+  format (:func:`uasnav.sim.flight.simulate_flight`, the vehicle's IMU part): ``nav_NNN.csv``
+  (CSV v1: IMU, magnetometer and ``truth_*`` columns, as ``uasnav simulate --profile flight``
+  writes it), ``nav_NNN_gnss.csv`` (the GNSS fixes) and ``nav_NNN.tlog``, the ground station's
+  telemetry (:func:`uasnav.io.tlog_write.write_tlog_flight`: position fixes from the truth at the
+  GNSS rate, the mission it flew — a per-vehicle circuit of four waypoints, flown lap after lap
+  — and the waypoint-reached events), which is what carries the plan: the flight format has
+  no mission of its own.
 
 ``fleet.json`` in the output folder is the ground truth: per file, vehicle, IMU model, noise
 factor, whether faulty or corrupt. Everything is a deterministic function of the arguments.
@@ -29,10 +37,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from uasnav.atomicfile import atomic_write_text, output_set
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog
+
+FloatArray = NDArray[np.float64]
 
 IMU_MODELS = ("lsm6dsm", "ax1")
 FAULT_NOISE_FACTOR = 8.0
@@ -114,6 +125,95 @@ def _flight_log(
     return ImuLog(t=t, gyro=gyro, accel=accel, temp=sim.temp, meta=meta)
 
 
+def _circuit(rng: np.random.Generator) -> tuple[tuple[float, float, float], ...]:
+    """A rectangle of 120–200 m × 80–140 m at 30–45 m (north, east, up from the start; m)."""
+    a, b = float(rng.uniform(120.0, 200.0)), float(rng.uniform(80.0, 140.0))
+    up = float(rng.uniform(30.0, 45.0))
+    return ((a, 0.0, up), (a, b, up + 5.0), (0.0, b, up), (0.0, 0.0, up))
+
+
+def _reached(
+    n: FloatArray,
+    e: FloatArray,
+    u: FloatArray,
+    t: FloatArray,
+    circuit: tuple[tuple[float, float, float], ...],
+) -> list[tuple[float, int]]:
+    """Waypoint-reached events: every pass of the track within 2 m of waypoint ``seq`` (1-based,
+    the closest sample of the pass), sorted by time."""
+    events = []
+    for s, (wn, we, wu) in enumerate(circuit, start=1):
+        d = np.sqrt((n - wn) ** 2 + (e - we) ** 2 + (u - wu) ** 2)
+        near = d < 2.0
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], near.astype(np.int8), [0]])))
+        for i0, i1 in zip(edges[::2], edges[1::2], strict=True):
+            k = i0 + int(np.argmin(d[i0:i1]))
+            events.append((float(t[k]), s))
+    return sorted(events)
+
+
+def _nav_flight(
+    out_p: Path, name: str, model_name: str, vehicle: int, flight: int, duration_s: float, rate_hz: float,
+    seed: int, start: dt.datetime, vehicle_id: str,
+) -> None:  # fmt: skip
+    """Write one GNSS/INS flight: ``name``.csv, ``name``_gnss.csv and ``name``.tlog (module docs)."""
+    from uasnav.io import write_csv_v1
+    from uasnav.io.gnss_csv import write_gnss_csv
+    from uasnav.io.tlog_write import write_tlog_flight
+    from uasnav.sim.flight import simulate_flight
+    from uasnav.trajectory.geometry import geodetic_to_local
+
+    rng = np.random.default_rng([seed, vehicle, flight, 15])
+    circuit = _circuit(np.random.default_rng([seed, vehicle, 15]))
+    lat0, lon0 = 45.0 + 0.01 * vehicle, 7.0 + 0.01 * flight
+    speed = 8.0
+    f = simulate_flight(
+        waypoints=circuit, duration_s=duration_s, speed_m_s=speed, rate_hz=rate_hz, latitude_deg=lat0,
+        longitude_deg=lon0, height_m=300.0, preset=model_name, seed=int(rng.integers(2**31)),
+    )  # fmt: skip
+    tr = f.truth
+    assert tr is not None and tr.vel is not None and tr.euler_deg is not None and f.mag is not None
+    t = f.imu.t
+    mag = np.column_stack([np.interp(t, f.mag.t, f.mag.field[:, i]) for i in range(3)])
+    truth = {
+        "lat": tr.lat,
+        "lon": tr.lon,
+        "alt": tr.alt,
+        "vel": tr.vel,
+        "euler_deg": tr.euler_deg,
+        "gyro_bias": tr.extra["gyro_bias"],
+        "accel_bias": tr.extra["accel_bias"],
+    }
+    meta = {
+        "vehicle": vehicle_id,
+        "autopilot": "uasnav-sim",
+        "imu_model": model_name,
+        "start_time": start.isoformat().replace("+00:00", "Z"),
+        "rate_hz": f"{rate_hz:g}",
+    }
+    log = dataclasses.replace(f.imu, mag=mag, truth=truth, meta={**f.imu.meta, **meta})
+    write_csv_v1(log, out_p / f"{name}.csv")
+    write_gnss_csv(out_p / f"{name}_gnss.csv", f.gnss)
+    # telemetry: the true track at the GNSS instants, on the wall clock of the flight's start
+    g = f.gnss.t
+    lat, lon, alt = (np.interp(g, tr.t, x) for x in (tr.lat, tr.lon, tr.alt))
+    vel = np.column_stack([np.interp(g, tr.t, tr.vel[:, i]) for i in range(3)])
+    ned = geodetic_to_local(lat, lon, alt, origin=(float(lat[0]), float(lon[0]), float(alt[0])))
+    reached = _reached(ned[:, 0], ned[:, 1], -ned[:, 2], g, circuit)
+    wall = start.timestamp()
+    wps = {}
+    for s, (wn, we, wu) in enumerate(circuit, start=1):
+        hits = [tt for tt, ss in reached if ss == s]
+        if not hits:
+            continue
+        k = int(np.argmin(np.abs(g - hits[0])))
+        wps[s] = (float(lat[k]), float(lon[k]), float(alt[k]))
+    write_tlog_flight(
+        out_p / f"{name}.tlog", t_unix=wall + g, lat=lat, lon=lon, alt=alt, vel_ned=vel, waypoints=wps,
+        reached=[(wall + tt, s) for tt, s in reached if s in wps], cruise_ms=speed,
+    )  # fmt: skip
+
+
 def simulate_fleet(
     out: str | Path,
     vehicles: int = 5,
@@ -125,6 +225,8 @@ def simulate_fleet(
     static_fraction: float = 0.5,
     vibration_m_s2: float = 0.5,
     corrupt: bool = True,
+    nav_flights: int = 0,
+    nav_duration_s: float = 180.0,
 ) -> SimulatedFleet:
     """Write a synthetic fleet into the folder ``out`` (module docs); all files or none.
 
@@ -143,9 +245,17 @@ def simulate_fleet(
         Airframe vibration in flight (m/s² rms per axis).
     corrupt : bool
         Also write the corrupt files.
+    nav_flights : int
+        GNSS/INS flights per vehicle (module docs), each three files.
+    nav_duration_s : float
+        Length of each GNSS/INS flight (s; 20 s on the ground, then laps of the circuit).
     """
     from uasnav.io import write_csv_v1
 
+    if nav_flights < 0 or not nav_duration_s > 20.0:
+        raise InputError(
+            f"nav_flights must be >= 0 and nav_duration_s > 20 s, got {nav_flights}, {nav_duration_s}"
+        )
     if vehicles < 1 or flights < 1:
         raise InputError(f"vehicles and flights must be >= 1, got {vehicles} and {flights}")
     if not (duration_s > 0 and rate_hz > 0 and 0 <= static_fraction <= 1):
@@ -175,6 +285,12 @@ def simulate_fleet(
                 name = f"{vid}/flight_{f + 1:03d}.csv"
                 write_csv_v1(log, out_p / name)
                 files.append(FleetFile(name, vid, model, f, float(noise[v]), k in faulty, False))
+            for f in range(nav_flights):
+                start = day0 + dt.timedelta(days=f // 2, hours=3 * (f % 2) + 1, minutes=7 * v)
+                name = f"{vid}/nav_{f + 1:03d}"
+                _nav_flight(out_p, name, model, v, f, nav_duration_s, rate_hz, seed, start, vid)
+                for ext in (".csv", "_gnss.csv", ".tlog"):
+                    files.append(FleetFile(name + ext, vid, model, f, 1.0, False, False))
         for b in range(n_bad):
             if b % 2 == 0:
                 name = f"corrupt/broken_{b + 1:03d}.csv"

@@ -91,7 +91,10 @@ def discover(sources: Sequence[str | os.PathLike[str]]) -> list[str]:
         else:
             _from_url(s, Path.cwd())  # a remote URL gets its own message
             raise InputError(f"{s}: no such file or directory")
-    return sorted({os.path.abspath(f) for f in found})
+    from uasnav.fleet.logs import is_gnss_companion
+
+    # a GNSS CSV beside its IMU log is part of that log (the GNSS/INS flight format), not a log
+    return sorted({os.path.abspath(f) for f in found if not is_gnss_companion(f)})
 
 
 __all__ = ["LIST_EXTENSIONS", "LOG_EXTENSIONS", "discover"]
