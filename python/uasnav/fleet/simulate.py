@@ -202,7 +202,7 @@ def _nav_flight(
     reached = _reached(ned[:, 0], ned[:, 1], -ned[:, 2], g, circuit)
     wall = start.timestamp()
     wps = {}
-    for s, (wn, we, wu) in enumerate(circuit, start=1):
+    for s in range(1, len(circuit) + 1):
         hits = [tt for tt, ss in reached if ss == s]
         if not hits:
             continue

@@ -86,7 +86,7 @@ def write_tlog_flight(
     def item(seq: int, command: int, x: float, y: float, z: float, param2: float = 0.0) -> object:
         return mavlink.MAVLink_mission_item_int_message(
             1, 1, seq, _MAV_FRAME_GLOBAL_INT, command, 0, 1, 0.0, param2, 0.0, 0.0,
-            int(round(x * 1e7)), int(round(y * 1e7)), float(z), 0,
+            round(float(x * 1e7)), round(float(y * 1e7)), float(z), 0,
         )  # fmt: skip
 
     # the mission as the ground station downloads it before take-off
@@ -102,21 +102,21 @@ def write_tlog_flight(
         add(
             float(t[k]),
             mavlink.MAVLink_global_position_int_message(
-                int(round((t[k] - t0) * 1e3)) & 0xFFFFFFFF,
-                int(round(cols[0][k] * 1e7)),
-                int(round(cols[1][k] * 1e7)),
-                int(round(cols[2][k] * 1e3)),
-                int(round((cols[2][k] - cols[2][0]) * 1e3)),
-                int(round(vel[k, 0] * 100)),
-                int(round(vel[k, 1] * 100)),
-                int(round(vel[k, 2] * 100)),
+                round(float((t[k] - t0) * 1e3)) & 0xFFFFFFFF,
+                round(float(cols[0][k] * 1e7)),
+                round(float(cols[1][k] * 1e7)),
+                round(float(cols[2][k] * 1e3)),
+                round(float((cols[2][k] - cols[2][0]) * 1e3)),
+                round(float(vel[k, 0] * 100)),
+                round(float(vel[k, 1] * 100)),
+                round(float(vel[k, 2] * 100)),
                 65535,
             ),
         )
     for when, s in reached:
         add(float(when), mavlink.MAVLink_mission_item_reached_message(int(s) + shift))
     records.sort(key=lambda r: (r[0], r[1]))
-    out = b"".join(struct.pack(">Q", int(round(w * 1e6))) + pkt for w, _, pkt in records)
+    out = b"".join(struct.pack(">Q", round(float(w * 1e6))) + pkt for w, _, pkt in records)
     atomic_write_bytes(path, out)
 
 
