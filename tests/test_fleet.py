@@ -366,3 +366,111 @@ def test_elements_dataset_trains_the_same_model(client, shared_data, fleet_dir, 
     assert res.exit_code == 0, res.output
     s5, seg5, _ = read_element_dataset(e5)
     assert seg5 == 5.0 and len(s5) == flight_samples([tlog], segment_m=5.0).n_elements
+
+
+@pytest.fixture(scope="module")
+def nav_fleet(tmp_path_factory):
+    """2 vehicles × (1 IMU-only log + 1 GNSS/INS flight of 130 s: .csv + _gnss.csv + .tlog)."""
+    d = tmp_path_factory.mktemp("navfleet")
+    fleet.simulate_fleet(
+        d, vehicles=2, flights=1, seed=5, duration_s=20.0, corrupt=False, nav_flights=1, nav_duration_s=130.0
+    )
+    return d
+
+
+def test_simulated_flights_carry_gnss_and_mission(client, nav_fleet, tmp_path):
+    from uasnav.fleet.elements import ELEMENTS
+    from uasnav.io import read_flight
+
+    truth = load_truth(nav_fleet)
+    assert sorted(f.file for f in truth.files if "nav_" in f.file) == [
+        f"V0{v}/nav_001{ext}" for v in (1, 2) for ext in (".csv", ".tlog", "_gnss.csv")
+    ]
+    s = fleet.run(fleet.SCAN, [nav_fleet], tmp_path / "scan.parquet", workers=0)
+    rows = {Path(r["path"]).relative_to(nav_fleet).as_posix(): r for r in read_dataset(s.out).to_pylist()}
+    # the GNSS CSV is part of its IMU log, not a log of its own
+    assert sorted(rows) == [
+        f"V0{v}/{n}" for v in (1, 2) for n in ("flight_001.csv", "nav_001.csv", "nav_001.tlog")
+    ]
+    for v in ("V01", "V02"):
+        imu_only, nav_csv, tlog = (
+            rows[f"{v}/flight_001.csv"],
+            rows[f"{v}/nav_001.csv"],
+            rows[f"{v}/nav_001.tlog"],
+        )
+        assert (imu_only["gnss"], imu_only["mission"]) == (False, False)
+        assert (nav_csv["format"], nav_csv["gnss"], nav_csv["mission"], nav_csv["vehicle"]) == (
+            "csv-v1",
+            True,
+            False,
+            v,
+        )
+        assert nav_csv["duration_s"] == pytest.approx(130.0, abs=0.02)
+        assert (tlog["format"], tlog["gnss"], tlog["mission"], tlog["n_waypoints"], tlog["n_imus"]) == (
+            "mavlink-tlog", True, True, 4, 0,
+        )  # fmt: skip
+        assert tlog["day"] == nav_csv["day"]  # the telemetry's wall clock is the flight's start
+        # the telemetry is the true track: the waypoints lie on it, reached lap after lap in order
+        fl = read_flight(nav_fleet / v / "nav_001.tlog")
+        assert fl.cruise_ms == 8.0
+        seqs = [q for _, q in fl.reached]
+        assert seqs[:5] == [5, 2, 3, 4, 5]  # top of the climb (last waypoint), then the circuit
+        for t_r, q in fl.reached:
+            k = int(np.argmin(np.abs(fl.t - t_r)))
+            lat, lon, _ = fl.waypoints[q]
+            assert abs(fl.lat[k] - lat) < 3e-5 and abs(fl.lon[k] - lon) < 4e-5  # within ~3 m
+    el = fleet.run(ELEMENTS, [nav_fleet], tmp_path / "el.parquet", client=client)
+    t = read_dataset(el.out)
+    assert el.n_errors == 0 and t.num_rows > 20
+    assert {Path(p).name for p in t.column("path").to_pylist()} == {"nav_001.tlog"}
+    single = fleet.run(ELEMENTS, [nav_fleet], tmp_path / "el1.parquet", workers=0)
+    assert read_dataset(single.out).equals(t)
+
+
+def test_fleet_nav_cluster_equals_single_process(client, nav_fleet, shared_data, tmp_path):
+    from uasnav.fleet.nav import NAV
+
+    ulg = shared_data / "logs" / "px4_sample_log_small.ulg"
+    s1 = fleet.run(NAV, [nav_fleet, ulg], tmp_path / "nav1.parquet", workers=0)
+    s2 = fleet.run(NAV, [nav_fleet, ulg], tmp_path / "nav2.parquet", client=client)
+    one, two = read_dataset(s1.out), read_dataset(s2.out)
+    assert one.num_rows == 3 and two.equals(one)
+    assert read_errors(s2.out).equals(read_errors(s1.out)) and s1.n_errors == 0
+    # IMU-only logs and telemetry-only logs give no row
+    assert (s1.n_ok, s1.n_empty) == (3, 4)
+    rows = {Path(r["path"]).name + r["vehicle"]: r for r in one.to_pylist()}
+    for v in ("V01", "V02"):
+        r = rows["nav_001.csv" + v]
+        assert (r["reference"], r["outage_against"], r["gnss_fixes"]) == ("truth", "truth", 651)
+        # GNSS σ is 1.5 m horizontally: the filter's solution is better than a fix
+        assert 0.05 < r["horizontal_rms_m"] < 1.5 and r["velocity_rms_m_s"] < 0.5
+        assert [r[f"outage_{d}s_n"] for d in (10, 30, 60)] == [3, 3, 3]
+        # drift grows with the outage (MEMS IMU: metres after 10 s, tens to hundreds after 60 s)
+        assert 0.2 < r["outage_10s_m"] < r["outage_30s_m"] < r["outage_60s_m"] < 2000.0
+    u = next(r for r in one.to_pylist() if r["path"].endswith(".ulg"))
+    assert u["reference"].startswith("PX4 EKF2") and u["outage_10s_n"] == 0 and u["outage_10s_m"] is None
+    # the same replay as `uasnav nav` (one filter, one comparison)
+    res = CliRunner().invoke(main, ["nav", str(ulg), "--json"])
+    assert res.exit_code == 0, res.output
+    ref = json.loads(res.output)["reference"]
+    assert (
+        u["horizontal_rms_m"] == ref["horizontal_rms_m"] and u["velocity_rms_m_s"] == ref["velocity_rms_m_s"]
+    )
+
+
+def test_cli_fleet_nav_and_simulate_nav_flights(tmp_path):
+    d = tmp_path / "f"
+    res = CliRunner().invoke(
+        main,
+        ["fleet", "simulate", "--vehicles", "1", "--flights", "1", "--nav-flights", "1", "--duration", "10",
+         "--out", str(d), "--json"],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.output)["files"] == 5  # 1 IMU log, 1 corrupt, the flight's 3 files
+    res = CliRunner().invoke(
+        main,
+        ["fleet", "nav", str(d / "V01"), "--out", str(tmp_path / "nav.parquet"), "--workers", "0", "--json"],
+    )
+    assert res.exit_code == 0, res.output
+    info = json.loads(res.output)
+    assert (info["logs"], info["ok"], info["rows"], info["errors"]) == (3, 1, 1, 0)

@@ -174,6 +174,15 @@ def elements(sources, out, scheduler, scheduler_file, workers, resume, as_json, 
     _print(_execute(analysis, sources, out, scheduler, scheduler_file, workers, resume), as_json)
 
 
+@command.command("nav")
+@_run_options
+def nav(sources, out, scheduler, scheduler_file, workers, resume, as_json):  # type: ignore[no-untyped-def]
+    """GNSS/INS replay of every log with IMU and GNSS: RMS against its reference, outage drift."""
+    from uasnav.fleet.nav import NAV
+
+    _print(_execute(NAV, sources, out, scheduler, scheduler_file, workers, resume), as_json)
+
+
 @command.command("simulate")
 @click.option("--vehicles", type=click.IntRange(1, 1000), required=True, help="Number of vehicles N.")
 @click.option("--flights", type=click.IntRange(1, 1000), required=True, help="Flights per vehicle M.")
