@@ -201,6 +201,52 @@ def test_scan_inventory_of_real_logs(shared_data, tmp_path):
     # the flight controller's UUID is the vehicle (and the partition)
     assert ulg["vehicle_id"] == ulg["vehicle"] == "000600000000383638393239510d0035002d"
     assert all(len(r["log_hash"]) == 64 for r in rows.values())
+    # the ULog's GNSS UTC time dates it; its three sensor_gyro/sensor_accel instances are listed
+    assert ulg["day"] == "2021-04-21"
+    assert [i["name"] for i in ulg["imus"]] == ["sensor_combined"] + [f"sensor_imu[{k}]" for k in range(3)]
+    # the DataFlash board identity line is the vehicle; GPS week/time of week date it
+    assert bin_["vehicle_id"] == "PX4v2 004A002F 33345119 32383433"
+    assert bin_["vehicle"] == "PX4v2_004A002F_33345119_32383433"  # partition names: no spaces
+    assert bin_["day"] == "2015-11-21"
+
+
+def test_ulog_instances_and_start_against_pyulog(shared_data):
+    import datetime as dt
+
+    from pyulog import ULog
+
+    from uasnav.io.px4 import read_ulog_imus
+
+    path = shared_data / "logs" / "px4_sample_log_small.ulg"
+    imus = read_ulog_imus(path)
+    u = ULog(str(path))
+    for k in range(3):
+        g = next(d for d in u.data_list if d.name == "sensor_gyro" and d.multi_id == k)
+        a = next(d for d in u.data_list if d.name == "sensor_accel" and d.multi_id == k)
+        log = imus[f"sensor_imu[{k}]"]
+        i = np.searchsorted(g.data["timestamp"], log.t[0] * 1e6 - 0.5)
+        n = log.n
+        np.testing.assert_array_equal(log.gyro[:, 0], g.data["x"][i : i + n])
+        np.testing.assert_array_equal(log.temp, g.data["temperature"][i : i + n])
+        # accelerometer linearly interpolated to the gyro's instants
+        ta, tg = a.data["timestamp"] * 1e-6, g.data["timestamp"][i : i + n] * 1e-6
+        np.testing.assert_allclose(log.accel[:, 2], np.interp(tg, ta, a.data["z"]), rtol=1e-6)
+    gps = next(d for d in u.data_list if d.name == "vehicle_gps_position")
+    start = dt.datetime.fromisoformat(imus["sensor_combined"].meta["start_time"])
+    expect = (gps.data["time_utc_usec"][0] - (gps.data["timestamp"][0] - u.start_timestamp)) * 1e-6
+    assert start.timestamp() == pytest.approx(expect, abs=1e-3)
+
+
+def test_dataflash_identity_closed_form(shared_data):
+    import datetime as dt
+
+    from uasnav.io.dataflash import read_dataflash_identity
+
+    ident = read_dataflash_identity(shared_data / "logs" / "ardupilot_log171.bin")
+    assert ident["vehicle"] == "PX4v2 004A002F 33345119 32383433"
+    # first 3-D fix: GPS week 1871, 603 882.4 s of week, boot time T = 45.136 s; GPS − UTC = 17 s
+    gps = dt.datetime(1980, 1, 6, tzinfo=dt.timezone.utc) + dt.timedelta(weeks=1871, seconds=603_882.4)
+    assert ident["boot_utc"] == gps - dt.timedelta(seconds=17 + 45.136)
 
 
 def test_imu_health_of_real_logs(shared_data, tmp_path):

@@ -5,8 +5,10 @@ says which reader a file needs (by extension, and for ``.csv`` by the header: CS
 the flight CSV) and gathers what every analysis needs: the IMU instances as
 :class:`~uasnav.imu.ImuLog` (``read_dataflash``/``read_tlog`` give every instance, ``read_ulog``
 the primary one) and the vehicle identity written in the log (CSV v1 ``# vehicle:``,
-``# autopilot:``, ``# start_time:`` comments; a ULog's flight-controller UUID; a ``.tlog``'s
-wall-clock time stamps; other logs' vehicle and day are ``unknown``). A CSV v1 log ``X.csv``
+``# autopilot:``, ``# start_time:`` comments; a ULog's flight-controller UUID and GNSS UTC time;
+a DataFlash log's board identity line and GPS week/time (:func:`uasnav.io.dataflash.read_dataflash_identity`);
+a ``.tlog``'s wall-clock time stamps; else ``unknown``). A ULog's IMUs are the primary one and
+every ``sensor_gyro``/``sensor_accel`` instance (:func:`uasnav.io.px4.read_ulog_imus`). A CSV v1 log ``X.csv``
 with ``X_gnss.csv`` beside it is one log of the GNSS/INS flight format (:func:`gnss_companion`);
 a ``.tlog`` without IMU streams is telemetry only.
 """
@@ -145,11 +147,18 @@ def read_fleet_log(path: str) -> FleetLog:
 
     fmt = format_of(path)
     imus: dict[str, ImuLog]
-    if fmt in ("csv-v1", "xio-csv", "npz", "px4-ulog"):
-        log = io.read_log(path)
-        imus = {str(log.meta.get("topic", "imu0")) if fmt == "px4-ulog" else "imu0": log}
+    identity: dict[str, Any] = {}
+    if fmt in ("csv-v1", "xio-csv", "npz"):
+        imus = {"imu0": io.read_log(path)}
+    elif fmt == "px4-ulog":
+        from uasnav.io.px4 import read_ulog_imus
+
+        imus = read_ulog_imus(path)
     elif fmt == "ardupilot-dataflash":
+        from uasnav.io.dataflash import read_dataflash_identity
+
         imus = io.read_dataflash(path)
+        identity = read_dataflash_identity(path)
     elif fmt == "mavlink-tlog":
         try:
             imus = io.read_tlog(path)
@@ -164,8 +173,12 @@ def read_fleet_log(path: str) -> FleetLog:
     else:  # flight CSV: telemetry only
         io.read_flight(path)
         imus = {}
-    meta = next(iter(imus.values())).meta if imus else {}
-    start = _start_time(dict(meta))
+    meta = dict(next(iter(imus.values())).meta) if imus else {}
+    if "vehicle" in identity:
+        meta["vehicle"] = identity["vehicle"]
+    start = _start_time(meta)
+    if start is None and "boot_utc" in identity and imus:
+        start = identity["boot_utc"] + dt.timedelta(seconds=min(float(m.t[0]) for m in imus.values()))
     if start is None and fmt == "mavlink-tlog":
         start = _tlog_start(path)
     return FleetLog(
