@@ -155,6 +155,83 @@ def test_gnss_ramp_fault_never_exceeds_the_protection_level_unannounced(
     assert r.excluded_fixes  # the ramp is detected
 
 
+def _with_fault_ned(f: ins.Flight, fault_ned_m: np.ndarray) -> ins.Flight:
+    """GNSS positions moved by a fault (m, N/E/D per fix); velocities untouched (a pseudorange
+    ramp leaves the Doppler velocity alone)."""
+    g = f.gnss
+    lat = g.lat + np.degrees(fault_ned_m[:, 0] / 6_367_000.0)
+    lon = g.lon + np.degrees(fault_ned_m[:, 1] / (6_378_000.0 * np.cos(np.radians(g.lat))))
+    alt = g.alt - fault_ned_m[:, 2]
+    return dataclasses.replace(f, gnss=dataclasses.replace(g, lat=lat, lon=lon, alt=alt))
+
+
+def _unannounced(r: ins.InsResult, truth: ins.Trajectory) -> tuple[int, float, float]:
+    """Rows where the true horizontal error exceeds the HPL or the vertical the VPL while no
+    flag is raised *at that epoch*: no alert (PL over HAL/VAL, separation alert) and the
+    latest tested fix was used (not excluded or reset). Also the worst error/PL ratios."""
+    d = ev.ned_difference(r.lat, r.lon, r.alt, truth, r.t)
+    eh, ev_ = np.hypot(d[:, 0], d[:, 1]), np.abs(d[:, 2])
+    tested = np.isin(r.fix_status, (0, 1, 2, 5, 6))
+    ft, fs = r.fix_t[tested], r.fix_status[tested]
+    i = np.searchsorted(ft, r.t, side="right") - 1
+    flag = r.alert | ((i >= 0) & np.isin(fs[np.maximum(i, 0)], (1, 2, 5, 6)))
+    bad = ((eh > r.hpl) | (ev_ > r.vpl)) & ~flag
+    return int(bad.sum()), float((eh / r.hpl).max()), float((ev_ / r.vpl).max())
+
+
+@pytest.fixture(scope="module")
+def long_flight() -> ins.Flight:
+    return simulate_flight(duration_s=600.0, seed=5, errors=NO_THERMAL)
+
+
+@pytest.mark.parametrize("rate_m_s", [0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 5.0])
+def test_slow_gnss_ramps_never_exceed_the_protection_levels_unannounced(
+    long_flight: ins.Flight, rate_m_s: float
+) -> None:
+    """Ramps on the GNSS position (north, a horizontal diagonal, down; from 60 s and 300 s of a
+    600 s flight): at every epoch the true error is within HPL/VPL or a flag is raised. The
+    filter follows slow ramps without an innovation alarm; the solution separation against
+    the GNSS-velocity reference bounds them."""
+    f = long_flight
+    worst = 0.0
+    detected = 0
+    for direction in ((1.0, 0.0, 0.0), (0.6, -0.8, 0.0), (0.0, 0.0, 1.0)):
+        for start in (60.0, 300.0):
+            a = np.clip(f.gnss.t - start, 0.0, None) * rate_m_s
+            r = ins.run(_with_fault_ned(f, np.outer(a, direction)), _matched(hal_m=40.0, val_m=50.0))
+            bad, wh, wv = _unannounced(r, f.truth)
+            assert bad == 0, (direction, start, wh, wv)
+            worst = max(worst, wh, wv)
+            flagged = r.summary["separation_alerts"] + r.summary["fixes_excluded"]
+            assert not np.isin(r.fix_status[f.gnss.t < start], (1, 2, 5, 6)).any()
+            detected += flagged > 0
+    if rate_m_s >= 0.05:
+        # The test is not vacuous: the true error does exceed the PL (then flagged) and every
+        # ramp is detected (the fault reaches ≥ 13 m before the flight ends).
+        assert worst > 1.0
+        assert detected == 6
+    else:
+        assert detected >= 2  # 0.02 m/s: caught only from 60 s (≤ 6 m from 300 s)
+
+
+def test_fault_free_separation_alerts_are_rare_and_pls_usable() -> None:
+    """Fault-free flights: no separation alert or exclusion in 20 × 200 s (≈ 20 000 fixes at
+    P_FA = 1e-5 per test), and median HPL/VPL well below a 40/50 m alert limit."""
+    flagged = fixes = 0
+    med = []
+    for s in range(20):
+        f = simulate_flight(duration_s=200.0, seed=100 + s, errors=NO_THERMAL)
+        r = ins.run(f, _matched())
+        flagged += r.summary["separation_alerts"] + r.summary["fixes_excluded"]
+        fixes += r.summary["fixes_used"] + r.summary["fixes_excluded"]
+        med.append((np.median(r.hpl), np.median(r.vpl)))
+        assert _unannounced(r, f.truth)[0] == 0
+    assert fixes > 19_000
+    assert flagged <= 2
+    hpl, vpl = np.median(med, axis=0)
+    assert hpl < 15.0 and vpl < 15.0
+
+
 def test_protection_levels_bound_fault_free_errors(flight: ins.Flight) -> None:
     r = ins.run(flight, _matched())
     d = ev.ned_difference(r.lat, r.lon, r.alt, flight.truth, r.t)

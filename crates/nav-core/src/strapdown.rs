@@ -301,13 +301,16 @@ pub(crate) fn joseph_update<T: Real, const M: usize>(
     let kt = g.chol.solve(&g.hp); // Kᵀ = S⁻¹·H·P
     let k = kt.transpose();
     let dx = k * z;
-    let ikh = Mat15::<T>::identity() - k * h;
-    let mut kr = k;
+    // The Joseph form expanded, (I−KH)P(I−KH)ᵀ + KRKᵀ = P − K·HP − (K·HP)ᵀ + K·S·Kᵀ with
+    // S = HPHᵀ + R — exact for any K, so it keeps the Joseph form's tolerance of an inexact gain,
+    // but costs M-row products (≈ 3.8k multiply-adds for M = 6) instead of two dense 15×15
+    // products (≈ 9.5k).
+    let khp = k * g.hp;
+    let mut s = g.hp * h.transpose();
     for j in 0..M {
-        let r = r_diag[j];
-        kr.column_mut(j).scale_mut(r);
+        s[(j, j)] += r_diag[j];
     }
-    let p_new = ikh * *p * ikh.transpose() + kr * kt;
+    let p_new = *p - khp - khp.transpose() + (k * s) * kt;
     let p_sym = (p_new + p_new.transpose()) * lit::<T>(0.5);
     for i in 0..N_STATES {
         let d = p_sym[(i, i)];

@@ -93,6 +93,8 @@ fn config(
                 "lambda_undetected" => &mut c.lambda_undetected,
                 "k_horizontal" => &mut c.k_horizontal,
                 "k_vertical" => &mut c.k_vertical,
+                "separation_k_h" => &mut c.separation_k_h,
+                "separation_k_v" => &mut c.separation_k_v,
                 "temp_slope_window_s" => &mut c.temp_slope_window_s,
                 _ => return Err(input_error(py, format!("config: unknown key {key:?}"))),
             };
@@ -305,6 +307,7 @@ fn ins_run<'py>(
     dict.set_item("course_reset", s.course_reset)?;
     dict.set_item("imu_gaps", s.imu_gaps)?;
     dict.set_item("gnss_resets", s.gnss_resets)?;
+    dict.set_item("separation_alerts", s.separation_alerts)?;
     Ok(dict)
 }
 

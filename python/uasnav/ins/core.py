@@ -48,7 +48,15 @@ TRACK_COLUMNS = "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw,bgx,bgy,bgz,bax,bay,baz,h
 #: the body by more than 6° between samples.
 MIN_IMU_RATE_HZ = 5.0
 #: Fix status codes of the Rust filter.
-FIX_STATUS = {0: "used", 1: "excluded", 2: "excluded_window", 3: "masked", 4: "unused", 5: "reset"}
+FIX_STATUS = {
+    0: "used",
+    1: "excluded",
+    2: "excluded_window",
+    3: "masked",
+    4: "unused",
+    5: "reset",
+    6: "separation_alert",
+}
 
 
 @lru_cache(maxsize=32)
@@ -73,6 +81,9 @@ def integrity_thresholds(p_fa: float, p_md: float, p_ir: float) -> dict[str, flo
         "lambda_undetected": lam,
         "k_horizontal": math.sqrt(-2.0 * math.log(p_ir)),
         "k_vertical": float(stats.norm.isf(p_ir / 2.0)),
+        # Solution separation (slow ramps): χ²₂ on the normalised N/E separation, Gaussian on D.
+        "separation_k_h": math.sqrt(-2.0 * math.log(p_fa)),
+        "separation_k_v": float(stats.norm.isf(p_fa / 2.0)),
     }
 
 
@@ -244,9 +255,20 @@ class InsResult:
         return out
 
     @property
+    def separation_alert(self) -> NDArray[np.bool_]:
+        """Per row: the latest GNSS fix tested at or before it raised a solution-separation
+        alert (a GNSS position fault such as a slow ramp is detected)."""
+        tested = self.fix_status <= 2  # used, excluded or separation alert, in time order
+        tested |= (self.fix_status == 5) | (self.fix_status == 6)
+        ft, fs = self.fix_t[tested], self.fix_status[tested]
+        i = np.searchsorted(ft, self.t, side="right") - 1
+        return (i >= 0) & (fs[np.maximum(i, 0)] == 6)
+
+    @property
     def alert(self) -> NDArray[np.bool_]:
-        """Per row: a protection level exceeds its alert limit (HAL/VAL)."""
-        a = np.zeros(self.t.size, dtype=bool)
+        """Per row: a protection level exceeds its alert limit (HAL/VAL), or the
+        solution-separation monitor is raising an alert (see :attr:`separation_alert`)."""
+        a = self.separation_alert.copy()
         if self.hal_m is not None:
             a |= self.hpl > self.hal_m
         if self.val_m is not None:
@@ -265,6 +287,8 @@ class InsResult:
             h = float(self.hpl[i0:i1].max())
             v = float(self.vpl[i0:i1].max())
             kinds = []
+            if self.separation_alert[i0:i1].any():
+                kinds.append("separation")
             if self.hal_m is not None and h > self.hal_m:
                 kinds.append("HAL")
             if self.val_m is not None and v > self.val_m:
@@ -565,6 +589,7 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         "course_reset": bool(out["course_reset"]),
         "imu_gaps": int(out["imu_gaps"]),
         "gnss_resets": int(out["gnss_resets"]),
+        "separation_alerts": int(out["separation_alerts"]),
         "alerts": len(res.alerts),
         "thresholds": integrity_thresholds(cfg.p_fa, cfg.p_md, cfg.p_ir),
     }

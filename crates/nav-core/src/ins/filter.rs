@@ -1,6 +1,7 @@
 //! The GNSS/INS filter: mechanisation step, aiding updates, integrity, and the batch runner.
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
+use super::separation::{self, VelocityReference};
 use super::{InsConfig, Mode, WINDOW_CAPACITY};
 use crate::attitude::{euler321_to_quat, quat_to_array, quat_to_dcm, quat_to_euler321};
 use crate::earth;
@@ -73,6 +74,10 @@ pub enum FixStatus {
     /// Excluded, and the filter re-initialised its position and velocity on it after too many
     /// consecutive exclusions.
     Reset = 5,
+    /// Used, but the solution separation against the GNSS-velocity reference exceeds its
+    /// threshold: a GNSS position fault (e.g. a slow ramp) is detected; a loosely coupled
+    /// filter cannot tell which source is wrong, so this is an integrity alert.
+    SeparationAlert = 6,
 }
 
 /// The GNSS/INS filter (see the module docs for the model). Never allocates.
@@ -102,6 +107,10 @@ pub struct InsFilter<T: Real> {
     bias_v: T,
     last_nis: T,
     earth: EarthCache<T>,
+    /// Time since the start (s), for the reference's velocity integral.
+    time_s: f64,
+    /// GNSS-velocity reference of the solution-separation monitor.
+    sep: VelocityReference,
 }
 
 /// Earth quantities at a reference point, refreshed when the position moves by more than
@@ -223,6 +232,11 @@ impl<T: Real> InsFilter<T> {
             bias_v: T::zero(),
             last_nis: T::zero(),
             earth: EarthCache::at(lat_rad, height_m),
+            time_s: 0.0,
+            sep: VelocityReference {
+                first_t: f64::NAN,
+                ..VelocityReference::default()
+            },
             cfg: config,
         })
     }
@@ -337,6 +351,7 @@ impl<T: Real> InsFilter<T> {
         self.lon += to_f64(v_bar.y) * dt64 / (re_h * e.cos_lat);
         self.bg += dbias_dt_rad_s2 * dt;
         self.w_hat = w_hat;
+        self.time_s += dt64;
         let e = ErrorDynamics {
             dt,
             c,
@@ -408,6 +423,106 @@ impl<T: Real> InsFilter<T> {
     /// valid `age_s` seconds before the current IMU time (≥ 0; the measured position is moved
     /// forward by the measured velocity). Runs the integrity tests and returns what was done.
     pub fn update_gnss(
+        &mut self,
+        llh: &[f64; 3],
+        vel_ned_m_s: &[T; 3],
+        acc: &[T; 3],
+        age_s: f64,
+    ) -> Result<FixStatus, NavError> {
+        let (ant_pre, p_pre) = self.antenna();
+        let st = self.update_gnss_innovation(llh, vel_ned_m_s, acc, age_s)?;
+        if st != FixStatus::Used {
+            self.sep.chain = false;
+            return Ok(st);
+        }
+        let cfg = self.cfg;
+        let ss = to_f64(num_traits::Float::max(
+            acc[2],
+            cfg.gnss_min_std_velocity_m_s,
+        ));
+        let v = Vector3::new(
+            to_f64(vel_ned_m_s[0]),
+            to_f64(vel_ned_m_s[1]),
+            to_f64(vel_ned_m_s[2]),
+        );
+        let radii = self.radii();
+        let (ant, p) = self.antenna();
+        if !self.sep.active {
+            // Anchor at the last trusted epoch: once the filter has converged on GNSS.
+            if !self.sep.first_t.is_finite() {
+                self.sep.first_t = self.time_s;
+            }
+            let sh = to_f64(num_traits::Float::max(acc[0], cfg.gnss_min_std_position_m));
+            let sv = to_f64(num_traits::Float::max(acc[1], cfg.gnss_min_std_position_m));
+            let f = separation::ANCHOR_VARIANCE_FRACTION;
+            let converged = p[0].max(p[1]) <= f * sh * sh && p[2] <= f * sv * sv;
+            if !(converged || self.time_s - self.sep.first_t >= separation::ANCHOR_MAX_WAIT_S) {
+                return Ok(FixStatus::Used);
+            }
+            self.sep.anchor(self.time_s, &v, ss * ss, &ant, &p);
+        } else {
+            self.sep
+                .advance(self.time_s, &v, ss * ss, &ant_pre, &p_pre, radii);
+        }
+        self.sep.last_ant = ant;
+        self.sep.last_p = p;
+        // Separation and its protection levels (see `separation`).
+        let vr = self.sep.variance();
+        let r = &self.sep.llh;
+        let d = [
+            (ant[0] - r[0]) * radii.0,
+            (ant[1] - r[1]) * radii.1,
+            -(ant[2] - r[2]),
+        ];
+        let vs = [vr[0] + p[0], vr[1] + p[1], vr[2] + p[2]];
+        let (kh, kv) = (to_f64(cfg.separation_k_h), to_f64(cfg.separation_k_v));
+        let alert =
+            d[0] * d[0] / vs[0] + d[1] * d[1] / vs[1] > kh * kh || d[2].abs() > kv * vs[2].sqrt();
+        let hpl_ss =
+            kh * vs[0].max(vs[1]).sqrt() + to_f64(cfg.k_horizontal) * vr[0].max(vr[1]).sqrt();
+        let vpl_ss = kv * vs[2].sqrt() + to_f64(cfg.k_vertical) * vr[2].sqrt();
+        let phh = self.p.fixed_view::<2, 2>(0, 0).into_owned();
+        let ff_h = to_f64(cfg.k_horizontal)
+            * to_f64(num_traits::Float::max(lambda_max2(&phh), T::zero())).sqrt();
+        let ff_v = to_f64(cfg.k_vertical) * p[2].sqrt();
+        self.bias_h = num_traits::Float::max(self.bias_h, lit(hpl_ss - ff_h));
+        self.bias_v = num_traits::Float::max(self.bias_v, lit(vpl_ss - ff_v));
+        Ok(if alert {
+            FixStatus::SeparationAlert
+        } else {
+            FixStatus::Used
+        })
+    }
+
+    /// (R_N + h, (R_E + h)·cos φ) (m) at the current position.
+    fn radii(&self) -> (f64, f64) {
+        let (sl, cl) = (self.lat.sin(), self.lat.cos());
+        let d = 1.0 - earth::WGS84_E2 * sl * sl;
+        let re = earth::WGS84_A / d.sqrt();
+        let rn = re * (1.0 - earth::WGS84_E2) / d;
+        (rn + self.h, (re + self.h) * cl)
+    }
+
+    /// Antenna latitude, longitude (rad), height (m) and the position variances (m², N/E/D).
+    fn antenna(&self) -> ([f64; 3], [f64; 3]) {
+        let cl_b = quat_to_dcm(&self.q) * Vector3::from(self.cfg.lever_arm_m);
+        let (rn_h, re_h_cos) = self.radii();
+        (
+            [
+                self.lat + to_f64(cl_b.x) / rn_h,
+                self.lon + to_f64(cl_b.y) / re_h_cos,
+                self.h - to_f64(cl_b.z),
+            ],
+            [
+                to_f64(self.p[(0, 0)]),
+                to_f64(self.p[(1, 1)]),
+                to_f64(self.p[(2, 2)]),
+            ],
+        )
+    }
+
+    /// The innovation tests and the measurement update of [`Self::update_gnss`].
+    fn update_gnss_innovation(
         &mut self,
         llh: &[f64; 3],
         vel_ned_m_s: &[T; 3],
@@ -604,6 +719,10 @@ impl<T: Real> InsFilter<T> {
             });
         }
         finite3("gnss velocity", self.index, vel_ned_m_s)?;
+        if self.sep.active {
+            let (a, p) = self.antenna();
+            self.sep.accumulate_bridge(&a, &p);
+        }
         let c = quat_to_dcm(&self.q);
         let cl_b = c * Vector3::from(self.cfg.lever_arm_m);
         let (sl, cl) = (
@@ -632,6 +751,12 @@ impl<T: Real> InsFilter<T> {
         }
         self.win_len = 0;
         self.win_head = 0;
+        // The reference bridges the jump: it follows the dead-reckoned displacement up to the
+        // reset and the filter's displacement from here on (never the jump itself).
+        let (a, p) = self.antenna();
+        self.sep.last_ant = a;
+        self.sep.last_p = p;
+        self.sep.chain = false;
         self.check_health()
     }
 
@@ -733,6 +858,8 @@ pub struct InsBatchSummary<T> {
     pub fixes_used: usize,
     /// GNSS fixes excluded by the integrity tests.
     pub fixes_excluded: usize,
+    /// Used fixes at which the solution-separation monitor raised an alert.
+    pub separation_alerts: usize,
     /// ZUPT/ZARU updates.
     pub static_updates: usize,
     /// Barometric updates.
@@ -938,6 +1065,7 @@ impl<T: Real> InsFilter<T> {
             initial_attitude: quat_to_array(&q0),
             fixes_used: 1,
             fixes_excluded: 0,
+            separation_alerts: 0,
             static_updates: 0,
             baro_updates: 0,
             mag_updates: 0,
@@ -1059,7 +1187,8 @@ impl<T: Real> InsFilter<T> {
                     let st = f.update_gnss(&input.gnss_llh[jg], &vel, &input.gnss_acc[jg], age)?;
                     out.fix_status[jg] = st as u8;
                     out.fix_nis[jg] = f.last_nis;
-                    if st == FixStatus::Used {
+                    if matches!(st, FixStatus::Used | FixStatus::SeparationAlert) {
+                        summary.separation_alerts += usize::from(st == FixStatus::SeparationAlert);
                         consecutive_excluded = 0;
                         summary.fixes_used += 1;
                         used_since_row = true;

@@ -71,6 +71,13 @@
 //! `b_H ≥ √(λ/W)·√λ_max(S_NE)`. The larger of the two is used; it is held between fixes and
 //! through outages.
 //!
+//! Neither bounds a slow ramp, which the filter follows with a constant lag (constant
+//! innovations, error growing as `r·t`). A solution-separation monitor against a reference
+//! free of GNSS *positions* does: the filter's antenna position at the first used fix moved
+//! by the integral of the GNSS velocities (see `separation.rs` for the test and the bound).
+//! When the separation exceeds its threshold the fix is still used but reported as
+//! [`FixStatus::SeparationAlert`]; its protection levels are folded into `b_H`, `b_V`.
+//!
 //! After `reset_after_exclusions` consecutive excluded fixes (default 50, 10 s at 5 Hz) the
 //! filter cannot tell a long GNSS fault from its own divergence; it re-initialises position and
 //! velocity on the fix and reports the reset ([`FixStatus::Reset`]).
@@ -79,6 +86,7 @@
 //! An IMU interval longer than five nominal sample periods is a logging gap: it is bridged with
 //! the last sample before it (the sample after a gap averages over an unknown part of it).
 mod filter;
+mod separation;
 
 pub use filter::{
     FixStatus, InsBatchInput, InsBatchOutput, InsBatchSummary, InsFilter, MagnetometerAiding,
@@ -151,6 +159,11 @@ pub struct InsConfig<T> {
     pub temp_slope_window_s: T,
     /// Consecutive excluded fixes after which the filter re-initialises on GNSS (0 = never).
     pub reset_after_exclusions: usize,
+    /// Horizontal false-alert multiplier of the solution-separation test (χ²₂ threshold
+    /// `k²`, on the normalised N/E separation): `√(−2 ln P_FA)`.
+    pub separation_k_h: T,
+    /// Vertical false-alert multiplier of the solution-separation test (on σ_D).
+    pub separation_k_v: T,
 }
 
 impl<T: Real> Default for InsConfig<T> {
@@ -192,6 +205,8 @@ impl<T: Real> Default for InsConfig<T> {
             k_vertical: lit(5.33),
             temp_slope_window_s: lit(30.0),
             reset_after_exclusions: 50,
+            separation_k_h: lit(4.80),
+            separation_k_v: lit(4.42),
         }
     }
 }
@@ -200,7 +215,7 @@ impl<T: Real> InsConfig<T> {
     /// Checks every field (finite, positive where a σ, an interval or a threshold); names
     /// the bad one.
     pub fn validate(&self) -> Result<(), NavError> {
-        let pos: [(&'static str, T); 22] = [
+        let pos: [(&'static str, T); 24] = [
             ("sigma_vrw_m_s_sqrt_s", self.noise.sigma_vrw_m_s_sqrt_s),
             ("sigma_arw_rad_sqrt_s", self.noise.sigma_arw_rad_sqrt_s),
             ("sigma_abi_m_s2", self.noise.sigma_abi_m_s2),
@@ -226,6 +241,8 @@ impl<T: Real> InsConfig<T> {
             ("lambda_undetected", self.lambda_undetected),
             ("k_horizontal", self.k_horizontal),
             ("k_vertical", self.k_vertical),
+            ("separation_k_h", self.separation_k_h),
+            ("separation_k_v", self.separation_k_v),
         ];
         for (what, v) in pos {
             if !(num_traits::Float::is_finite(v) && v > T::zero()) {
