@@ -402,6 +402,102 @@ def bench_utm(n_intents: int, n_sub: int, repeat: int) -> None:
         f"utm F3548 JSON parse + check: {t_json / n_json * 1e3:.2f} ms per 30-volume intent "
         f"(≈ {t_json / n_json * n_intents:.0f} s for {n_intents:.0e} intents)"
     )
+# --- issue 19: fleet-scale processing on Dask -------------------------------------------------
+
+_FLEET_PER_LOG = """
+import json, resource, sys, time, tracemalloc, warnings
+warnings.simplefilter("ignore")
+from uasnav.fleet.runner import process_log
+from uasnav.fleet import IMU_HEALTH, SCAN
+analysis = {"scan": SCAN, "imu_health": IMU_HEALTH}[sys.argv[2]]
+process_log(sys.argv[1], analysis, sys.argv[3] + "-warm")  # imports and caches: untimed
+c0 = time.process_time()
+r = process_log(sys.argv[1], analysis, sys.argv[3] + "-cpu")
+cpu = time.process_time() - c0
+tracemalloc.start()
+process_log(sys.argv[1], analysis, sys.argv[3] + "-mem")
+traced = tracemalloc.get_traced_memory()[1]
+print(json.dumps({"status": r.status, "cpu_s": cpu, "traced_mb": traced / 2**20,
+                  "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+
+def bench_fleet(vehicles: int, flights: int, duration_s: float, repeat: int) -> None:
+    """Fleet throughput (logs/s, MB/s) of ``imu-health`` and ``scan`` on LocalClusters of 1 and 2
+    worker processes (cluster started and warmed up before timing), and per-log CPU-seconds and
+    memory by format, in a fresh process per log after one untimed warm-up run: the task's peak
+    of Python/numpy allocations (tracemalloc; the Rust core's few buffers are not counted) and
+    the process' peak RSS (interpreter and libraries included)."""
+    import json
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    from distributed import Client
+
+    from uasnav import fleet
+
+    with tempfile.TemporaryDirectory(prefix="bench-fleet-") as tmp:
+        src = Path(tmp) / "fleet"
+        fleet.simulate_fleet(src, vehicles, flights, seed=1, duration_s=duration_s, corrupt=False)
+        mb = sum(f.stat().st_size for f in src.rglob("*.csv")) / 1e6
+        n = vehicles * flights
+        for analysis in (fleet.IMU_HEALTH, fleet.SCAN):
+            rates = {}
+            for workers in (1, 2):
+                cluster = fleet.local_cluster(workers)
+                client = Client(cluster)
+                # warm-up (imports on every worker), not timed
+                warm = [str(p) for p in sorted(src.rglob("*.csv"))[:workers]]
+                fleet.run(analysis, warm, Path(tmp) / f"warm-{analysis.name}-{workers}", client=client)
+                times = []
+                for k in range(repeat):
+                    out = Path(tmp) / f"{analysis.name}-{workers}-{k}.parquet"
+                    t0 = time.perf_counter()
+                    fleet.run(analysis, [src], out, client=client)
+                    times.append(time.perf_counter() - t0)
+                client.close()
+                cluster.close()
+                rates[workers] = statistics.median(times)
+            print(
+                f"fleet {analysis.name} {n} CSV v1 logs ({mb:.0f} MB, {duration_s:g} s at 100 Hz): "
+                + " | ".join(
+                    f"{w} worker(s) {n / t:5.2f} logs/s {mb / t:5.1f} MB/s" for w, t in rates.items()
+                )
+                + f" | speed-up 2 vs 1: {rates[1] / rates[2]:.2f}x"
+            )
+        shared = Path(__file__).resolve().parents[2] / "shared" / "data"
+        samples = {f"csv-v1 (simulated, {duration_s:g} s 100 Hz)": str(next(src.rglob("*.csv")))}
+        for label, rel in (
+            ("px4-ulog (px4_sample.ulg, 69 s)", "logs/px4_sample.ulg"),
+            ("ardupilot-dataflash (log171.bin, 3 IMUs)", "logs/ardupilot_log171.bin"),
+            ("mavlink-tlog (phoenix mission1)", "flights/phoenix_mission1_arducopter.tlog"),
+        ):
+            if (shared / rel).exists():
+                samples[label] = str(shared / rel)
+        for label, path in samples.items():
+            size = os.path.getsize(path) / 1e6
+            parts = []
+            for name in ("scan", "imu_health"):
+                cpu, traced, rss = [], [], []
+                for k in range(repeat):
+                    out = Path(tmp) / f"one-{name}-{k}-{abs(hash(path))}"
+                    r = subprocess.run(
+                        [sys.executable, "-c", _FLEET_PER_LOG, path, name, str(out)],
+                        capture_output=True, text=True, check=True,
+                    )  # fmt: skip
+                    d = json.loads(r.stdout.strip().splitlines()[-1])
+                    cpu.append(d["cpu_s"])
+                    traced.append(d["traced_mb"])
+                    rss.append(d["rss_mb"])
+                parts.append(
+                    f"{name} {statistics.median(cpu):5.2f} CPU-s, task peak "
+                    f"{statistics.median(traced):5.1f} MB (process RSS {statistics.median(rss):4.0f} MB) "
+                    f"[{d['status']}]"
+                )
+            print(f"fleet per log {label} {size:.1f} MB: " + " | ".join(parts))
 
 
 def bench_ins(n: int, n_peer: int, repeat: int) -> None:
@@ -480,6 +576,9 @@ CASES: dict[str, Callable[[bool], None]] = {
     "io": lambda quick: bench_io(10**4 if quick else 10**5, 1 if quick else 3),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
     "utm": lambda quick: bench_utm(10**4 if quick else 10**5, 500 if quick else 3000, 3),
+    "fleet": lambda quick: bench_fleet(
+        3 if quick else 5, 2 if quick else 8, 40.0 if quick else 120.0, 1 if quick else 3
+    ),
     "ins": lambda quick: bench_ins(
         10**5 if quick else 10**6, 10**4 if quick else 5 * 10**4, 3 if quick else 5
     ),

@@ -109,6 +109,10 @@ def _number(param: click.Parameter, hostile: bool) -> st.SearchStrategy[str]:
         valid = st.sampled_from(["10", "50", "100"])
     elif param.name in ("segment", "max_gap", "per_face", "prototypes"):
         valid = st.sampled_from(["1", "5", "10"])
+    elif param.name in ("vehicles", "flights"):
+        valid = st.sampled_from(["1", "2"])  # fleet simulate: a small fleet
+    elif param.name == "nav_flights":
+        valid = st.just("0")  # a simulated mission takes seconds (tested in tests/test_fleet.py)
     if not hostile:
         return valid
     bad = _HOSTILE_INTS if isinstance(param.type, click.types.IntParamType) else _HOSTILE_NUMBERS

@@ -82,7 +82,7 @@ def _apply(opts):  # type: ignore[no-untyped-def]
 
 
 @command.command("train")
-@click.argument("flights", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("flights", nargs=-1, required=True, type=click.Path())
 @click.option("--out", "out", required=True, type=OutputPath(), help="Model JSON to write.")
 @_apply(_common_opts)
 @click.option("--algorithm", type=click.Choice(["lvq1", "lvq2.1", "glvq"]), default="lvq1", show_default=True)
@@ -92,14 +92,15 @@ def _apply(opts):  # type: ignore[no-untyped-def]
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, prototypes, seed, as_json):  # type: ignore[no-untyped-def]
-    """Train a model on the flown elements of FLIGHT... (.tlog, .bin, .ulg, .csv) and write it."""
-    from uasnav.trajectory.flights import flight_samples
+    """Train a model on the flown elements of FLIGHT... (.tlog, .bin, .ulg, .csv, or element
+    datasets .parquet from `uasnav fleet elements`) and write it."""
+    from uasnav.trajectory.element_table import training_samples
     from uasnav.trajectory.predictor import TrajectoryPredictor
 
     check_outputs([*flights, plan], {"--out": out})
     wind = parse_wind(wind_text) if wind_text else None
-    fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
-    all_s = fs.concat()
+    # flight logs and/or element datasets (.parquet, e.g. from `uasnav fleet elements`)
+    all_s, n_runs = training_samples(flights, plan, speed, wind, segment, max_gap)
     import warnings
 
     from uasnav.trajectory.baselines import class_method_reason
@@ -115,7 +116,7 @@ def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, pro
     model.save(out)
     info = {
         "model": out,
-        "n_runs": len(fs),
+        "n_runs": n_runs,
         "n_elements": len(all_s),
         "n_classes": int((model.count_table_ > 0).sum()),
         "cruise_ms": model.cruise_ms_,

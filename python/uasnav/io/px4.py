@@ -20,6 +20,7 @@ and warn once with the counts (:class:`~uasnav.errors.CorruptDataWarning`).
 
 from __future__ import annotations
 
+import datetime as dt
 import os
 from pathlib import Path
 from typing import Any
@@ -135,6 +136,14 @@ def read_ulog(path: str | os.PathLike[str]) -> ImuLog:
     ulog, decoder = _open(p)
     sp = str(p)
     meta: dict[str, Any] = {"source": sp, "format": "px4-ulog", "frame": "FRD"}
+    # the flight controller's identity when the log records it (uasnav.fleet partitions by it)
+    info = getattr(ulog, "msg_info_dict", None) or {}
+    meta.update(
+        {k: str(info[i]) for k, i in (("vehicle", "sys_uuid"), ("hardware", "ver_hw")) if info.get(i)}
+    )
+    start = _start_utc(ulog)
+    if start is not None:
+        meta["start_time"] = start
     sc = _dataset(ulog, "sensor_combined")
     mag = None
     if sc is not None:
@@ -176,6 +185,65 @@ def read_ulog(path: str | os.PathLike[str]) -> ImuLog:
     meta["topic"] = topic
     meta.update(corruption_meta(decoder, dropped + temp_dropped))
     return build_log(sp, topic, t, gyro, accel, temp, meta, mag=mag)
+
+
+def _start_utc(ulog: Any) -> str | None:
+    """UTC (ISO 8601) of the log's start from the first GNSS record with a UTC time, or None."""
+    g = _dataset(ulog, "vehicle_gps_position") or _dataset(ulog, "sensor_gps")
+    if g is None or "time_utc_usec" not in g.data:
+        return None
+    utc = np.asarray(g.data["time_utc_usec"], dtype=np.float64)
+    k = np.flatnonzero(utc > 946_684_800e6)  # after 2000: a real UTC time
+    if not k.size:
+        return None
+    i = int(k[0])
+    t0 = float(utc[i] - (float(g.data["timestamp"][i]) - float(ulog.start_timestamp))) * 1e-6
+    return dt.datetime.fromtimestamp(t0, tz=dt.timezone.utc).isoformat(timespec="milliseconds")
+
+
+def read_ulog_imus(path: str | os.PathLike[str]) -> dict[str, ImuLog]:
+    """Every IMU of a PX4 ULog: the primary (:func:`read_ulog`, keyed by its topic) and each
+    ``sensor_gyro``/``sensor_accel`` instance pair N logged, keyed ``sensor_imu[N]`` (the
+    accelerometer interpolated to the gyro's sample times, both FRD in rad/s and m/s²; the
+    gyro's temperature, °C). An instance with fewer than 2 valid records is left out.
+
+    Raises
+    ------
+    DataFormatError
+        As :func:`read_ulog` (the primary IMU is required).
+    """
+    p = Path(path)
+    primary = read_ulog(p)
+    out = {str(primary.meta["topic"]): primary}
+    ulog, _ = _open(p)
+    sp = str(p)
+    for g in [d for d in ulog.data_list if d.name == "sensor_gyro"]:
+        a = _dataset(ulog, "sensor_accel", g.multi_id)
+        if a is None or not {"x", "y", "z"} <= set(g.data) or not {"x", "y", "z"} <= set(a.data):
+            continue
+        tg = np.asarray(g.data["timestamp"], dtype=np.float64) * 1e-6
+        ta = np.asarray(a.data["timestamp"], dtype=np.float64) * 1e-6
+        if tg.size < 2 or ta.size < 2 or np.any(np.diff(ta) <= 0):
+            continue
+        gyro = np.column_stack([np.asarray(g.data[c], dtype=np.float64) for c in "xyz"])
+        accel = np.column_stack([np.interp(tg, ta, np.asarray(a.data[c], dtype=np.float64)) for c in "xyz"])
+        temp = np.asarray(g.data["temperature"], dtype=np.float64) if "temperature" in g.data else None
+        values = {"gyro": gyro, "accel": accel}
+        keep = salvage(tg, values, imu_limits(False))
+        keep &= (tg >= ta[0]) & (tg <= ta[-1])  # no extrapolated accelerometer samples
+        if keep.sum() < 2:
+            continue
+        if temp is not None and not np.all(np.isfinite(temp[keep])):
+            temp = None
+        name = f"sensor_imu[{g.multi_id}]"
+        meta = {"source": sp, "format": "px4-ulog", "frame": "FRD", "topic": name}
+        meta.update({k: primary.meta[k] for k in ("vehicle", "hardware", "start_time") if k in primary.meta})
+        if "device_id" in g.data:
+            meta["device_id"] = str(int(g.data["device_id"][0]))
+        out[name] = build_log(
+            sp, name, tg[keep], gyro[keep], accel[keep], None if temp is None else temp[keep], meta
+        )
+    return out
 
 
 def read_ulog_flight(path: str | os.PathLike[str]) -> FlightLog:
@@ -229,4 +297,4 @@ def read_ulog_flight(path: str | os.PathLike[str]) -> FlightLog:
     return flight_from_fixes(fixes, p, waypoints={}, reached=reached, wind=wind, decoder=decoder)
 
 
-__all__ = ["read_ulog", "read_ulog_flight"]
+__all__ = ["read_ulog", "read_ulog_flight", "read_ulog_imus"]
