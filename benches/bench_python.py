@@ -402,6 +402,8 @@ def bench_utm(n_intents: int, n_sub: int, repeat: int) -> None:
         f"utm F3548 JSON parse + check: {t_json / n_json * 1e3:.2f} ms per 30-volume intent "
         f"(≈ {t_json / n_json * n_intents:.0f} s for {n_intents:.0e} intents)"
     )
+
+
 # --- issue 19: fleet-scale processing on Dask -------------------------------------------------
 
 _FLEET_PER_LOG = """
