@@ -54,6 +54,7 @@ by the user, never assumed) → #6 TMPR → #7 SAIL → #9 OSOs.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -331,6 +332,9 @@ def igrc_25(dimension_m: float, speed_ms: float, population: str, mass_g: float 
 CASEX_MIN_MASS_G = 1000.0
 
 
+# A pure function of four numbers that rebuilds casex's models (≈ 2 ms) on every call: the web
+# app asks for the same UA's value on every request, so the last results are kept.
+@functools.lru_cache(maxsize=1024)
 def annex_f_igrc(
     *, dimension_m: float, speed_ms: float, mass_g: float, density_ppl_km2: float
 ) -> tuple[int, float, float]:
