@@ -171,15 +171,12 @@ def _simulate_flight(
 ) -> None:
     """``--profile flight``: OUT holds gyro, accel, temp, mx/my/mz and truth_* (lat, lon deg;
     alt m; vel m/s NED; euler deg; gyro/accel bias); OUT_gnss.csv the GNSS fixes."""
-    import dataclasses
-
-    import numpy as np
 
     from uasnav.atomicfile import output_set
     from uasnav.io import write_log
     from uasnav.io.gnss_csv import write_gnss_csv
     from uasnav.sim import load_preset
-    from uasnav.sim.flight import simulate_flight
+    from uasnav.sim.flight import imu_log_with_truth, simulate_flight
 
     gnss_path = out_path.with_name(f"{out_path.stem}_gnss.csv")
     check_outputs([preset], {"--out": [out_path, gnss_path]})
@@ -196,20 +193,7 @@ def _simulate_flight(
         height_m=height_m,
         preset=model,
     )
-    tr = f.truth
-    assert tr is not None and tr.vel is not None and tr.euler_deg is not None and f.mag is not None
-    t = f.imu.t
-    mag = np.column_stack([np.interp(t, f.mag.t, f.mag.field[:, i]) for i in range(3)])
-    truth = {
-        "lat": tr.lat,
-        "lon": tr.lon,
-        "alt": tr.alt,
-        "vel": tr.vel,
-        "euler_deg": tr.euler_deg,
-        "gyro_bias": tr.extra["gyro_bias"],
-        "accel_bias": tr.extra["accel_bias"],
-    }
-    log = dataclasses.replace(f.imu, mag=mag, truth=truth)
+    log = imu_log_with_truth(f)
     with output_set():  # the IMU log and the GNSS file, or neither
         write_log(log, out_path)
         write_gnss_csv(gnss_path, f.gnss)

@@ -156,23 +156,7 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
     feas = None
     if req is not None:
         feas = model.feasibility(plan_ne, np.array(req), wind, tolerance, speed)
-    el, f = p.elements, p.features
-    rows = [
-        {
-            "element": i,
-            "kind": str(el.kind[i]),
-            "length_m": float(el.length_m[i]),
-            "theta_deg": float(f.theta_deg[i]),
-            "theta_w_deg": float(f.theta_w_deg[i]),
-            "wind_ms": float(f.wind_ms[i]),
-            "class": int(p.cell_used[i]),
-            "dv_ms": float(p.dv_ms[i]),
-            "time_s": float(p.time_s[i]),
-            "low_confidence": bool(p.flags[i]),
-            "flags": p.flags[i],
-        }
-        for i in range(len(el))
-    ]
+    rows = p.element_rows()
     if as_json:
         out = {"eta_s": p.eta_s, "waypoint_times_s": p.waypoint_times_s, "elements": rows}
         if feas is not None:

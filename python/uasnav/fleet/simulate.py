@@ -160,7 +160,7 @@ def _nav_flight(
     from uasnav.io import write_csv_v1
     from uasnav.io.gnss_csv import write_gnss_csv
     from uasnav.io.tlog_write import write_tlog_flight
-    from uasnav.sim.flight import simulate_flight
+    from uasnav.sim.flight import imu_log_with_truth, simulate_flight
     from uasnav.trajectory.geometry import geodetic_to_local
 
     rng = np.random.default_rng([seed, vehicle, flight, 15])
@@ -171,19 +171,9 @@ def _nav_flight(
         waypoints=circuit, duration_s=duration_s, speed_m_s=speed, rate_hz=rate_hz, latitude_deg=lat0,
         longitude_deg=lon0, height_m=300.0, preset=model_name, seed=int(rng.integers(2**31)),
     )  # fmt: skip
+    log_with_truth = imu_log_with_truth(f)
     tr = f.truth
-    assert tr is not None and tr.vel is not None and tr.euler_deg is not None and f.mag is not None
-    t = f.imu.t
-    mag = np.column_stack([np.interp(t, f.mag.t, f.mag.field[:, i]) for i in range(3)])
-    truth = {
-        "lat": tr.lat,
-        "lon": tr.lon,
-        "alt": tr.alt,
-        "vel": tr.vel,
-        "euler_deg": tr.euler_deg,
-        "gyro_bias": tr.extra["gyro_bias"],
-        "accel_bias": tr.extra["accel_bias"],
-    }
+    assert tr is not None and tr.vel is not None  # imu_log_with_truth checked it
     meta = {
         "vehicle": vehicle_id,
         "autopilot": "uasnav-sim",
@@ -191,7 +181,7 @@ def _nav_flight(
         "start_time": start.isoformat().replace("+00:00", "Z"),
         "rate_hz": f"{rate_hz:g}",
     }
-    log = dataclasses.replace(f.imu, mag=mag, truth=truth, meta={**f.imu.meta, **meta})
+    log = dataclasses.replace(log_with_truth, meta={**f.imu.meta, **meta})
     write_csv_v1(log, out_p / f"{name}.csv")
     write_gnss_csv(out_p / f"{name}_gnss.csv", f.gnss)
     # telemetry: the true track at the GNSS instants, on the wall clock of the flight's start

@@ -27,6 +27,7 @@ Deterministic from ``seed``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -339,6 +340,28 @@ def simulate_flight(
 def _quat(rot: Rotation) -> FloatArray:
     q = rot.as_quat()  # scalar last
     return np.column_stack([q[:, 3], q[:, :3]])
+
+
+def imu_log_with_truth(flight: Flight) -> ImuLog:
+    """The IMU log of a simulated ``flight`` as log format v1 carries it: the magnetometer
+    interpolated to the IMU times (µT) and the truth as ``truth_*`` channels (lat, lon in deg,
+    alt in m, NED velocity m/s, roll/pitch/yaw deg, gyro bias rad/s, accel bias m/s²) — what
+    ``uasnav simulate --profile flight`` and the synthetic fleet write beside the GNSS CSV."""
+    tr = flight.truth
+    if tr is None or tr.vel is None or tr.euler_deg is None or flight.mag is None:
+        raise InputError("flight: a simulated flight with truth and magnetometer is needed")
+    t = flight.imu.t
+    mag = np.column_stack([np.interp(t, flight.mag.t, flight.mag.field[:, i]) for i in range(3)])
+    truth = {
+        "lat": tr.lat,
+        "lon": tr.lon,
+        "alt": tr.alt,
+        "vel": tr.vel,
+        "euler_deg": tr.euler_deg,
+        "gyro_bias": tr.extra["gyro_bias"],
+        "accel_bias": tr.extra["accel_bias"],
+    }
+    return dataclasses.replace(flight.imu, mag=mag, truth=truth)
 
 
 def matched_config_values(errors: FlightErrors | None = None) -> dict[str, float]:

@@ -82,6 +82,28 @@ class PlanPrediction:
         """Boolean mask of flagged elements."""
         return np.array([bool(f) for f in self.flags], dtype=bool)
 
+    def element_rows(self) -> list[dict]:
+        """One plain dict per element (what ``uasnav trajectory predict --json`` prints under
+        ``elements`` and the web app shows): kind, length (m), turn and relative wind angles
+        (deg), wind (m/s), class used, ΔV (m/s), predicted time (s), lower-confidence flags."""
+        el, f = self.elements, self.features
+        return [
+            {
+                "element": i,
+                "kind": str(el.kind[i]),
+                "length_m": float(el.length_m[i]),
+                "theta_deg": float(f.theta_deg[i]),
+                "theta_w_deg": float(f.theta_w_deg[i]),
+                "wind_ms": float(f.wind_ms[i]),
+                "class": int(self.cell_used[i]),
+                "dv_ms": float(self.dv_ms[i]),
+                "time_s": float(self.time_s[i]),
+                "low_confidence": bool(self.flags[i]),
+                "flags": list(self.flags[i]),
+            }
+            for i in range(len(el))
+        ]
+
 
 @dataclass
 class Feasibility:

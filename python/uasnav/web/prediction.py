@@ -193,7 +193,7 @@ def predict_plan(
     feas = None
     if required_s is not None:
         feas = Feasibility(np.asarray(required_s, dtype=float), p.waypoint_times_s, float(tolerance_s))
-    el, f = p.elements, p.features
+    el = p.elements
     latlon = None
     if origin is not None:
         import pymap3d
@@ -215,27 +215,18 @@ def predict_plan(
             w["required_s"] = float(feas.required_s[i])
             w["ok"] = bool(feas.ok[i])
         waypoints.append(w)
+    # the predictor's own rows (as `uasnav trajectory predict --json`), plus what the page draws
     elements = [
         {
-            "element": i,
-            "kind": str(el.kind[i]),
-            "length_m": float(el.length_m[i]),
-            "theta_deg": float(f.theta_deg[i]),
-            "theta_w_deg": float(f.theta_w_deg[i]),
-            "wind_ms": float(f.wind_ms[i]),
-            "class": int(p.cell_used[i]),
-            "dv_ms": float(p.dv_ms[i]),
-            "time_s": float(p.time_s[i]),
+            **row,
             "start_time_s": float(np.sum(p.time_s[:i])),
-            "low_confidence": bool(p.flags[i]),
-            "flags": list(p.flags[i]),
             "path_ne_m": [
                 [float(el.start_ne[i, 0]), float(el.start_ne[i, 1])],
                 [float(el.mid_ne[i, 0]), float(el.mid_ne[i, 1])],
                 [float(el.end_ne[i, 0]), float(el.end_ne[i, 1])],
             ],
         }
-        for i in range(len(el))
+        for i, row in enumerate(p.element_rows())
     ]
     return RoutePrediction(
         eta_s=float(p.eta_s),
