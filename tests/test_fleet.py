@@ -695,3 +695,23 @@ def test_url_sources_in_process_and_cli(log_server, fleet_dir, reference, tmp_pa
     (tmp_path / "s3.urls").write_text("s3://bucket/log.ulg\n")
     with pytest.raises(InputError, match="s3:// URLs are not supported"):
         fleet.run(fleet.SCAN, [tmp_path / "s3.urls"], tmp_path / "x.parquet", workers=0)
+
+
+def test_cli_memory_limit_of_the_local_workers(fleet_dir, tmp_path):
+    run = CliRunner().invoke
+    out = tmp_path / "s.parquet"
+    r = run(
+        main,
+        ["fleet", "scan", str(fleet_dir / "V01"), "--out", str(out), "--workers", "1",
+         "--memory-limit", "700M", "--json"],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    info = json.loads(r.stdout)
+    assert (info["workers"], info["worker_memory_limit"], info["ok"]) == (1, 700 * 1024**2, 2)
+    for argv, msg in (
+        (["--memory-limit", "1G", "--workers", "0"], "local cluster"),
+        (["--memory-limit", "lots"], "--memory-limit"),
+        (["--memory-limit", "1k"], "at least 64M"),
+    ):
+        r = run(main, ["fleet", "scan", str(fleet_dir), "--out", str(tmp_path / "x.parquet"), *argv])
+        assert r.exit_code == 2 and msg in r.stderr, r.output

@@ -95,7 +95,7 @@ def opener(deadline: Deadline) -> urllib.request.OpenerDirector:
                 super().__init__(*args, **kw)  # type: ignore[arg-type]
                 # Watch the TCP socket as soon as it exists, so that a TLS handshake or a proxy
                 # CONNECT that drips is cut at the deadline too.
-                create = self._create_connection
+                create = self._create_connection  # type: ignore[has-type]
 
                 def create_watched(*a: object, **k: object) -> socket.socket:
                     sock = create(*a, **k)
@@ -136,7 +136,7 @@ def opener(deadline: Deadline) -> urllib.request.OpenerDirector:
     return urllib.request.build_opener(Http, Https, Redirect)
 
 
-def one_line(exc: BaseException) -> str:
+def one_line(exc: BaseException | str) -> str:
     """An exception's text on one line, at most 200 characters (servers send anything)."""
     text = " ".join(str(exc).split()) or type(exc).__name__
     return text if len(text) <= 200 else text[:197] + "..."

@@ -272,6 +272,8 @@ class RunSummary:
     cpu_s: float = 0.0
     workers: int = 0
     scheduler: str = "in-process"
+    #: Smallest memory limit of the cluster's workers (bytes; None in process or unlimited).
+    worker_memory_limit: int | None = None
     errors: list[dict[str, str | None]] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
 
@@ -318,6 +320,7 @@ def run(
     progress: Progress = None,
     fetch_timeout_s: float = FETCH_TIMEOUT_S,
     fetch_max_bytes: int | None = None,
+    memory_limit: str | int = "auto",
 ) -> RunSummary:
     """Run ``analysis`` over every log of ``sources`` and write the dataset ``out``.
 
@@ -342,6 +345,9 @@ def run(
     fetch_timeout_s, fetch_max_bytes : optional
         Total deadline (s) and size limit (bytes, default :func:`uasnav.limits.max_memory` on
         the worker) of the download of each http(s) log.
+    memory_limit : str or int
+        Memory limit of each worker process of the local cluster (bytes, or Dask's ``"auto"``:
+        the machine's memory ÷ workers); a worker above it is restarted by its nanny.
 
     Returns
     -------
@@ -370,7 +376,7 @@ def run(
     fetch = {"fetch_timeout_s": fetch_timeout_s, "fetch_max_bytes": fetch_max_bytes}
     try:
         return _run(analysis, out_p, todo, len(paths), skipped, manifest or Manifest(out_p), t0,
-                    client, scheduler, scheduler_file, workers, progress, fetch)  # fmt: skip
+                    client, scheduler, scheduler_file, workers, progress, fetch, memory_limit)  # fmt: skip
     except BaseException:
         # a run that failed before committing anything (e.g. no scheduler at that address)
         # leaves nothing behind
@@ -393,6 +399,7 @@ def _run(
     workers: int | None,
     progress: Progress,
     fetch: dict[str, Any],
+    memory_limit: str | int = "auto",
 ) -> RunSummary:
     summary = RunSummary(analysis.name, str(out_p), n_logs, n_skipped=skipped)
     if progress is not None:
@@ -432,7 +439,17 @@ def _run(
             record(process_log(p, analysis, str(out_p), **fetch))
     elif todo:
         _run_distributed(
-            analysis, todo, out_p, record, summary, client, scheduler, scheduler_file, workers, fetch
+            analysis,
+            todo,
+            out_p,
+            record,
+            summary,
+            client,
+            scheduler,
+            scheduler_file,
+            workers,
+            fetch,
+            memory_limit,
         )
     if analysis.finish is not None:
         summary.extra = analysis.finish(out_p) or {}
@@ -451,6 +468,7 @@ def _run_distributed(
     scheduler_file: str | None,
     workers: int | None,
     fetch: dict[str, Any],
+    memory_limit: str | int = "auto",
 ) -> None:
     from distributed import Client, as_completed
 
@@ -460,11 +478,13 @@ def _run_distributed(
         if scheduler is not None or scheduler_file is not None:
             client = Client(address=scheduler, scheduler_file=scheduler_file, timeout="30s")
         else:
-            cluster = local_cluster(workers)
+            cluster = local_cluster(workers, memory_limit)
             client = Client(cluster)
     try:
         summary.scheduler = str(client.scheduler.address)
         summary.workers = len(client.nthreads())
+        limits = [w.get("memory_limit") for w in client.scheduler_info().get("workers", {}).values()]
+        summary.worker_memory_limit = min((int(m) for m in limits if m), default=None)
         # Keys name the analysis and the log: a task is identified by what it computes, so a
         # resubmission (after a lost worker) is the same task.
         futures = client.map(process_log, todo, analysis=analysis, out=str(out), pure=False, **fetch)
