@@ -520,3 +520,198 @@ def test_cli_fleet_nav_and_simulate_nav_flights(tmp_path):
     assert res.exit_code == 0, res.output
     info = json.loads(res.output)
     assert (info["logs"], info["ok"], info["rows"], info["errors"]) == (3, 1, 1, 0)
+
+
+# --- logs named by http(s) URLs: each worker downloads its own log ---------------------------
+
+_SLOW_S = 20.0  # how long /slow.csv drips (the runs below give up after 2 s)
+
+
+@pytest.fixture(scope="module")
+def log_server(fleet_dir):
+    """A real HTTP server on loopback serving the simulated fleet, plus broken URLs: /slow.csv
+    drips one byte per 0.2 s, /huge.csv streams 8 MB without Content-Length, /moved.csv
+    redirects to a file:// URL; anything else missing is a 404. Records every GET."""
+    from functools import partial
+    from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+
+    stop = threading.Event()
+    requested: list[str] = []
+
+    class Handler(SimpleHTTPRequestHandler):
+        def log_message(self, *args):  # quiet
+            pass
+
+        def do_GET(self):
+            requested.append(self.path)
+            if self.path == "/slow.csv":
+                self.send_response(200)
+                self.send_header("Content-Length", "1000")
+                self.end_headers()
+                t0 = time.monotonic()
+                while not stop.is_set() and time.monotonic() - t0 < _SLOW_S:
+                    try:
+                        self.wfile.write(b"#")
+                        self.wfile.flush()
+                    except OSError:
+                        return
+                    stop.wait(0.2)
+            elif self.path == "/huge.csv":
+                self.send_response(200)
+                self.end_headers()  # no Content-Length: the size is found while reading
+                try:
+                    for _ in range(8):
+                        self.wfile.write(b"0" * (1 << 20))
+                except OSError:
+                    pass
+                self.close_connection = True
+            elif self.path == "/moved.csv":
+                self.send_response(302)
+                self.send_header("Location", "file:///etc/passwd")
+                self.end_headers()
+            else:
+                super().do_GET()
+
+    server = ThreadingHTTPServer(("127.0.0.1", 0), partial(Handler, directory=str(fleet_dir)))
+    server.daemon_threads = True
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{server.server_address[1]}", requested
+    stop.set()
+    server.shutdown()
+    server.server_close()
+
+
+def _url_list(path, base, fleet_dir, logs, broken=()):
+    lines = ["# a fleet's logs on a web server"] + [
+        f"{base}/{Path(p).relative_to(fleet_dir).as_posix()}" for p in logs
+    ]
+    path.write_text("\n".join([*lines, *(f"{base}/{b}" for b in broken)]) + "\n")
+    return path
+
+
+_BROKEN = ("missing.csv", "slow.csv", "huge.csv", "moved.csv")
+
+
+def _check_broken(errors, base):
+    by_path = dict(zip(errors.column("path").to_pylist(), errors.column("error").to_pylist(), strict=True))
+    kinds = dict(zip(errors.column("path").to_pylist(), errors.column("error_type").to_pylist(), strict=True))
+    assert "HTTP 404" in by_path[f"{base}/missing.csv"]
+    assert "timeout of 2 s" in by_path[f"{base}/slow.csv"]
+    assert "size limit of 4194304 bytes" in by_path[f"{base}/huge.csv"]
+    assert "redirect to 'file:///etc/passwd' refused" in by_path[f"{base}/moved.csv"]
+    assert all(kinds[f"{base}/{b}"] == "FetchError" for b in _BROKEN)
+
+
+def test_url_list_equals_the_logs_read_from_disk(client, log_server, fleet_dir, reference, tmp_path):
+    """A .urls list of http:// logs on the 2-worker cluster: the same rows and hashes as the
+    logs read from disk, the corrupt log and every broken URL in the errors table (with the URL
+    and the reason), temporary downloads removed; --resume fetches only what is missing."""
+    import tempfile
+
+    base, requested = log_server
+    _, ref_rows, ref_errors = reference["imu_health"]
+    logs = sorted({*ref_rows.column("path").to_pylist(), *ref_errors.column("path").to_pylist()})
+    assert len(logs) == 7
+    url_of = {p: f"{base}/{Path(p).relative_to(fleet_dir).as_posix()}" for p in logs}
+    fetch = {"fetch_timeout_s": 2.0, "fetch_max_bytes": 4 << 20}
+    assert max(os.path.getsize(p) for p in logs) < 4 << 20
+    tmp0 = set(Path(tempfile.gettempdir()).glob("uasnav-fleet-*"))
+
+    # first run: 3 of the logs and the broken URLs
+    out = tmp_path / "h.parquet"
+    first = fleet.run(
+        fleet.IMU_HEALTH, [_url_list(tmp_path / "a.urls", base, fleet_dir, logs[:3], _BROKEN)], out,
+        client=client, **fetch,
+    )  # fmt: skip
+    assert (first.n_logs, first.n_errors) == (7, 4 + (ref_errors.column("path")[0].as_py() in logs[:3]))
+    _check_broken(read_errors(out), base)
+    # resume with the whole list: the 3 finished URLs are not fetched again, the broken ones are
+    # tried again (a URL may come back), the 4 others are fetched once each
+    requested.clear()
+    full = _url_list(tmp_path / "all.urls", base, fleet_dir, logs, _BROKEN)
+    again = fleet.run(fleet.IMU_HEALTH, [full], out, client=client, resume=True, **fetch)
+    assert (again.n_logs, again.n_skipped) == (11, 3)
+    got_paths = sorted(requested)
+    assert got_paths == sorted([f"/{b}" for b in _BROKEN] + [url_of[p][len(base) :] for p in logs[3:]])
+
+    rows = read_dataset(out)
+    # the same numbers and content hashes as from disk; the path column names the URL
+    assert rows.drop_columns(["path"]).equals(ref_rows.drop_columns(["path"]))
+    assert rows.column("path").to_pylist() == [url_of[p] for p in ref_rows.column("path").to_pylist()]
+    errors = read_errors(out)
+    _check_broken(errors, base)
+    bad = url_of[ref_errors.column("path")[0].as_py()]
+    bad_row = errors.filter(pa_compute_equal(errors, "path", bad))
+    assert bad_row.num_rows == 1
+    assert bad_row.column("error")[0].as_py() == ref_errors.column("error")[0].as_py().replace(
+        ref_errors.column("path")[0].as_py(), bad
+    )
+    assert bad_row.column("log_hash").equals(ref_errors.column("log_hash"))
+    assert errors.num_rows == 5
+    assert (
+        fleet.read_scores(out)
+        .drop_columns(["path"])
+        .equals(fleet.read_scores(Path(reference["imu_health"][0].out)).drop_columns(["path"]))
+    )
+    # the manifest holds each URL once, by content hash; the broken ones are not in it
+    entries = [json.loads(x) for x in (out / MANIFEST).read_text().splitlines()]
+    assert sorted(e["path"] for e in entries) == sorted(url_of.values())
+    assert {e["log_hash"] for e in entries} == {
+        *ref_rows.column("log_hash").to_pylist(),
+        *ref_errors.column("log_hash").to_pylist(),
+    }
+    # a rerun fetches only the broken URLs again; nothing left in the workers' temporary folder
+    requested.clear()
+    nothing = fleet.run(fleet.IMU_HEALTH, [full], out, client=client, resume=True, **fetch)
+    assert (nothing.n_skipped, nothing.n_ok, nothing.n_errors) == (7, 0, 4)
+    assert sorted(requested) == sorted(f"/{b}" for b in _BROKEN)
+    assert set(Path(tempfile.gettempdir()).glob("uasnav-fleet-*")) == tmp0
+
+
+def pa_compute_equal(table, column, value):
+    import pyarrow.compute as pc
+
+    return pc.equal(table.column(column), value)
+
+
+def test_url_sources_in_process_and_cli(log_server, fleet_dir, reference, tmp_path):
+    """The single-process path and the CLI take the same URL lists; other schemes are refused."""
+    base, _ = log_server
+    _, ref_rows, _ = reference["scan"]
+    logs = sorted(ref_rows.column("path").to_pylist())[:2]
+    lst = _url_list(tmp_path / "two.list", base, fleet_dir, logs, ["missing.csv"])
+    r = CliRunner().invoke(
+        main, ["fleet", "scan", str(lst), "--out", str(tmp_path / "s.parquet"), "--workers", "0", "--json"]
+    )
+    assert r.exit_code == 0, r.output
+    summary = json.loads(r.stdout)
+    assert (summary["logs"], summary["ok"], summary["errors"]) == (3, 2, 1)
+    assert "HTTP 404" in summary["error_list"][0]["error"]
+    rows = read_dataset(tmp_path / "s.parquet")
+    want = ref_rows.filter(pa_compute_equal(ref_rows, "path", logs[0])).drop_columns(["path"])
+    got = rows.filter(pa_compute_equal(rows, "log_hash", want.column("log_hash")[0])).drop_columns(["path"])
+    assert got.equals(want)
+    (tmp_path / "s3.urls").write_text("s3://bucket/log.ulg\n")
+    with pytest.raises(InputError, match="s3:// URLs are not supported"):
+        fleet.run(fleet.SCAN, [tmp_path / "s3.urls"], tmp_path / "x.parquet", workers=0)
+
+
+def test_cli_memory_limit_of_the_local_workers(fleet_dir, tmp_path):
+    run = CliRunner().invoke
+    out = tmp_path / "s.parquet"
+    r = run(
+        main,
+        ["fleet", "scan", str(fleet_dir / "V01"), "--out", str(out), "--workers", "1",
+         "--memory-limit", "700M", "--json"],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    info = json.loads(r.stdout)
+    assert (info["workers"], info["worker_memory_limit"], info["ok"]) == (1, 700 * 1024**2, 2)
+    for argv, msg in (
+        (["--memory-limit", "1G", "--workers", "0"], "local cluster"),
+        (["--memory-limit", "lots"], "--memory-limit"),
+        (["--memory-limit", "1k"], "at least 64M"),
+    ):
+        r = run(main, ["fleet", "scan", str(fleet_dir), "--out", str(tmp_path / "x.parquet"), *argv])
+        assert r.exit_code == 2 and msg in r.stderr, r.output

@@ -17,7 +17,8 @@ def command() -> None:
     """Process a fleet's logs on a Dask cluster (a local one by default).
 
     SOURCE is a directory (scanned recursively for .ulg .bin .tlog .csv .txt .npz), a glob
-    pattern, a list file (.list/.urls: one path or file:// URL per line) or a log file. The
+    pattern, a list file (.list/.urls: one path, file:// or http(s):// URL per line; each worker
+    downloads its URL logs itself) or a log file. The
     output is a Parquet dataset directory (partitioned by vehicle and day, one file per log);
     unreadable logs go to its errors table and never stop the run.
     """
@@ -27,6 +28,20 @@ def _check_scheduler(ctx: click.Context, param: click.Parameter, value: str | No
     if value is not None and "://" not in value:
         raise click.BadParameter(f"expected an address like tcp://HOST:8786, got {value!r}")
     return value
+
+
+def _check_memory_limit(ctx: click.Context, param: click.Parameter, value: str | None) -> str | int | None:
+    if value is None or value.strip().lower() == "auto":
+        return value and "auto"
+    from uasnav.limits import parse_size
+
+    try:
+        n = parse_size(value, "--memory-limit")
+    except InputError as e:
+        raise click.BadParameter(str(e)) from None
+    if n < 64 * 1024**2:
+        raise click.BadParameter(f"expected at least 64M per worker process, got {value!r}")
+    return n
 
 
 def _run_options(f: Any) -> Any:
@@ -47,6 +62,10 @@ def _run_options(f: Any) -> Any:
         click.option(
             "--workers", type=click.IntRange(0, 4096),
             help="Worker processes of the local cluster (default one per core; 0 = in this process).",
+        ),
+        click.option(
+            "--memory-limit", callback=_check_memory_limit, metavar="SIZE",
+            help="Memory limit of each local worker process (e.g. 2G; default auto: memory ÷ workers).",
         ),
         click.option("--resume", is_flag=True, help="Continue a run in --out: only logs not yet finished."),
         click.option("--json", "as_json", is_flag=True, help="Print the run summary as JSON."),
@@ -79,7 +98,8 @@ def _progress() -> Any:
 
 
 def _execute(analysis: Any, sources: tuple[str, ...], out: str, scheduler: str | None,
-             scheduler_file: str | None, workers: int | None, resume: bool) -> Any:  # fmt: skip
+             scheduler_file: str | None, workers: int | None, resume: bool,
+             memory_limit: str | int | None = None) -> Any:  # fmt: skip
     from uasnav.fleet.runner import run
 
     _check_out(out, ".parquet")
@@ -87,9 +107,11 @@ def _execute(analysis: Any, sources: tuple[str, ...], out: str, scheduler: str |
         raise click.UsageError("give --scheduler or --scheduler-file, not both")
     if workers is not None and (scheduler or scheduler_file):
         raise click.UsageError("--workers sizes the local cluster; it does not apply with --scheduler")
+    if memory_limit is not None and (scheduler or scheduler_file or workers == 0):
+        raise click.UsageError("--memory-limit applies to the local cluster's workers only")
     return run(
         analysis, list(sources), out, scheduler=scheduler, scheduler_file=scheduler_file,
-        workers=workers, resume=resume, progress=_progress(),
+        workers=workers, resume=resume, progress=_progress(), memory_limit=memory_limit or "auto",
     )  # fmt: skip
 
 
@@ -109,6 +131,7 @@ def _print(summary: Any, as_json: bool) -> None:
         "logs_per_s": summary.logs_per_s,
         "workers": summary.workers,
         "scheduler": summary.scheduler,
+        "worker_memory_limit": summary.worker_memory_limit,
         "error_list": summary.errors,
         **summary.extra,
     }
@@ -128,11 +151,11 @@ def _print(summary: Any, as_json: bool) -> None:
 
 @command.command("scan")
 @_run_options
-def scan(sources, out, scheduler, scheduler_file, workers, resume, as_json):  # type: ignore[no-untyped-def]
+def scan(sources, out, scheduler, scheduler_file, workers, resume, memory_limit, as_json):  # type: ignore[no-untyped-def]
     """Inventory: one row per log (format, vehicle, start, duration, IMUs, GNSS, mission, hash)."""
     from uasnav.fleet.scan import SCAN
 
-    _print(_execute(SCAN, sources, out, scheduler, scheduler_file, workers, resume), as_json)
+    _print(_execute(SCAN, sources, out, scheduler, scheduler_file, workers, resume, memory_limit), as_json)
 
 
 @command.command("imu-health")
@@ -140,13 +163,13 @@ def scan(sources, out, scheduler, scheduler_file, workers, resume, as_json):  # 
 @click.option(
     "--report", "report_path", type=OutputPath(), help="Write an HTML page (FLEET.html) of the fleet."
 )
-def imu_health(sources, out, scheduler, scheduler_file, workers, resume, as_json, report_path):  # type: ignore[no-untyped-def]
+def imu_health(sources, out, scheduler, scheduler_file, workers, resume, memory_limit, as_json, report_path):  # type: ignore[no-untyped-def]
     """Per log and IMU: noise terms, turn-on bias, temperature slope, vibration, clipping, anomaly score."""
     from uasnav.fleet.imu_health import IMU_HEALTH
 
     if report_path is not None:
         _check_out(report_path, ".html", "--report")
-    summary = _execute(IMU_HEALTH, sources, out, scheduler, scheduler_file, workers, resume)
+    summary = _execute(IMU_HEALTH, sources, out, scheduler, scheduler_file, workers, resume, memory_limit)
     if report_path is not None:
         from uasnav.fleet.html import write_health_report
 
@@ -166,21 +189,25 @@ def imu_health(sources, out, scheduler, scheduler_file, workers, resume, as_json
     show_default=True,
     help="Largest telemetry gap in an element (s).",
 )
-def elements(sources, out, scheduler, scheduler_file, workers, resume, as_json, segment, speed, max_gap):  # type: ignore[no-untyped-def]
+def elements(
+    sources, out, scheduler, scheduler_file, workers, resume, memory_limit, as_json, segment, speed, max_gap
+):  # type: ignore[no-untyped-def]
     """Trajectory elements (features, measured times) of every log that flew a mission."""
     from uasnav.fleet.elements import elements_analysis
 
     analysis = elements_analysis(segment, speed, max_gap)
-    _print(_execute(analysis, sources, out, scheduler, scheduler_file, workers, resume), as_json)
+    _print(
+        _execute(analysis, sources, out, scheduler, scheduler_file, workers, resume, memory_limit), as_json
+    )
 
 
 @command.command("nav")
 @_run_options
-def nav(sources, out, scheduler, scheduler_file, workers, resume, as_json):  # type: ignore[no-untyped-def]
+def nav(sources, out, scheduler, scheduler_file, workers, resume, memory_limit, as_json):  # type: ignore[no-untyped-def]
     """GNSS/INS replay of every log with IMU and GNSS: RMS against its reference, outage drift."""
     from uasnav.fleet.nav import NAV
 
-    _print(_execute(NAV, sources, out, scheduler, scheduler_file, workers, resume), as_json)
+    _print(_execute(NAV, sources, out, scheduler, scheduler_file, workers, resume, memory_limit), as_json)
 
 
 @command.command("simulate")

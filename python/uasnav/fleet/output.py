@@ -145,9 +145,11 @@ class Manifest:
     def __init__(self, out: Path) -> None:
         self.path = out / MANIFEST
         self.entries: dict[tuple[str, str, int, int], ManifestEntry] = {}
+        self._paths: set[tuple[str, str]] = set()
         if self.path.exists():
             for e in self._read():
                 self.entries[(e.table, e.path, e.size, e.mtime_ns)] = e
+                self._paths.add((e.table, e.path))
 
     def _read(self) -> Iterable[ManifestEntry]:
         with open(self.path, encoding="utf-8") as fh:
@@ -166,6 +168,11 @@ class Manifest:
         """True if the log with this :func:`stat_key` was finished for ``table``."""
         return (table, *key) in self.entries
 
+    def done_url(self, table: str, url: str) -> bool:
+        """True if the log at the http(s) ``url`` was finished for ``table`` (the client never
+        downloads, so a URL is recognised by its text; its content hash is in the entry)."""
+        return (table, url) in self._paths
+
     def commit(self, entries: list[ManifestEntry]) -> None:
         """Append ``entries`` and fsync (the client commits as results arrive)."""
         if not entries:
@@ -175,6 +182,7 @@ class Manifest:
             for e in entries:
                 fh.write(json.dumps(asdict(e), sort_keys=True) + "\n")
                 self.entries[(e.table, e.path, e.size, e.mtime_ns)] = e
+                self._paths.add((e.table, e.path))
             fh.flush()
             os.fsync(fh.fileno())
 

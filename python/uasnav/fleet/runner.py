@@ -17,6 +17,14 @@ manifest lists as finished (``resume=True``), and maps :func:`process_log` over 
   each, so that each worker holds one log at a time and its memory limit bounds a task's memory, or
 - in this process (``workers=0``): the single-process path, the same function in a loop.
 
+A log named by an http(s) URL is downloaded by the worker that processes it (never by the
+client) with the project's hardened HTTP transport (:func:`uasnav.httpfetch.download`: total
+deadline ``fetch_timeout_s``, redirects to http(s) only, at most ``fetch_max_bytes``, default
+:func:`uasnav.limits.max_memory`), streamed to a temporary file on the worker, hashed, analysed
+and removed; the rows carry the URL as their ``path``. A URL that cannot be fetched (404,
+timeout, too large, refused redirect) is a row of the errors table; it is not committed to the
+manifest, so ``resume=True`` tries it again, while a finished URL is skipped by its text.
+
 Each task reads its log once, writes its rows to one Parquet file named by the log's content
 hash (atomically, :mod:`uasnav.fleet.output`) and returns a small :class:`TaskResult`; no
 samples travel to the client. A log that cannot be read becomes a row of the errors table and
@@ -29,7 +37,9 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import shutil
+import tempfile
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -54,6 +64,8 @@ from uasnav.fleet.output import (
     write_table,
 )
 from uasnav.fleet.sources import discover
+from uasnav.httpfetch import FetchError, download, is_url
+from uasnav.limits import max_memory
 
 #: Columns the runner adds in front of every analysis' own (the partition columns ``vehicle``
 #: and ``day`` come from the directory names).
@@ -68,6 +80,10 @@ Progress = Callable[[int, int], None] | None
 #: Errors listed in a :class:`RunSummary` (and the ``--json`` summary); the errors table in the
 #: output holds every one.
 MAX_LISTED_ERRORS = 1000
+#: Default total deadline of one log's download (s).
+FETCH_TIMEOUT_S = 600.0
+#: Task statuses that are not committed to the manifest (``--resume`` tries them again).
+RETRIED = ("lost", "unfetched")
 
 
 @dataclass(frozen=True)
@@ -114,7 +130,9 @@ class TaskResult:
     size: int
     mtime_ns: int
     log_hash: str | None
-    status: str  # "ok", "empty", "error" (a bad log), "lost" (the cluster gave up on the task)
+    # "ok", "empty", "error" (a bad log), "lost" (the cluster gave up on the task),
+    # "unfetched" (an http(s) log that could not be downloaded)
+    status: str
     n_rows: int = 0
     cpu_s: float = 0.0
     error: str | None = None
@@ -131,25 +149,75 @@ def _rows_table(analysis: Analysis, rows: list[dict[str, Any]], key: dict[str, A
     return pa.Table.from_pydict(cols, schema=analysis.full_schema)
 
 
-def process_log(path: str, analysis: Analysis, out: str) -> TaskResult:
+def process_log(
+    path: str,
+    analysis: Analysis,
+    out: str,
+    *,
+    fetch_timeout_s: float = FETCH_TIMEOUT_S,
+    fetch_max_bytes: int | None = None,
+) -> TaskResult:
     """Run ``analysis`` on one log and write its rows (or its error row); idempotent.
 
     Runs on a worker (or in this process). Never raises for a bad log: any exception of the
     reading or the analysis becomes an errors-table row. A log whose content hash already has
     its file in ``out`` is not computed again: logs are identified by content, so two copies of
-    one log are stored once (under the path of the copy processed first).
+    one log are stored once (under the path of the copy processed first). An http(s) ``path``
+    is downloaded first (module docs), within ``fetch_timeout_s`` seconds and
+    ``fetch_max_bytes`` bytes (default :func:`uasnav.limits.max_memory`).
     """
     cpu0 = time.process_time()
     out_p = Path(out)
+    if is_url(path):
+        limit = max_memory() if fetch_max_bytes is None else int(fetch_max_bytes)
+        return _process_url(path, analysis, out_p, cpu0, fetch_timeout_s, limit)
     try:
         size, mtime_ns = stat_key(path)[1:]
     except OSError as e:
         row = error_row(path, None, analysis.name, e)
         write_table(pa.Table.from_pylist([row], schema=ERRORS_SCHEMA), error_file(out_p, _path_key(path)))
         return TaskResult(path, -1, -1, None, "error", error=row["error"])
+    return _process_file(path, path, size, mtime_ns, analysis, out_p, cpu0)
+
+
+def _local_name(url: str) -> str:
+    """A safe file name for the download of ``url`` that keeps its extension (the readers
+    recognise formats by it)."""
+    from urllib.parse import unquote, urlsplit
+
+    base = os.path.basename(unquote(urlsplit(url).path))
+    return re.sub(r"[^A-Za-z0-9._-]", "_", base).lstrip(".")[-120:] or "log"
+
+
+def _process_url(
+    url: str, analysis: Analysis, out_p: Path, cpu0: float, timeout_s: float, max_bytes: int
+) -> TaskResult:
+    tmpdir = tempfile.mkdtemp(prefix="uasnav-fleet-")
+    try:
+        local = os.path.join(tmpdir, _local_name(url))
+        try:
+            with open(local, "wb") as fh:
+                size = download(url, fh, timeout_s=timeout_s, max_bytes=max_bytes, user_agent="uasnav-fleet")
+        except FetchError as e:
+            row = error_row(url, None, analysis.name, e)
+            write_table(pa.Table.from_pylist([row], schema=ERRORS_SCHEMA), error_file(out_p, _path_key(url)))
+            return TaskResult(
+                url, -1, -1, None, "unfetched", cpu_s=time.process_time() - cpu0, error=row["error"]
+            )
+        # fetched now: an error row left by an earlier failed fetch of this URL no longer holds
+        error_file(out_p, _path_key(url)).unlink(missing_ok=True)
+        return _process_file(local, url, size, 0, analysis, out_p, cpu0)
+    finally:
+        shutil.rmtree(tmpdir, ignore_errors=True)
+
+
+def _process_file(
+    local: str, path: str, size: int, mtime_ns: int, analysis: Analysis, out_p: Path, cpu0: float
+) -> TaskResult:
+    """Hash, analyse and write the log in the file ``local``, known to the tables as ``path``."""
     log_hash: str | None = None
     try:
-        log_hash = content_hash(path)
+        log_hash = content_hash(local)
         done = sorted(out_p.glob(f"vehicle=*/day=*/{log_hash}.parquet"))
         if done:
             # the same content was finished before (a resumed run, a renamed or copied log, or
@@ -161,7 +229,7 @@ def process_log(path: str, analysis: Analysis, out: str) -> TaskResult:
         with warnings.catch_warnings():
             # corrupt-record warnings of the readers: the log is salvaged; the run stays quiet
             warnings.simplefilter("ignore")
-            result = analysis.compute(path)
+            result = analysis.compute(local)
         if not result.rows:
             return TaskResult(path, size, mtime_ns, log_hash, "empty", cpu_s=time.process_time() - cpu0)
         table = _rows_table(analysis, result.rows, {"log_hash": log_hash, "path": path, "size_bytes": size})
@@ -171,6 +239,8 @@ def process_log(path: str, analysis: Analysis, out: str) -> TaskResult:
         )
     except Exception as e:  # a corrupt log must never stop the run (issue 19): record it
         row = error_row(path, log_hash, analysis.name, e)
+        if local != path:  # the reader names the temporary download: name the URL instead
+            row["error"] = row["error"].replace(local, path)
         key = f"{analysis.name}-{log_hash or _path_key(path)}"
         write_table(pa.Table.from_pylist([row], schema=ERRORS_SCHEMA), error_file(out_p, key))
         return TaskResult(
@@ -181,7 +251,8 @@ def process_log(path: str, analysis: Analysis, out: str) -> TaskResult:
 def _path_key(path: str) -> str:
     import hashlib
 
-    return "path-" + hashlib.sha256(os.path.abspath(path).encode()).hexdigest()
+    name = path if is_url(path) else os.path.abspath(path)
+    return "path-" + hashlib.sha256(name.encode()).hexdigest()
 
 
 @dataclass
@@ -201,6 +272,8 @@ class RunSummary:
     cpu_s: float = 0.0
     workers: int = 0
     scheduler: str = "in-process"
+    #: Smallest memory limit of the cluster's workers (bytes; None in process or unlimited).
+    worker_memory_limit: int | None = None
     errors: list[dict[str, str | None]] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
 
@@ -245,6 +318,9 @@ def run(
     workers: int | None = None,
     resume: bool = False,
     progress: Progress = None,
+    fetch_timeout_s: float = FETCH_TIMEOUT_S,
+    fetch_max_bytes: int | None = None,
+    memory_limit: str | int = "auto",
 ) -> RunSummary:
     """Run ``analysis`` over every log of ``sources`` and write the dataset ``out``.
 
@@ -266,6 +342,12 @@ def run(
         existing, non-empty ``out`` is refused.
     progress : callable(done, total), optional
         Called after each log.
+    fetch_timeout_s, fetch_max_bytes : optional
+        Total deadline (s) and size limit (bytes, default :func:`uasnav.limits.max_memory` on
+        the worker) of the download of each http(s) log.
+    memory_limit : str or int
+        Memory limit of each worker process of the local cluster (bytes, or Dask's ``"auto"``:
+        the machine's memory ÷ workers); a worker above it is restarted by its nanny.
 
     Returns
     -------
@@ -279,7 +361,10 @@ def run(
     todo, skipped = [], 0
     for p in paths:
         try:
-            done = manifest is not None and manifest.done(analysis.name, stat_key(p))
+            if is_url(p):
+                done = manifest is not None and manifest.done_url(analysis.name, p)
+            else:
+                done = manifest is not None and manifest.done(analysis.name, stat_key(p))
         except OSError:
             done = False  # unreadable: the task records the error
         if done:
@@ -288,9 +373,10 @@ def run(
             todo.append(p)
     created = not out_p.exists()
     out_p.mkdir(parents=True, exist_ok=True)
+    fetch = {"fetch_timeout_s": fetch_timeout_s, "fetch_max_bytes": fetch_max_bytes}
     try:
         return _run(analysis, out_p, todo, len(paths), skipped, manifest or Manifest(out_p), t0,
-                    client, scheduler, scheduler_file, workers, progress)  # fmt: skip
+                    client, scheduler, scheduler_file, workers, progress, fetch, memory_limit)  # fmt: skip
     except BaseException:
         # a run that failed before committing anything (e.g. no scheduler at that address)
         # leaves nothing behind
@@ -312,17 +398,19 @@ def _run(
     scheduler_file: str | None,
     workers: int | None,
     progress: Progress,
+    fetch: dict[str, Any],
+    memory_limit: str | int = "auto",
 ) -> RunSummary:
     summary = RunSummary(analysis.name, str(out_p), n_logs, n_skipped=skipped)
     if progress is not None:
         progress(0, len(todo))
 
     def record(res: TaskResult) -> None:
-        if res.status != "lost":
+        if res.status not in RETRIED:
             manifest.commit(
                 [
                     ManifestEntry(
-                        os.path.abspath(res.path),
+                        res.path if is_url(res.path) else os.path.abspath(res.path),
                         res.size,
                         res.mtime_ns,
                         res.log_hash,
@@ -348,9 +436,21 @@ def _run(
     if workers == 0 and client is None and scheduler is None and scheduler_file is None:
         summary.workers, summary.scheduler = 0, "in-process"
         for p in todo:
-            record(process_log(p, analysis, str(out_p)))
+            record(process_log(p, analysis, str(out_p), **fetch))
     elif todo:
-        _run_distributed(analysis, todo, out_p, record, summary, client, scheduler, scheduler_file, workers)
+        _run_distributed(
+            analysis,
+            todo,
+            out_p,
+            record,
+            summary,
+            client,
+            scheduler,
+            scheduler_file,
+            workers,
+            fetch,
+            memory_limit,
+        )
     if analysis.finish is not None:
         summary.extra = analysis.finish(out_p) or {}
     summary.wall_s = time.perf_counter() - t0
@@ -367,6 +467,8 @@ def _run_distributed(
     scheduler: str | None,
     scheduler_file: str | None,
     workers: int | None,
+    fetch: dict[str, Any],
+    memory_limit: str | int = "auto",
 ) -> None:
     from distributed import Client, as_completed
 
@@ -376,14 +478,16 @@ def _run_distributed(
         if scheduler is not None or scheduler_file is not None:
             client = Client(address=scheduler, scheduler_file=scheduler_file, timeout="30s")
         else:
-            cluster = local_cluster(workers)
+            cluster = local_cluster(workers, memory_limit)
             client = Client(cluster)
     try:
         summary.scheduler = str(client.scheduler.address)
         summary.workers = len(client.nthreads())
+        limits = [w.get("memory_limit") for w in client.scheduler_info().get("workers", {}).values()]
+        summary.worker_memory_limit = min((int(m) for m in limits if m), default=None)
         # Keys name the analysis and the log: a task is identified by what it computes, so a
         # resubmission (after a lost worker) is the same task.
-        futures = client.map(process_log, todo, analysis=analysis, out=str(out), pure=False)
+        futures = client.map(process_log, todo, analysis=analysis, out=str(out), pure=False, **fetch)
         by_key = {f.key: p for f, p in zip(futures, todo, strict=True)}
         for fut in as_completed(futures):
             try:
@@ -410,6 +514,7 @@ def _run_distributed(
 
 
 __all__ = [
+    "FETCH_TIMEOUT_S",
     "KEY_FIELDS",
     "Analysis",
     "LogRows",

@@ -5,12 +5,15 @@ A SOURCE of ``uasnav fleet …`` is
 - a directory: every file under it (recursively, hidden ones left out) whose extension is a log
   format of :mod:`uasnav.io` (``.ulg``, ``.bin``, ``.tlog``, ``.csv``, ``.txt``, ``.npz``);
 - a glob pattern (``logs/2026-*/**/*.ulg``; ``**`` crosses directories);
-- a list file ending in ``.list`` or ``.urls``: one path or ``file://`` URL per line (``#``
-  comments and blank lines skipped; relative paths are relative to the list file);
+- a list file ending in ``.list`` or ``.urls``: one path, ``file://`` URL or ``http(s)://`` URL
+  per line (``#`` comments and blank lines skipped; relative paths are relative to the list file);
+- an ``http://`` or ``https://`` URL of one log;
 - a file: taken as it is, whatever its extension (an unknown format becomes an error row).
 
-Remote URLs (``http://``, ``s3://`` …) are refused with a clear error: the workers read logs
-from a file system they share with the client (a network file system on a real cluster).
+Local paths are read by the workers from a file system they share with the client (a network
+file system on a real cluster). An http(s) URL is kept as it is: the worker that processes it
+downloads the log itself (:func:`uasnav.fleet.runner.process_log`), never the client. Other
+schemes (``s3://``, ``ftp://`` …) are refused with a clear error.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from uasnav.errors import InputError
+from uasnav.httpfetch import is_url
 
 #: Extensions picked up when a directory is scanned.
 LOG_EXTENSIONS = (".ulg", ".bin", ".tlog", ".csv", ".txt", ".npz")
@@ -30,12 +34,14 @@ _GLOB_CHARS = set("*?[")
 
 
 def _from_url(text: str, base: Path) -> str:
+    if is_url(text):
+        return text
     u = urlparse(text)
     if u.scheme == "file":
         return unquote(u.path)
     if u.scheme and len(u.scheme) > 1:  # not a Windows drive letter
         raise InputError(
-            f"{text}: remote URLs are not supported (the workers read logs from a shared file system)"
+            f"{text}: {u.scheme}:// URLs are not supported (only paths, file:// and http(s):// URLs)"
         )
     p = Path(text).expanduser()
     return str(p if p.is_absolute() else base / p)
@@ -54,13 +60,14 @@ def _walk(d: Path) -> list[str]:
 
 
 def discover(sources: Sequence[str | os.PathLike[str]]) -> list[str]:
-    """The log files named by ``sources`` (see the module docs), absolute, sorted, each once.
+    """The logs named by ``sources`` (see the module docs): absolute paths and http(s) URLs,
+    sorted, each once.
 
     Raises
     ------
     InputError
-        A source that does not exist, a glob or directory that holds no log, a remote URL, or no
-        source at all.
+        A source that does not exist, a glob or directory that holds no log, a URL of another
+        scheme than file or http(s), or no source at all.
     """
     if not sources:
         raise InputError("no SOURCE given (directories, glob patterns, list files or log files)")
@@ -84,6 +91,8 @@ def discover(sources: Sequence[str | os.PathLike[str]]) -> list[str]:
                     line = line.strip()
                     if line and not line.startswith("#"):
                         found.append(_from_url(line, p.parent))
+        elif is_url(s):
+            found.append(s)
         elif p.exists():
             if not p.is_file():
                 raise InputError(f"{s}: not a regular file or directory")
@@ -94,7 +103,9 @@ def discover(sources: Sequence[str | os.PathLike[str]]) -> list[str]:
     from uasnav.fleet.logs import is_gnss_companion
 
     # a GNSS CSV beside its IMU log is part of that log (the GNSS/INS flight format), not a log
-    return sorted({os.path.abspath(f) for f in found if not is_gnss_companion(f)})
+    return sorted(
+        {f if is_url(f) else os.path.abspath(f) for f in found if is_url(f) or not is_gnss_companion(f)}
+    )
 
 
 __all__ = ["LIST_EXTENSIONS", "LOG_EXTENSIONS", "discover"]

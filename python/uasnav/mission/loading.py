@@ -26,9 +26,6 @@ import http.client
 import json
 import math
 import os
-import socket
-import threading
-import time
 import urllib.error
 import urllib.parse
 import urllib.request
@@ -41,6 +38,9 @@ from lxml import etree
 
 from uasnav.atomicfile import atomic_write_bytes, atomic_write_text
 from uasnav.errors import DataFormatError, InputError, ResourceLimitError
+from uasnav.httpfetch import Deadline as _Deadline
+from uasnav.httpfetch import one_line as _one_line
+from uasnav.httpfetch import opener as _opener
 from uasnav.limits import read_file_limited, read_limited
 
 #: Largest document accepted (bytes).
@@ -193,109 +193,6 @@ def check_timeout(timeout_s: float) -> float:
     if not (math.isfinite(t) and t > 0):
         raise InputError(f"timeout: expected a finite number of seconds > 0, got {timeout_s!r}")
     return t
-
-
-class _Deadline:
-    """A total deadline for one fetch: at expiry every connection it watches is shut down.
-
-    ``socket`` timeouts apply to each read, so a server sending one byte per second never trips
-    them; shutting the socket down from a timer thread wakes any blocked read (connect, status
-    line, headers, body) at the deadline, whatever the server does.
-    """
-
-    def __init__(self, seconds: float) -> None:
-        self.end = time.monotonic() + seconds
-        self.expired = False
-        self._lock = threading.Lock()
-        self._socks: list[socket.socket] = []
-        self._timer = threading.Timer(seconds, self._expire)
-        self._timer.daemon = True
-        self._timer.start()
-
-    def remaining(self) -> float:
-        return max(self.end - time.monotonic(), 1e-3)
-
-    def watch(self, sock: socket.socket | None) -> None:
-        if sock is None:
-            return
-        with self._lock:
-            self._socks.append(sock)
-            if self.expired:
-                self._shut(sock)
-
-    @staticmethod
-    def _shut(sock: socket.socket) -> None:
-        try:
-            sock.shutdown(socket.SHUT_RDWR)
-        except OSError:
-            pass  # already closed
-
-    def _expire(self) -> None:
-        with self._lock:
-            self.expired = True
-            for sock in self._socks:
-                self._shut(sock)
-
-    def cancel(self) -> None:
-        self._timer.cancel()
-
-
-def _opener(deadline: _Deadline) -> urllib.request.OpenerDirector:
-    """A urllib opener (proxies from the environment as usual) whose connections obey
-    ``deadline`` and whose redirects go to http(s) only."""
-
-    def watched(base: type[http.client.HTTPConnection]) -> type[http.client.HTTPConnection]:
-        class Conn(base):  # type: ignore[misc, valid-type]
-            def __init__(self, *args: object, **kw: object) -> None:
-                kw["timeout"] = deadline.remaining()  # per operation; the deadline is total
-                super().__init__(*args, **kw)  # type: ignore[arg-type]
-                # Watch the TCP socket as soon as it exists, so that a TLS handshake or a proxy
-                # CONNECT that drips is cut at the deadline too.
-                create = self._create_connection
-
-                def create_watched(*a: object, **k: object) -> socket.socket:
-                    sock = create(*a, **k)
-                    deadline.watch(sock)
-                    return sock
-
-                self._create_connection = create_watched
-
-        return Conn
-
-    http_conn, https_conn = watched(http.client.HTTPConnection), watched(http.client.HTTPSConnection)
-
-    class Http(urllib.request.HTTPHandler):
-        def http_open(self, req):  # type: ignore[no-untyped-def]
-            return self.do_open(http_conn, req)
-
-    class Https(urllib.request.HTTPSHandler):
-        def https_open(self, req):  # type: ignore[no-untyped-def]
-            return self.do_open(https_conn, req, context=self._context)  # type: ignore[attr-defined]
-
-    class Redirect(urllib.request.HTTPRedirectHandler):
-        max_redirections = 5
-
-        def http_error_302(self, req, fp, code, msg, headers):  # type: ignore[no-untyped-def]
-            # urllib follows ftp:// redirects and reports file:// ones as an HTTP error; only
-            # http(s) is promised, so anything else is refused here with its target named.
-            target = headers.get("location") or headers.get("uri") or ""
-            scheme = urllib.parse.urlsplit(urllib.parse.urljoin(req.full_url, target)).scheme.lower()
-            if scheme not in ("http", "https"):
-                fp.close()
-                raise InputError(
-                    f"{req.full_url}: redirect to {target!r} refused (only http:// and https:// are followed)"
-                )
-            return super().http_error_302(req, fp, code, msg, headers)
-
-        http_error_301 = http_error_303 = http_error_307 = http_error_308 = http_error_302
-
-    return urllib.request.build_opener(Http, Https, Redirect)
-
-
-def _one_line(exc: BaseException) -> str:
-    """An exception's text on one line, at most 200 characters (servers send anything)."""
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    return text if len(text) <= 200 else text[:197] + "..."
 
 
 def _download(req: urllib.request.Request, url: str, deadline: _Deadline, max_bytes: int):
