@@ -1049,6 +1049,7 @@ impl<T: Real> InsFilter<T> {
         let dt_nominal_s = span / (n - 1) as f64;
         let dt_nominal: T = lit(dt_nominal_s);
         let mut slope = SlopeEstimator::new(config.temp_slope_window_s, dt_nominal);
+        let thermal_wander = config.mode == Mode::Zupt && config.sigma_gbt_rad_s_sqrt_c > T::zero();
         let zupt_every = to_f64(config.zupt_interval_s);
         let mag_every = to_f64(config.mag_interval_s);
         let mag_until = t0 + to_f64(config.heading_aiding_s);
@@ -1097,7 +1098,8 @@ impl<T: Real> InsFilter<T> {
             if k > 0 {
                 let dt: T = lit(tk - input.imu_t_s[k - 1]);
                 let mut rate = Vector3::zeros();
-                if config.mode == Mode::Tczupt {
+                let mut thermal_var = T::zero();
+                if config.mode == Mode::Tczupt || thermal_wander {
                     if let Some(temps) = input.temp_c {
                         let temp = temps[k];
                         if !num_traits::Float::is_finite(temp) {
@@ -1107,7 +1109,12 @@ impl<T: Real> InsFilter<T> {
                             });
                         }
                         let dtdt = slope.push(temp);
-                        rate = deriv.dbias_dtemp(k, temp) * dtdt;
+                        if config.mode == Mode::Tczupt {
+                            rate = deriv.dbias_dtemp(k, temp) * dtdt;
+                        } else {
+                            let s = config.sigma_gbt_rad_s_sqrt_c;
+                            thermal_var = s * s * num_traits::Float::abs(dtdt) * dt;
+                        }
                     }
                 }
                 // A logging gap: the sample after it averages over an unknown part of the gap
@@ -1118,7 +1125,12 @@ impl<T: Real> InsFilter<T> {
                 summary.imu_gaps += usize::from(gap);
                 f.predict(&input.gyro_rad_s[j], &input.accel_m_s2[j], dt, &rate)
                     .map_err(|e| reindex(e, k))?;
-            } else if config.mode == Mode::Tczupt {
+                if thermal_var > T::zero() {
+                    for i in 12..15 {
+                        f.p[(i, i)] += thermal_var;
+                    }
+                }
+            } else if config.mode == Mode::Tczupt || thermal_wander {
                 if let Some(temps) = input.temp_c {
                     slope.push(temps[0]);
                 }
