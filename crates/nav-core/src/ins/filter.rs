@@ -392,6 +392,7 @@ impl<T: Real> InsFilter<T> {
         }
     }
 
+    #[inline(always)]
     fn check_health(&self) -> Result<(), NavError> {
         let sol = self.vel.sum() + self.q.coords.sum() + self.bg.sum() + self.ba.sum();
         if !(num_traits::Float::is_finite(sol) && (self.lat + self.lon + self.h).is_finite()) {
