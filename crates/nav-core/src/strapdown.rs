@@ -176,6 +176,7 @@ impl<T: Real> PhiBlocks<T> {
 // Index loops mirror the block algebra (row i, column j) and unroll fully; every index is a
 // constant below 15.
 #[allow(clippy::needless_range_loop, clippy::indexing_slicing)]
+#[inline(always)]
 pub(crate) fn propagate_covariance<T: Real>(
     p: &mut Mat15<T>,
     e: &ErrorDynamics<T>,

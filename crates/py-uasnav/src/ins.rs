@@ -73,6 +73,7 @@ fn config(
                 "sigma_arw_rad_sqrt_s" => &mut c.noise.sigma_arw_rad_sqrt_s,
                 "sigma_abi_m_s2" => &mut c.noise.sigma_abi_m_s2,
                 "sigma_gbi_rad_s" => &mut c.noise.sigma_gbi_rad_s,
+                "sigma_gbt_rad_s_sqrt_c" => &mut c.sigma_gbt_rad_s_sqrt_c,
                 "init_std_tilt_rad" => &mut c.init_std_tilt_rad,
                 "init_std_heading_rad" => &mut c.init_std_heading_rad,
                 "init_std_accel_bias_m_s2" => &mut c.init_std_accel_bias_m_s2,

@@ -84,6 +84,10 @@ pub enum FixStatus {
 #[derive(Debug, Clone)]
 pub struct InsFilter<T: Real> {
     cfg: InsConfig<T>,
+    /// The attitude quaternion whose DCM is `dcm` (a cache: a step's new DCM is the next
+    /// step's old one; any other change of `q` is detected by comparing).
+    dcm_q: UnitQuaternion<T>,
+    dcm: Matrix3<T>,
     /// Latitude (rad), longitude (rad), ellipsoidal height (m): f64 always.
     lat: f64,
     lon: f64,
@@ -238,6 +242,8 @@ impl<T: Real> InsFilter<T> {
                 ..VelocityReference::default()
             },
             cfg: config,
+            dcm_q: q,
+            dcm: quat_to_dcm(&q),
         })
     }
 
@@ -332,12 +338,18 @@ impl<T: Real> InsFilter<T> {
         let w_in = w_ie + w_en;
         let w_hat = Vector3::from(*gyro_rad_s) - self.bg;
         let f_hat = Vector3::from(*accel_m_s2) - self.ba;
-        let c = quat_to_dcm(&self.q);
+        let c = if self.dcm_q == self.q {
+            self.dcm
+        } else {
+            quat_to_dcm(&self.q)
+        };
         let q_nav = strapdown::small_rotation(&(w_in * (-dt)));
         self.q = strapdown::attitude_step(&self.q, &w_hat, dt, &q_nav);
+        self.dcm_q = self.q;
+        self.dcm = quat_to_dcm(&self.q);
         // Specific force resolved with the mean of the old and new attitude (Groves eq. 5.84):
         // with the old one alone a turn leaves a systematic velocity error of |f|·|ω|·Ts/2.
-        let c_mid = (c + quat_to_dcm(&self.q)) * lit::<T>(0.5);
+        let c_mid = (c + self.dcm) * lit::<T>(0.5);
         let f_n = c_mid * f_hat;
         let g = e.gravity;
         let w_v = w_ie * lit::<T>(2.0) + w_en;
@@ -380,6 +392,7 @@ impl<T: Real> InsFilter<T> {
         }
     }
 
+    #[inline(always)]
     fn check_health(&self) -> Result<(), NavError> {
         let sol = self.vel.sum() + self.q.coords.sum() + self.bg.sum() + self.ba.sum();
         if !(num_traits::Float::is_finite(sol) && (self.lat + self.lon + self.h).is_finite()) {
@@ -560,20 +573,19 @@ impl<T: Real> InsFilter<T> {
         for i in 0..3 {
             z[3 + i] = v_ant[i] - v_meas[i];
         }
-        let mut hm = SMatrix::<T, 6, N_STATES>::zeros();
-        hm.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&Matrix3::identity());
-        hm.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-skew(&cl_b)));
-        hm.fixed_view_mut::<3, 3>(3, 3)
-            .copy_from(&Matrix3::identity());
-        hm.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(&c_wl)));
-        hm.fixed_view_mut::<3, 3>(3, 12).copy_from(&(c * skew(&l)));
         let cfg = self.cfg;
         let sh = num_traits::Float::max(acc[0], cfg.gnss_min_std_position_m);
         let sv = num_traits::Float::max(acc[1], cfg.gnss_min_std_position_m);
         let ss = num_traits::Float::max(acc[2], cfg.gnss_min_std_velocity_m_s);
         let r = Vec6::from([sh * sh, sh * sh, sv * sv, ss * ss, ss * ss, ss * ss]);
-        let g = strapdown::gain(&self.p, &hm, &r, "GNSS innovation covariance S")?;
+        // H = [I 0 −[Ĉl×] 0 0; 0 I −[Ĉ(ω̂×l)×] 0 Ĉ[l×]]: H·P and S = H·P·Hᵀ + R from its
+        // identity and lever-arm blocks (the lever-arm terms vanish without a lever arm).
+        let lever = l != Vector3::zeros();
+        let g = gnss_gain(
+            &self.p,
+            lever.then(|| (-skew(&cl_b), -skew(&c_wl), c * skew(&l))),
+            &r,
+        )?;
         let nis = z.dot(&g.chol.solve(&z));
         self.last_nis = nis;
         let passes = nis <= cfg.gate_chi2; // false for NaN too
@@ -1049,6 +1061,7 @@ impl<T: Real> InsFilter<T> {
         let dt_nominal_s = span / (n - 1) as f64;
         let dt_nominal: T = lit(dt_nominal_s);
         let mut slope = SlopeEstimator::new(config.temp_slope_window_s, dt_nominal);
+        let thermal_wander = config.mode == Mode::Zupt && config.sigma_gbt_rad_s_sqrt_c > T::zero();
         let zupt_every = to_f64(config.zupt_interval_s);
         let mag_every = to_f64(config.mag_interval_s);
         let mag_until = t0 + to_f64(config.heading_aiding_s);
@@ -1097,7 +1110,8 @@ impl<T: Real> InsFilter<T> {
             if k > 0 {
                 let dt: T = lit(tk - input.imu_t_s[k - 1]);
                 let mut rate = Vector3::zeros();
-                if config.mode == Mode::Tczupt {
+                let mut thermal_var = T::zero();
+                if config.mode == Mode::Tczupt || thermal_wander {
                     if let Some(temps) = input.temp_c {
                         let temp = temps[k];
                         if !num_traits::Float::is_finite(temp) {
@@ -1107,7 +1121,12 @@ impl<T: Real> InsFilter<T> {
                             });
                         }
                         let dtdt = slope.push(temp);
-                        rate = deriv.dbias_dtemp(k, temp) * dtdt;
+                        if config.mode == Mode::Tczupt {
+                            rate = deriv.dbias_dtemp(k, temp) * dtdt;
+                        } else {
+                            let s = config.sigma_gbt_rad_s_sqrt_c;
+                            thermal_var = s * s * num_traits::Float::abs(dtdt) * dt;
+                        }
                     }
                 }
                 // A logging gap: the sample after it averages over an unknown part of the gap
@@ -1118,7 +1137,12 @@ impl<T: Real> InsFilter<T> {
                 summary.imu_gaps += usize::from(gap);
                 f.predict(&input.gyro_rad_s[j], &input.accel_m_s2[j], dt, &rate)
                     .map_err(|e| reindex(e, k))?;
-            } else if config.mode == Mode::Tczupt {
+                if thermal_var > T::zero() {
+                    for i in 12..15 {
+                        f.p[(i, i)] += thermal_var;
+                    }
+                }
+            } else if config.mode == Mode::Tczupt || thermal_wander {
                 if let Some(temps) = input.temp_c {
                     slope.push(temps[0]);
                 }
@@ -1251,5 +1275,78 @@ fn reindex(e: NavError, k: usize) -> NavError {
     match e {
         NavError::NonFinite { what, .. } => NavError::NonFinite { what, index: k },
         other => other,
+    }
+}
+
+/// [`strapdown::gain`] for the GNSS rows, with `H` given by its blocks: `H·P` is P's δr and δv
+/// rows plus, with a lever arm, `A·P[ψ]`, `B·P[ψ] + D·P[δb_g]` (`lever` = (A, B, D)); `S` is
+/// built the same way from the columns of `H·P`. Without a lever arm `H = [I₆ 0]` and the
+/// result is exactly the dense product's (the skipped terms are exact zeros).
+fn gnss_gain<T: Real>(
+    p: &Mat15<T>,
+    lever: Option<(Matrix3<T>, Matrix3<T>, Matrix3<T>)>,
+    r_diag: &Vec6<T>,
+) -> Result<strapdown::Gain<T, 6>, NavError> {
+    let mut hp: SMatrix<T, 6, N_STATES> = p.fixed_rows::<6>(0).into_owned();
+    let mut s: Mat6<T> = hp.fixed_columns::<6>(0).into_owned();
+    if let Some((a, b, d)) = lever {
+        let p_psi = p.fixed_rows::<3>(6);
+        let top = a * p_psi;
+        let bot = b * p_psi + d * p.fixed_rows::<3>(12);
+        let mut hp_top = hp.fixed_rows_mut::<3>(0);
+        hp_top += top;
+        let mut hp_bot = hp.fixed_rows_mut::<3>(3);
+        hp_bot += bot;
+        let hp_psi = hp.fixed_columns::<3>(6);
+        let s_pos = hp.fixed_columns::<3>(0) + hp_psi * a.transpose();
+        let s_vel = hp.fixed_columns::<3>(3)
+            + hp_psi * b.transpose()
+            + hp.fixed_columns::<3>(12) * d.transpose();
+        s.fixed_columns_mut::<3>(0).copy_from(&s_pos);
+        s.fixed_columns_mut::<3>(3).copy_from(&s_vel);
+    }
+    for i in 0..6 {
+        s[(i, i)] += r_diag[i];
+    }
+    let chol = s.cholesky().ok_or(NavError::NotPositiveDefinite {
+        what: "GNSS innovation covariance S",
+    })?;
+    Ok(strapdown::Gain { chol, hp, s })
+}
+
+#[cfg(test)]
+mod gain_tests {
+    use super::*;
+
+    #[test]
+    fn structured_gnss_gain_equals_the_dense_product() {
+        // A full SPD P (A·Aᵀ + I) and a lever arm with attitude and rate terms.
+        let a = Mat15::<f64>::from_fn(|i, j| ((i * 7 + j * 3) % 11) as f64 * 0.1 - 0.4);
+        let p = a * a.transpose() + Mat15::identity();
+        let c = quat_to_dcm(&euler321_to_quat(0.1, -0.2, 2.0));
+        let l = Vector3::new(0.3, -0.1, -0.2);
+        let w = Vector3::new(0.2, 0.1, -0.5);
+        let (cl, cwl) = (c * l, c * w.cross(&l));
+        let mut h = SMatrix::<f64, 6, N_STATES>::zeros();
+        h.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&Matrix3::identity());
+        h.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-skew(&cl)));
+        h.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&Matrix3::identity());
+        h.fixed_view_mut::<3, 3>(3, 6).copy_from(&(-skew(&cwl)));
+        h.fixed_view_mut::<3, 3>(3, 12).copy_from(&(c * skew(&l)));
+        let r = Vec6::from([2.0, 2.0, 6.0, 0.02, 0.02, 0.02]);
+        let dense = strapdown::gain(&p, &h, &r, "S").unwrap();
+        let blocks = (-skew(&cl), -skew(&cwl), c * skew(&l));
+        let ours = gnss_gain(&p, Some(blocks), &r).unwrap();
+        assert!((ours.hp - dense.hp).abs().max() < 1e-12);
+        assert!((ours.s - dense.s).abs().max() < 1e-12);
+        // Without a lever arm: exactly the dense product with H = [I₆ 0].
+        let mut h0 = SMatrix::<f64, 6, N_STATES>::zeros();
+        h0.fixed_view_mut::<6, 6>(0, 0).fill_with_identity();
+        let dense0 = strapdown::gain(&p, &h0, &r, "S").unwrap();
+        let ours0 = gnss_gain(&p, None, &r).unwrap();
+        assert_eq!(ours0.hp, dense0.hp);
+        assert_eq!(ours0.s, dense0.s);
     }
 }

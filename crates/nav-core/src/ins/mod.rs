@@ -155,8 +155,16 @@ pub struct InsConfig<T> {
     pub k_horizontal: T,
     /// Vertical fault-free multiplier `k_V` (on σ_D).
     pub k_vertical: T,
-    /// Window (s) of the least-squares dT/dt slope (TCZUPT).
+    /// Window (s) of the least-squares dT/dt slope (TCZUPT, and the classic filter's
+    /// thermal bias wander).
     pub temp_slope_window_s: T,
+    /// Classic filter only: the gyro bias's thermal wander, modelled as a random walk *in
+    /// temperature* (rad/s/√°C): with the die temperature given, each step adds
+    /// σ²·|dT/dt|·Δt to the gyro-bias variance (nothing while the temperature is constant).
+    /// Without it an uncompensated bias following a warming die (≈ 2·10⁻⁴ rad/s/°C for a
+    /// consumer MEMS gyro) outruns the σ_GBI random walk, the heading error grows beyond its
+    /// σ and sound GNSS fixes are excluded at the next acceleration. 0 = off.
+    pub sigma_gbt_rad_s_sqrt_c: T,
     /// Consecutive excluded fixes after which the filter re-initialises on GNSS (0 = never).
     pub reset_after_exclusions: usize,
     /// Horizontal false-alert multiplier of the solution-separation test (χ²₂ threshold
@@ -204,6 +212,7 @@ impl<T: Real> Default for InsConfig<T> {
             k_horizontal: lit(6.0),
             k_vertical: lit(5.33),
             temp_slope_window_s: lit(30.0),
+            sigma_gbt_rad_s_sqrt_c: T::zero(),
             reset_after_exclusions: 50,
             separation_k_h: lit(4.80),
             separation_k_v: lit(4.42),
@@ -252,9 +261,10 @@ impl<T: Real> InsConfig<T> {
                 });
             }
         }
-        let nonneg: [(&'static str, T); 2] = [
+        let nonneg: [(&'static str, T); 3] = [
             ("heading_aiding_s", self.heading_aiding_s),
             ("temp_slope_window_s", self.temp_slope_window_s),
+            ("sigma_gbt_rad_s_sqrt_c", self.sigma_gbt_rad_s_sqrt_c),
         ];
         for (what, v) in nonneg {
             if !(num_traits::Float::is_finite(v) && v >= T::zero()) {
