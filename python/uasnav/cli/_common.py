@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
+import warnings
+from collections.abc import Iterator
 from typing import Any
 
 import click
@@ -11,6 +14,17 @@ import click
 from uasnav.errors import InputError
 from uasnav.jsonable import to_jsonable
 from uasnav.units import parse_quantity
+
+
+@contextlib.contextmanager
+def warnings_after_success() -> Iterator[None]:
+    """Hold the warnings raised inside the block and show them only once it succeeded: a failed
+    command prints its one ``error: …`` line and nothing else (the CLI contract)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    for w in caught:
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
 def echo_json(obj: Any) -> None:

@@ -21,6 +21,7 @@ from uasnav.cli._common import (
     check_outputs,
     echo_json,
     parse_float_list,
+    warnings_after_success,
 )
 from uasnav.errors import InputError
 
@@ -99,20 +100,21 @@ def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, pro
 
     check_outputs([*flights, plan], {"--out": out})
     wind = parse_wind(wind_text) if wind_text else None
-    # flight logs and/or element datasets (.parquet, e.g. from `uasnav fleet elements`)
-    all_s, n_runs = training_samples(flights, plan, speed, wind, segment, max_gap)
-    import warnings
-
     from uasnav.trajectory.baselines import class_method_reason
 
-    why = class_method_reason(all_s.cell, "populated feature cells")
+    # warnings (telemetry gaps) are shown once training succeeded: a failed run prints its one
+    # error line only
+    with warnings_after_success():
+        # flight logs and/or element datasets (.parquet, e.g. from `uasnav fleet elements`)
+        all_s, n_runs = training_samples(flights, plan, speed, wind, segment, max_gap)
+        why = class_method_reason(all_s.cell, "populated feature cells")
+        with warnings.catch_warnings():
+            # said once below in our words (the rule `evaluate` reports as "not applicable")
+            # instead of scikit-learn's "number of unique classes is greater than 50%"
+            warnings.filterwarnings("ignore", message="The number of unique classes", category=UserWarning)
+            model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
     if why is not None:
-        # Say it once, in our words (the same rule `evaluate` reports as "not applicable"),
-        # instead of scikit-learn's "number of unique classes is greater than 50%" UserWarning.
         click.echo(f"warning: {why}", err=True)
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message="The number of unique classes", category=UserWarning)
-        model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
     model.save(out)
     info = {
         "model": out,
@@ -225,13 +227,10 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         wind = parse_wind(wind_text) if wind_text else None
         # warnings (telemetry gaps) are shown once the evaluation succeeded: a failed run
         # prints its one error line only
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with warnings_after_success():
             fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
             limits = _log_limits(flights)
             errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
-        for w in caught:
-            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
         table = {
             e.name: {
                 "applicable": True,
