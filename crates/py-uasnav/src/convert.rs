@@ -3,7 +3,7 @@
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyOverflowError;
 use pyo3::prelude::*;
-use pyo3::types::PyString;
+use pyo3::types::{PyDict, PyString};
 
 use crate::errors::input_error;
 
@@ -117,6 +117,26 @@ pub fn floats<const N: usize>(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<[f
         .collect::<PyResult<Vec<f64>>>()?;
     <[f64; N]>::try_from(v.as_slice())
         .map_err(|_| input_error(py, format!("{name}: expected {N} values, got {}", v.len())))
+}
+
+/// The entries of a filter's config dict of floats (`{"sigma_gbi_rad_s": 1e-5, …}`) as
+/// `(key, value)`: a key that is not a str or a value that is not a float is an `InputError`
+/// naming it. The caller maps each key to its field (and refuses unknown keys).
+pub fn float_items(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<Vec<(String, f64)>> {
+    d.iter()
+        .map(|(k, v)| {
+            let key: String = k.extract().map_err(|_| {
+                input_error(py, format!("config: keys must be str, got {}", repr(&k)))
+            })?;
+            let x: f64 = v.extract().map_err(|_| {
+                input_error(
+                    py,
+                    format!("config[{key:?}]: expected a float, got {}", repr(&v)),
+                )
+            })?;
+            Ok((key, x))
+        })
+        .collect()
 }
 
 /// `repr(obj)`, shortened, for messages ("got -1", not a Rust debug dump).

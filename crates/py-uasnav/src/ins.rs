@@ -8,7 +8,7 @@ use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{repr, rows, slice1};
+use crate::convert::{float_items, rows, slice1};
 use crate::errors::{input_error, IntoPy};
 use crate::zupt::to2;
 use crate::{floats_arg, uint_arg};
@@ -58,16 +58,7 @@ fn config(
         ..InsConfig::default()
     };
     if let Some(d) = values {
-        for (k, v) in d.iter() {
-            let key: String = k.extract().map_err(|_| {
-                input_error(py, format!("config: keys must be str, got {}", repr(&k)))
-            })?;
-            let x: f64 = v.extract().map_err(|_| {
-                input_error(
-                    py,
-                    format!("config[{key:?}]: expected a float, got {}", repr(&v)),
-                )
-            })?;
+        for (key, x) in float_items(py, d)? {
             let slot = match key.as_str() {
                 "sigma_vrw_m_s_sqrt_s" => &mut c.noise.sigma_vrw_m_s_sqrt_s,
                 "sigma_arw_rad_sqrt_s" => &mut c.noise.sigma_arw_rad_sqrt_s,
