@@ -42,14 +42,21 @@ def test_rural_vlos_flight_is_open_with_only_what_it_needs() -> None:
     assert "300 m" in vis["requirement"] and "§A.5.2.5" in vis["rule"]
     assert out["ranking"] and all(r["open_subcategory"] in ("A1", "A2", "A3") for r in out["ranking"])
     # kept in sight at 300 m needs a UA the pilot can see that far (EASA ALOS from its size): the
-    # small Phantoms (0.35 m: 134 m) are rejected, a 0.9 m Matrice 300 (314 m) is not
-    rej = {(x["item"], x["test"]) for x in out["rejections"]}
-    assert ("dji-phantom-3-professional", "vlos-distance") in rej
-    assert ("dji-matrice-300-rtk", "vlos-distance") not in rej
+    # small Phantoms (0.35 m: 134 m) are not dropped but flown BVLOS in the specific category
+    # (listed under "operations"); the configurations needing no authorisation rank first
     db = load_database()
     for r in out["ranking"]:
         i = db.uas.ids.index(r["uas_id"])
         assert vlos_distance_of(db.uas.span_m[i], db.uas.types[i]) >= 300.0
+        assert (r["visibility"], r["category"]) == ("VLOS", "open")
+    ops = {(o["visibility"], o["category"]): o for o in out["operations"]}
+    assert list(ops) == [("VLOS", "open"), ("BVLOS", "specific")]
+    assert "dji-matrice-300-rtk" in ops["VLOS", "open"]["uas"]
+    assert "dji-phantom-3-professional" in ops["BVLOS", "specific"]["uas"]
+    assert ops["VLOS", "open"]["rank"] == 1 and not {"blos-c2"} & set(
+        ops["VLOS", "open"]["necessary_equipment"]
+    )
+    assert "blos-c2" in ops["BVLOS", "specific"]["necessary_equipment"]
 
 
 def test_thesis_scenario_is_bvlos_specific_with_sora_and_blos_link() -> None:
@@ -121,8 +128,12 @@ def test_open_subcategory_follows_class_and_people() -> None:
     assert regs.open_subcategory(5000.0, "C3") == "A3"
     assert regs.open_subcategory(200.0, "C0", over_people="assemblies") is None
     sel = select(Requirements(range_m=300.0, over_people="uninvolved"))
-    assert sel.operation.category == "open" and not sel.ranking  # nothing in the db is C0 / < 250 g
+    # nothing in the db is C0 / < 250 g: the open operation ranks nothing, the small UAS flown
+    # BVLOS in the specific category do
+    open_op = sel.operations[0]
+    assert (open_op.visibility, open_op.category, open_op.best) == ("VLOS", "open", None)
     assert any(r.test == "open-subcategory" for r in sel.rejections)
+    assert sel.operation.category == "specific" and all(r.category == "specific" for r in sel.ranking)
 
 
 def test_faa_part107_checks() -> None:
@@ -172,11 +183,16 @@ def test_observers_make_evlos_in_the_specific_category() -> None:
     assert derive_operation(Requirements(range_m=1042.0, observers=2)).visibility == "BVLOS"
     sel = select(Requirements(range_m=1400.0, observers=2))
     assert sel.operation is not None and sel.operation.visibility == "EVLOS"
-    # each ranked UA is kept in sight by the pilot or an observer over its own distance
+    # each ranked UA is flown EVLOS when the pilot or an observer keeps it in sight over its own
+    # distance, else BVLOS; the EVLOS configurations rank first
     u = sel.database.uas
+    assert sel.ranking[0].visibility == "EVLOS"
     for r in sel.ranking:
         i = u.ids.index(r.uas_id)
-        assert 3 * vlos_distance_of(u.span_m[i], u.types[i]) >= 1400.0
+        assert (3 * vlos_distance_of(u.span_m[i], u.types[i]) >= 1400.0) == (r.visibility == "EVLOS")
+    assert [r.visibility for r in sel.ranking] == sorted(
+        (r.visibility for r in sel.ranking), key=["EVLOS", "BVLOS"].index
+    )
     need = {e.id for e in sel.equipment if e.necessary}
     assert {"blos-c2", "lost-link-mode"} <= need
     # SORA counts EVLOS as VLOS (observers give the see-and-avoid): no TMPR
@@ -222,3 +238,35 @@ def test_a_given_vlos_distance_overrides_the_size_rule() -> None:
     assert sel.operation is not None and sel.operation.vlos_distance_m == 400.0
     assert not any(r.test == "vlos-distance" for r in sel.rejections)
     assert any(r.uas_id.startswith("dji-phantom") for r in sel.ranking)
+
+
+def test_operation_follows_each_ua_not_the_best_candidate() -> None:
+    """At 300 m a large UA is flown VLOS (open) and a small one BVLOS (specific): both are
+    evaluated, each configuration says its operation, and the no-authorisation ones rank first."""
+    sel = select(Requirements(range_m=300.0), top=200)
+    u = sel.database.uas
+    assert [(o.visibility, o.category) for o in sel.operations] == [("VLOS", "open"), ("BVLOS", "specific")]
+    seen = set()
+    for r in sel.ranking:
+        i = u.ids.index(r.uas_id)
+        own = "VLOS" if vlos_distance_of(u.span_m[i], u.types[i]) >= 300.0 else "BVLOS"
+        assert (r.visibility, r.category) == (own, "open" if own == "VLOS" else "specific")
+        assert (r.sail is None) == (own == "VLOS")
+        seen.add(own)
+    assert seen == {"VLOS", "BVLOS"}
+    vis = [r.visibility for r in sel.ranking]
+    assert vis == sorted(vis, key=["VLOS", "BVLOS"].index)  # open before specific, then by score
+    bv = sel.operations[1]
+    assert bv.best is not None and bv.best.uas_id == "dji-phantom-3-professional" and bv.best.sail == "II"
+    assert bv.rank == vis.index("BVLOS") + 1
+    # the small UA's operation carries its own equipment: a BLOS C2 link is necessary for it
+    assert "blos-c2" in bv.necessary_equipment and "blos-c2" not in sel.operations[0].necessary_equipment
+    # with --top 10 the BVLOS configurations are beyond the ranking but still reported
+    assert select(Requirements(range_m=300.0)).operations[1].rank is None
+
+
+def test_given_vlos_distance_gives_one_operation_for_every_ua() -> None:
+    sel = select(Requirements(range_m=300.0, vlos_distance_m=500.0))
+    assert len(sel.operations) == 1 and sel.operations[0].visibility == "VLOS"
+    assert len(sel.operations[0].uas) == len(sel.database.uas)
+    assert all(r.visibility == "VLOS" and r.category == "open" for r in sel.ranking)

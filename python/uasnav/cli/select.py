@@ -124,6 +124,16 @@ def command(as_json: bool, **options: Any) -> None:
             f"airspace {op.airspace}"
         )
         click.echo(f"  category: {op.legal_basis}")
+        if len(sel.operations) > 1:
+            # The operation follows from each UA's own VLOS distance: list every one implied.
+            for o in sel.operations:
+                best = (
+                    f"best {o.best.uas} + {o.best.camera} ({o.best.score:.2f})" if o.best else "none feasible"
+                )
+                click.echo(
+                    f"  {o.visibility}/{o.category} for {len(o.uas)} UAS "
+                    f"(in sight up to {o.vlos_distance_m:g} m): {best}"
+                )
     if sel.sora is not None:
         s = sel.sora
         click.echo(
@@ -166,11 +176,13 @@ def command(as_json: bool, **options: Any) -> None:
         f"\nRanked configurations (weights range {w.range:g}, weight {w.weight:g}, cost {w.cost:g}, "
         f"resolution {w.resolution:g}; lower is better):"
     )
-    click.echo(f"  {'#':>2} {'UAS':<30} {'camera':<26} {'score':>6} {'mass g':>7} {'cost $':>7}  open")
+    click.echo(
+        f"  {'#':>2} {'UAS':<30} {'camera':<26} {'score':>6} {'mass g':>7} {'cost $':>7}  open  operation"
+    )
     for rank_no, pair in enumerate(sel.ranking, 1):
         click.echo(
             f"  {rank_no:>2} {pair.uas:<30} {pair.camera:<26} {pair.score:6.2f} {pair.mass_g:7.0f}"
-            f" {pair.cost_usd:7.0f}  {pair.open_subcategory or '-'}"
+            f" {pair.cost_usd:7.0f}  {pair.open_subcategory or '-':<4}  {pair.visibility}/{pair.category}"
         )
     if not sel.ranking and sel.withheld:
         click.echo("  (none flyable: the area enters a PROHIBITED zone)")

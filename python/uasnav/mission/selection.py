@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -84,6 +84,10 @@ class RankedPair:
     open_subcategory: str | None
     #: SORA SAIL of this configuration in the specific category (None elsewhere, or certified).
     sail: str | None = None
+    #: The operation this configuration implies: VLOS/EVLOS/BVLOS (from the distance at which
+    #: this UA can be kept in sight) and its category.
+    visibility: str | None = None
+    category: str | None = None
 
 
 @dataclass
@@ -118,6 +122,9 @@ class Selection:
     withheld: list[RankedPair] = field(default_factory=list)
     #: The flight window the zone schedules were checked over (start, end, duration_s, from).
     flight_window: dict | None = None
+    #: Every operation the candidate UAS imply (one per VLOS/EVLOS/BVLOS present), least
+    #: demanding first, each with its best configuration; ``operation`` is the chosen one's.
+    operations: list[OperationChoice] = field(default_factory=list)
 
     @property
     def authorisation(self) -> dict:
@@ -246,6 +253,7 @@ class Selection:
             "authorisation": self.authorisation,
             "withheld_ranking": [c.__dict__ for c in self.withheld],
             "flight_window": self.flight_window,
+            "operations": [o.to_dict() for o in self.operations],
         }
 
 
@@ -274,38 +282,75 @@ def _flight_duration(u, req: Requirements, ranking: list[RankedPair]) -> tuple[f
     return float(finite.max()), "longest mission time estimate in the database (no configuration ranked)"
 
 
-def _vlos_defaults(
-    u, req: Requirements, regs: Regulations
-) -> tuple[np.ndarray | None, tuple[float, str] | None]:
-    """Each UAS's VLOS distance from its size (:func:`~uasnav.mission.operation.vlos_distance_of`)
-    and the operation's default: the largest over the UAS that pass the aircraft tests of the
-    category a flight in sight would be in (a flight is VLOS when at least one candidate UA can be
-    kept in sight; the others are then rejected by the ``vlos-distance`` test). (None, None) when
-    the user gives ``--vlos-distance``."""
+#: Order of the operations by what they ask of the operator: a flight in the remote pilot's
+#: own sight before one with observers before one beyond sight, and a category that needs no
+#: operational authorisation (EASA open) before one that does.
+_VISIBILITY_ORDER = {"VLOS": 0, "EVLOS": 1, "BVLOS": 2}
+_CATEGORY_ORDER = {"open": 0}
+
+
+def _burden(op: Operation) -> tuple[int, int]:
+    """Sort key of an operation: (needs an authorisation, how far beyond the pilot's sight)."""
+    return (_CATEGORY_ORDER.get(op.category, 1), _VISIBILITY_ORDER[op.visibility])
+
+
+def _visibility_of(dist: float, reach: np.ndarray, observers: int) -> np.ndarray:
+    """VLOS / EVLOS / BVLOS of each UA kept in sight up to ``reach`` (m) at pilot distance
+    ``dist`` (m), the same rule as :func:`~uasnav.mission.operation.derive_operation`."""
+    out = np.full(reach.shape, "BVLOS", dtype=object)
+    if observers > 0:
+        out[dist <= reach * (observers + 1)] = "EVLOS"
+    out[dist <= reach] = "VLOS"
+    return out
+
+
+def _operations_per_uas(u, req: Requirements, regs: Regulations) -> list[tuple[Operation, np.ndarray]]:
+    """The operations the candidate UAS imply, each with its member UAS (bool mask).
+
+    The operation follows from the distance at which *this* UA can be kept in sight (its
+    :func:`~uasnav.mission.operation.vlos_distance_of`): at the same pilot distance a large UA
+    may be flown VLOS in the open category while a small one is flown BVLOS in the specific
+    category; both are evaluated. Each operation reports as its VLOS distance the largest of
+    its member UAS that pass the aircraft tests of its category (else of all its members).
+    One operation for every UAS when ``--vlos-distance`` is given or the database is empty.
+    """
+    dist = req.max_distance_m if req.max_distance_m is not None else req.range_m
     if req.vlos_distance_m is not None or len(u) == 0:
-        return None, None
+        return [(derive_operation(req), np.ones(len(u), dtype=bool))]
     per = np.asarray(vlos_distance_of(u.span_m, list(u.types)), dtype=float)
-    in_sight = derive_operation(req, vlos_default=(np.inf, ""))
-    lim = regs.category(req.jurisdiction, in_sight.category).limit("mtom")
-    ok = np.ones(len(u), dtype=bool)
-    for t in uas_tests(u, req, lim.value_si if lim is not None else np.inf) + _equipment_tests(
-        u, req.gnss_autopilot, []
-    ):
-        ok &= t.ok
-    pool = np.flatnonzero(ok) if ok.any() else np.arange(len(u))
-    k = int(pool[np.argmax(per[pool])])
-    src = (
-        f"{VLOS_SOURCE}; the largest of the candidate UAS: {u.label(k)}, {float(u.span_m[k]):g} m "
-        f"{u.types[k]}; each UAS is held to its own distance"
-    )
-    return per, (float(per[k]), src)
+    vis = _visibility_of(float(dist), per, req.observers)
+    present = [v for v in ("VLOS", "EVLOS", "BVLOS") if (vis == v).any()]
+    out = []
+    for v in present:
+        members = vis == v
+        k = int(np.flatnonzero(members)[np.argmax(per[members])])
+        op = derive_operation(req, vlos_default=(float(per[k]), ""))
+        lim = regs.category(req.jurisdiction, op.category).limit("mtom")
+        ok = members.copy()
+        for t in uas_tests(u, req, lim.value_si if lim is not None else np.inf) + _equipment_tests(
+            u, req.gnss_autopilot, []
+        ):
+            ok &= t.ok
+        pool = np.flatnonzero(ok) if ok.any() else np.flatnonzero(members)
+        k = int(pool[np.argmax(per[pool])])
+        src = (
+            f"{VLOS_SOURCE}; the largest of the candidate UAS"
+            + (f" flown {v} ({int(members.sum())} of {len(u)} UAS)" if len(present) > 1 else "")
+            + f": {u.label(k)}, {float(u.span_m[k]):g} m {u.types[k]}; each UAS is held to its own distance"
+        )
+        out.append((derive_operation(req, vlos_default=(float(per[k]), src)), members))
+    return sorted(out, key=lambda x: _burden(x[0]))
 
 
-def _reject(tests: list[TestResult], kind: str, labels, ids) -> tuple[np.ndarray, list[Rejection]]:
-    ok = np.ones(len(ids), dtype=bool)
+def _reject(
+    tests: list[TestResult], kind: str, labels, ids, rows: np.ndarray | None = None
+) -> tuple[np.ndarray, list[Rejection]]:
+    """Combine ``tests``; rejections only for the items in ``rows`` (all when None)."""
+    rows = np.ones(len(ids), dtype=bool) if rows is None else rows
+    ok = rows.copy()
     out = []
     for t in tests:
-        for i in np.flatnonzero(~t.ok):
+        for i in np.flatnonzero(~t.ok & rows):
             out.append(
                 Rejection(
                     kind,
@@ -319,6 +364,251 @@ def _reject(tests: list[TestResult], kind: str, labels, ids) -> tuple[np.ndarray
             )
         ok &= t.ok
     return ok, out
+
+
+def _sora_of(op: Operation, req: Requirements, u, i: int, m: float, quantitative: bool = False) -> SoraResult:
+    """SORA of UAS ``i`` at take-off mass ``m`` (g) flown as ``op``."""
+    return assess(
+        dimension_m=float(u.span_m[i]),
+        speed_ms=float(u.max_speed_ms[i]),
+        population=op.population,
+        # SORA treats EVLOS like VLOS: the observers give the see-and-avoid (TMPR)
+        bvlos=op.visibility == "BVLOS",
+        mass_g=m,
+        height_m=req.altitude_m,
+        airspace=req.airspace,
+        urban=op.urban,
+        mitigations=dict(req.mitigations),
+        residual_arc=req.residual_arc,
+        edition=req.sora_edition,
+        density_ppl_km2=op.population_density,
+        quantitative=quantitative,
+    )
+
+
+@dataclass(frozen=True)
+class OperationChoice:
+    """One operation the candidate UAS imply (see :func:`select`): the operation, the UAS that
+    imply it, its necessary equipment and its best configuration (None if none is feasible)."""
+
+    visibility: str
+    category: str
+    legal_basis: str
+    vlos_distance_m: float
+    uas: tuple[str, ...]
+    feasible_pairs: int
+    necessary_equipment: tuple[str, ...]
+    best: RankedPair | None
+    #: Rank (1-based) of ``best`` in the selection's ranking, None when beyond ``top``.
+    rank: int | None
+
+    def to_dict(self) -> dict:
+        """Plain JSON."""
+        d = dict(self.__dict__)
+        d["uas"] = list(self.uas)
+        d["necessary_equipment"] = list(self.necessary_equipment)
+        d["best"] = self.best.__dict__ if self.best else None
+        return d
+
+
+@dataclass
+class _Branch:
+    """The selection steps run for one operation over the UAS (``members``) that imply it."""
+
+    op: Operation
+    members: np.ndarray
+    equipment: list[EquipmentNeed]
+    h_reg: float
+    h_cam: float
+    vlos_required: bool
+    uas_ok: np.ndarray
+    cam_ok: np.ndarray
+    pair_ok: np.ndarray
+    rejections: list[Rejection]
+    notes: list[str]
+    scores: ScoreMatrix
+    best: RankedPair | None = None
+
+    def choice(self, ranking: list[RankedPair], of_branch: list[int], index: int) -> OperationChoice:
+        """This branch as an :class:`OperationChoice`."""
+        rank_no = next((k + 1 for k, b in enumerate(of_branch) if b == index), None)
+        return OperationChoice(
+            self.op.visibility,
+            self.op.category,
+            self.op.legal_basis,
+            self.op.vlos_distance_m,
+            tuple(self.uas_ids),
+            int(np.count_nonzero(self.pair_ok)),
+            tuple(e.id for e in self.equipment if e.necessary),
+            self.best,
+            rank_no,
+        )
+
+    uas_ids: tuple[str, ...] = ()
+
+
+def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _Branch:
+    """Equipment, regulation checks, feasibility tests and scores for operation ``op`` flown by
+    the UAS in ``members`` (thesis Figure 66 steps 1–5)."""
+    feats = narrowed_features(dict(mission.features), op)
+    equipment = []
+    for e in mx.equipment.values():
+        st = mx.status_for(e.id, feats, op.facts)
+        if st.status != INCOMPATIBLE:
+            equipment.append(
+                EquipmentNeed(e.id, e.name, e.group, st.status == NECESSARY, st.reason, e.onboard, e.retrofit)
+            )
+    category = op.category
+    cat = regs.category(req.jurisdiction, category)
+    h_reg = regs.max_height_m(req.jurisdiction, category)
+    mtom_lim = cat.limit("mtom")
+    max_mtom = mtom_lim.value_si if mtom_lim is not None else np.inf
+    notes: list[str] = []
+    rejections: list[Rejection] = []
+    height_checks = regs.check(req.jurisdiction, category, height_m=req.altitude_m)
+    mission_ok = all(c.ok for c in height_checks)
+    notes += list(op.notes)
+    if cat.vlos_required and op.bvlos and req.jurisdiction == "faa":
+        # Part 107's VLOS rule is waivable (§107.205): the flight needs a waiver, listed with
+        # the FAA checks, it is not refused.
+        notes.append(f"faa/{category}: BVLOS needs a waiver of 14 CFR §107.31 (§107.205)")
+    elif cat.vlos_required and op.bvlos:
+        mission_ok = False
+        rejections.append(
+            Rejection(
+                "mission",
+                req.mission,
+                "regulation-vlos",
+                op.max_distance_m,
+                op.vlos_distance_m,
+                "m",
+                f"{req.jurisdiction}/{category} requires VLOS ({cat.source}); the pilot-UA distance "
+                f"{op.max_distance_m:g} m exceeds the {op.vlos_distance_m:g} m kept in sight",
+            )
+        )
+    for chk in height_checks:
+        if not chk.ok:
+            rejections.append(
+                Rejection(
+                    "mission",
+                    req.mission,
+                    "regulation-height",
+                    req.altitude_m,
+                    chk.limit.value_si,
+                    "m",
+                    f"required altitude {req.altitude_m:g} m exceeds {chk.limit.describe()}",
+                )
+            )
+    if cat.vlos_required and not op.bvlos:
+        notes.append(
+            f"{req.jurisdiction}/{category}: VLOS required ({cat.source}); "
+            f"{op.max_distance_m:g} m from the pilot, within the {op.vlos_distance_m:g} m kept in sight"
+        )
+    # eq. 60 at the highest height the regulations allow (thesis §5.2.3.4); if the category sets
+    # no height limit the required altitude is used instead.
+    h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
+    uas_ok, rej = _reject(
+        uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids, members
+    )
+    rejections += rej
+    cam_ok, rej = _reject(camera_tests(c, req, h_cam), "camera", c.label, c.ids)
+    rejections += rej
+    pair_ok = uas_ok[:, None] & cam_ok[None, :] & mission_ok
+    for t in pair_tests(u, c, max_mtom):
+        bad = pair_ok & ~t.ok
+        for i, j in zip(*np.nonzero(bad), strict=True):
+            rejections.append(
+                Rejection(
+                    "pair",
+                    f"{u.ids[i]}+{c.ids[j]}",
+                    t.name,
+                    float(t.value[i, j]),
+                    float(t.limit[i, j]),
+                    t.unit,
+                    describe(t, (i, j), f"{u.label(i)} + {c.label(j)}"),
+                )
+            )
+        pair_ok &= t.ok
+    if req.jurisdiction == "easa" and category == "open":
+        # The open subcategory follows the class label, the mass and the distances to people;
+        # a pair the open category cannot admit under this operation is rejected.
+        for i, j in zip(*np.nonzero(pair_ok), strict=True):
+            m = float(u.mass_g[i] + c.mass_g[j])
+            if regs.open_subcategory(m, u.eu_class[i], over_people=op.over_people, urban=op.urban) is None:
+                pair_ok[i, j] = False
+                rejections.append(
+                    Rejection(
+                        "pair",
+                        f"{u.ids[i]}+{c.ids[j]}",
+                        "open-subcategory",
+                        m,
+                        float("nan"),
+                        "g",
+                        f"{u.label(i)} + {c.label(j)}: no open subcategory (A1/A2/A3) admits class "
+                        f"{u.eu_class[i] or 'none'} at {m:.0f} g over people '{op.over_people}'"
+                        f"{' in an urban area' if op.urban else ''}",
+                    )
+                )
+    scores = score_matrix(
+        u.max_range_m, u.mass_g, u.cost_usd, c.mass_g, c.cost_usd, c.ifov_deg, targets, weights, pair_ok
+    )
+    return _Branch(
+        op,
+        members,
+        equipment,
+        h_reg,
+        h_cam,
+        cat.vlos_required,
+        uas_ok,
+        cam_ok,
+        pair_ok,
+        rejections,
+        notes,
+        scores,
+        uas_ids=tuple(u.ids[i] for i in np.flatnonzero(members)),
+    )
+
+
+def _merge_rankings(branches: list[_Branch], req, regs, u, c, top: int) -> tuple[list[RankedPair], list[int]]:
+    """The ``top`` configurations over all branches, ranked by the operation they need
+    (:func:`_burden`: the branches' order), then by score; with the branch of each. Sets each
+    branch's ``best``."""
+    cands = []
+    for k, br in enumerate(branches):
+        for i, j in rank(br.scores.total, top):
+            cands.append((k, i, j))
+            if br.best is None:
+                br.best = _ranked(br, req, regs, u, c, i, j)
+    # Branches are already in burden order and rank() returns each branch's pairs best first
+    # with reproducible ties, so a stable sort by branch keeps both orders.
+    cands.sort(key=lambda x: x[0])
+    chosen = cands[:top]
+    return [_ranked(branches[k], req, regs, u, c, i, j) for k, i, j in chosen], [k for k, _, _ in chosen]
+
+
+def _ranked(br: _Branch, req, regs, u, c, i: int, j: int) -> RankedPair:
+    """The :class:`RankedPair` of UAS ``i`` and camera ``j`` in branch ``br``."""
+    op, scores = br.op, br.scores
+    m = float(scores.mass_g[i, j])
+    return RankedPair(
+        u.ids[i],
+        u.label(i),
+        c.ids[j],
+        c.label(j),
+        float(scores.total[i, j]),
+        float(scores.range[i, 0]),
+        float(scores.weight[i, j]),
+        float(scores.cost[i, j]),
+        float(scores.resolution[0, j]),
+        m,
+        float(scores.cost_usd[i, j]),
+        regs.open_subcategory(m, u.eu_class[i], over_people=op.over_people, urban=op.urban)
+        if "easa" in regs.jurisdictions
+        else None,
+        _sora_of(op, req, u, i, m).sail if req.jurisdiction == "easa" and op.category == "specific" else None,
+        op.visibility,
+        op.category,
+    )
 
 
 def select(
@@ -365,178 +655,53 @@ def select(
     regs = regulations if regulations is not None else load_regulations()
     mission = mx.mission(req.mission)
     u, c = db.uas, db.cameras
-    per_ua_vlos, vlos_default = _vlos_defaults(u, req, regs)
-    op = derive_operation(req, vlos_default=vlos_default)
-    feats = narrowed_features(dict(mission.features), op)
-    equipment = []
-    for e in mx.equipment.values():
-        st = mx.status_for(e.id, feats, op.facts)
-        if st.status != INCOMPATIBLE:
-            equipment.append(
-                EquipmentNeed(e.id, e.name, e.group, st.status == NECESSARY, st.reason, e.onboard, e.retrofit)
-            )
-    category = op.category
-    cat = regs.category(req.jurisdiction, category)
-    h_reg = regs.max_height_m(req.jurisdiction, category)
-    mtom_lim = cat.limit("mtom")
-    max_mtom = mtom_lim.value_si if mtom_lim is not None else np.inf
-    notes = []
-    rejections: list[Rejection] = []
-    height_checks = regs.check(req.jurisdiction, category, height_m=req.altitude_m)
-    mission_ok = all(c.ok for c in height_checks)
-    notes += list(op.notes)
-    if cat.vlos_required and op.bvlos and req.jurisdiction == "faa":
-        # Part 107's VLOS rule is waivable (§107.205): the flight needs a waiver, listed with
-        # the FAA checks, it is not refused.
-        notes.append(f"faa/{category}: BVLOS needs a waiver of 14 CFR §107.31 (§107.205)")
-    elif cat.vlos_required and op.bvlos:
-        mission_ok = False
-        rejections.append(
-            Rejection(
-                "mission",
-                req.mission,
-                "regulation-vlos",
-                op.max_distance_m,
-                op.vlos_distance_m,
-                "m",
-                f"{req.jurisdiction}/{category} requires VLOS ({cat.source}); the pilot-UA distance "
-                f"{op.max_distance_m:g} m exceeds the {op.vlos_distance_m:g} m kept in sight",
-            )
-        )
-    for chk in height_checks:
-        if not chk.ok:
-            rejections.append(
-                Rejection(
-                    "mission",
-                    req.mission,
-                    "regulation-height",
-                    req.altitude_m,
-                    chk.limit.value_si,
-                    "m",
-                    f"required altitude {req.altitude_m:g} m exceeds {chk.limit.describe()}",
-                )
-            )
-    if cat.vlos_required and not op.bvlos:
+    branches = [
+        _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights)
+        for op, members in _operations_per_uas(u, req, regs)
+    ]
+    ranking, of_branch = _merge_rankings(branches, req, regs, u, c, top)
+    # The output describes the operation of the configuration ranked first; when nothing
+    # ranks, the least demanding operation (the branches are sorted by _burden).
+    main = branches[of_branch[0]] if ranking else branches[0]
+    op, equipment = main.op, main.equipment
+    notes = list(main.notes)
+    rejections = list(main.rejections)
+    for br in branches:
+        if br is main:
+            continue
+        tag = f"[{br.op.visibility}/{br.op.category}] "
+        seen = {(r.kind, r.item, r.test, r.message) for r in rejections}
+        for r in br.rejections:
+            if r.kind == "uas" or (r.kind, r.item, r.test, r.message) not in seen:
+                rejections.append(r if r.kind == "uas" else replace(r, message=tag + r.message))
+    if len(branches) > 1:
         notes.append(
-            f"{req.jurisdiction}/{category}: VLOS required ({cat.source}); "
-            f"{op.max_distance_m:g} m from the pilot, within the {op.vlos_distance_m:g} m kept in sight"
-        )
-    # eq. 60 at the highest height the regulations allow (thesis §5.2.3.4); if the category sets
-    # no height limit the required altitude is used instead.
-    h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
-    sight = []
-    if per_ua_vlos is not None and op.visibility != "BVLOS":
-        # The operation is flown in sight (of the pilot, or of an observer each): a UA too small
-        # to be kept in sight at the pilot distance cannot fly it.
-        reach = per_ua_vlos * (op.observers + 1)
-        sight.append(
-            TestResult(
-                "vlos-distance",
-                reach >= op.max_distance_m,
-                reach,
-                np.full(len(u), op.max_distance_m),
-                "m",
-                ">=",
+            "operation per UA (each UAS is held to the distance at which it can be kept in sight): "
+            + "; ".join(
+                f"{int(br.members.sum())} UAS {br.op.visibility} ({br.op.category})" for br in branches
             )
+            + "; configurations ranked by the operation they need (no authorisation first, then "
+            "the pilot's own sight before observers before BVLOS), then by score"
         )
-    uas_ok, rej = _reject(
-        uas_tests(u, req, max_mtom) + sight + equipment_tests(u, req, equipment), "uas", u.label, u.ids
-    )
-    rejections += rej
-    cam_ok, rej = _reject(camera_tests(c, req, h_cam), "camera", c.label, c.ids)
-    rejections += rej
-    pair_ok = uas_ok[:, None] & cam_ok[None, :] & mission_ok
-    for t in pair_tests(u, c, max_mtom):
-        bad = pair_ok & ~t.ok
-        for i, j in zip(*np.nonzero(bad), strict=True):
-            rejections.append(
-                Rejection(
-                    "pair",
-                    f"{u.ids[i]}+{c.ids[j]}",
-                    t.name,
-                    float(t.value[i, j]),
-                    float(t.limit[i, j]),
-                    t.unit,
-                    describe(t, (i, j), f"{u.label(i)} + {c.label(j)}"),
-                )
-            )
-        pair_ok &= t.ok
-    scores = score_matrix(
-        u.max_range_m, u.mass_g, u.cost_usd, c.mass_g, c.cost_usd, c.ifov_deg, targets, weights, pair_ok
-    )
-    is_open = req.jurisdiction == "easa" and category == "open"
-    if is_open:
-        # The open subcategory follows the class label, the mass and the distances to people;
-        # a pair the open category cannot admit under this operation is rejected.
-        for i, j in zip(*np.nonzero(pair_ok), strict=True):
-            m = float(u.mass_g[i] + c.mass_g[j])
-            if regs.open_subcategory(m, u.eu_class[i], over_people=op.over_people, urban=op.urban) is None:
-                pair_ok[i, j] = False
-                rejections.append(
-                    Rejection(
-                        "pair",
-                        f"{u.ids[i]}+{c.ids[j]}",
-                        "open-subcategory",
-                        m,
-                        float("nan"),
-                        "g",
-                        f"{u.label(i)} + {c.label(j)}: no open subcategory (A1/A2/A3) admits class "
-                        f"{u.eu_class[i] or 'none'} at {m:.0f} g over people '{op.over_people}'"
-                        f"{' in an urban area' if op.urban else ''}",
-                    )
-                )
-        scores = score_matrix(
-            u.max_range_m, u.mass_g, u.cost_usd, c.mass_g, c.cost_usd, c.ifov_deg, targets, weights, pair_ok
-        )
-    is_specific = req.jurisdiction == "easa" and category == "specific"
-
-    def sora_of(i: int, m: float, quantitative: bool = False) -> SoraResult:
-        return assess(
-            dimension_m=float(u.span_m[i]),
-            speed_ms=float(u.max_speed_ms[i]),
-            population=op.population,
-            # SORA treats EVLOS like VLOS: the observers give the see-and-avoid (TMPR)
-            bvlos=op.visibility == "BVLOS",
-            mass_g=m,
-            height_m=req.altitude_m,
-            airspace=req.airspace,
-            urban=op.urban,
-            mitigations=dict(req.mitigations),
-            residual_arc=req.residual_arc,
-            edition=req.sora_edition,
-            density_ppl_km2=op.population_density,
-            quantitative=quantitative,
-        )
-
-    ranking = []
-    for i, j in rank(scores.total, top):
-        m = float(scores.mass_g[i, j])
-        ranking.append(
-            RankedPair(
-                u.ids[i],
-                u.label(i),
-                c.ids[j],
-                c.label(j),
-                float(scores.total[i, j]),
-                float(scores.range[i, 0]),
-                float(scores.weight[i, j]),
-                float(scores.cost[i, j]),
-                float(scores.resolution[0, j]),
-                m,
-                float(scores.cost_usd[i, j]),
-                regs.open_subcategory(m, u.eu_class[i], over_people=op.over_people, urban=op.urban)
-                if "easa" in regs.jurisdictions
-                else None,
-                sora_of(i, m).sail if is_specific else None,
-            )
-        )
+    uas_ok = np.zeros(len(u), dtype=bool)
+    cam_ok = np.zeros(len(c), dtype=bool)
+    pair_ok = np.zeros((len(u), len(c)), dtype=bool)
+    total = np.full((len(u), len(c)), np.inf)
+    for br in branches:
+        uas_ok |= br.uas_ok
+        cam_ok |= br.cam_ok
+        pair_ok |= br.pair_ok
+        total[br.members] = br.scores.total[br.members]
+    scores = replace(main.scores, total=total)
+    operations = [br.choice(ranking, of_branch, i) for i, br in enumerate(branches)]
+    is_specific = req.jurisdiction == "easa" and op.category == "specific"
     sora = None
     scenarios: tuple[ScenarioCheck, ...] = ()
     if ranking:
         best = ranking[0]
         bi = u.ids.index(best.uas_id)
         if is_specific:
-            sora = sora_of(bi, best.mass_g, quantitative=True)
+            sora = _sora_of(op, req, u, bi, best.mass_g, quantitative=True)
         if req.jurisdiction == "easa":
             scenarios = eu_scenarios(
                 op,
@@ -602,9 +767,9 @@ def select(
         mission.name,
         dict(mission.features),
         equipment,
-        h_reg,
-        required_hfov_deg(req.image_size_m[0], h_cam),
-        cat.vlos_required,
+        main.h_reg,
+        required_hfov_deg(req.image_size_m[0], main.h_cam),
+        main.vlos_required,
         uas_ok,
         cam_ok,
         pair_ok,
@@ -619,4 +784,5 @@ def select(
         scenarios,
         withheld,
         window,
+        operations,
     )
