@@ -105,6 +105,8 @@ class Requirements:
     observers: int = 0
     residual_arc: str | None = None
     flight_duration_s: float | None = None
+    #: Where ``altitude_m`` came from when not ``--altitude`` (a plan flying higher), else None.
+    altitude_source: str | None = None
 
     def __post_init__(self) -> None:
         checks = {

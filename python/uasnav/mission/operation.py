@@ -211,7 +211,7 @@ def derive_operation(req: Requirements, *, vlos_default: tuple[float, str] | Non
         Fact(
             "height",
             f"{req.altitude_m:g} m AGL",
-            f"--altitude = {req.altitude_m:g} m",
+            req.altitude_source or f"--altitude = {req.altitude_m:g} m",
             "(EU) 2019/947 Art. 4(1)(e) 120 m; 14 CFR §107.51(b) 400 ft",
         )
     )

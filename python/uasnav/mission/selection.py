@@ -366,6 +366,25 @@ def _reject(
     return ok, out
 
 
+def _plan_altitude(req: Requirements, area: MissionArea) -> tuple[Requirements, str | None]:
+    """``req`` with the height the plan ``area`` flies when it is above ``--altitude`` (the
+    height checks use the higher), and the note saying which was used."""
+    from uasnav.mission.zones import plan_height
+
+    got = plan_height(area, ground_elevation_m=req.ground_elevation_m)
+    if got is None:
+        return req, None
+    h, how = got
+    if h > req.altitude_m:
+        note = (
+            f"the plan flies up to {h:g} m above ground ({how}), above --altitude {req.altitude_m:g} m: "
+            f"the height checks use {h:g} m"
+        )
+        return replace(req, altitude_m=h, altitude_source=f"plan, highest item ({how})"), note
+    note = f"the plan's highest item is {h:g} m above ground ({how}), within --altitude {req.altitude_m:g} m"
+    return req, note
+
+
 def _sora_of(op: Operation, req: Requirements, u, i: int, m: float, quantitative: bool = False) -> SoraResult:
     """SORA of UAS ``i`` at take-off mass ``m`` (g) flown as ``op``."""
     return assess(
@@ -655,6 +674,9 @@ def select(
     regs = regulations if regulations is not None else load_regulations()
     mission = mx.mission(req.mission)
     u, c = db.uas, db.cameras
+    plan_note = None
+    if area is not None and area.plan_altitudes:
+        req, plan_note = _plan_altitude(req, area)
     branches = [
         _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights)
         for op, members in _operations_per_uas(u, req, regs)
@@ -664,7 +686,7 @@ def select(
     # ranks, the least demanding operation (the branches are sorted by _burden).
     main = branches[of_branch[0]] if ranking else branches[0]
     op, equipment = main.op, main.equipment
-    notes = list(main.notes)
+    notes = list(main.notes) + ([plan_note] if plan_note else [])
     rejections = list(main.rejections)
     for br in branches:
         if br is main:

@@ -37,7 +37,7 @@ from shapely.validation import explain_validity
 from uasnav import jsoncheck as jc
 from uasnav.errors import DataFormatError, InputError
 from uasnav.io.ed269 import MAX_BYTES, Volume, Zone, parse_zones
-from uasnav.io.mission_plan import MissionPlan, plan_route
+from uasnav.io.mission_plan import AltitudeFrame, MissionPlan, plan_route
 from uasnav.io.plan_formats.csv_plan import parse_plan_csv
 from uasnav.io.plan_formats.qgc import parse_qgc_plan
 from uasnav.io.plan_formats.source import MAX_PLAN_BYTES
@@ -138,6 +138,9 @@ class MissionArea:
     parts: tuple[Any, ...]
     buffer_m: float
     where: str
+    #: For a plan's footprint: each positioned item's altitude as (altitude m, frame — an
+    #: :class:`~uasnav.io.mission_plan.AltitudeFrame` value —, item index); empty otherwise.
+    plan_altitudes: tuple[tuple[float, str, int], ...] = ()
 
     def centre(self) -> tuple[float, float]:
         """(lon, lat) deg: mean of every vertex (the projection origin)."""
@@ -211,7 +214,45 @@ def area_from_plan(plan: MissionPlan, where: str = "plan", *, buffer_m: float) -
     lat, lon, _ = pymap3d.ned2geodetic(route[:, 0], route[:, 1], 0.0, lat0, lon0, 0.0)
     pts = list(zip(np.atleast_1d(lon).tolist(), np.atleast_1d(lat).tolist(), strict=True))
     part = ("point", pts[:1]) if len(pts) == 1 else ("line", pts)
-    return MissionArea((part,), float(buffer_m), where)
+    alts = tuple(
+        (float(it.alt_m), it.altitude_frame.value, k)
+        for k, it in enumerate(plan.items)
+        if it.has_position and math.isfinite(it.alt_m) and it.altitude_frame is not AltitudeFrame.NONE
+    )
+    return MissionArea((part,), float(buffer_m), where, alts)
+
+
+def plan_height(area: MissionArea, *, ground_elevation_m: float | None) -> tuple[float, str] | None:
+    """The highest height above ground (m) a plan's footprint ``area`` flies, and which item and
+    frame gave it; None when the area is no plan or no item carries an altitude.
+
+    Frames: ``terrain`` is above the ground below the UA (AGL); ``relative`` is above the
+    take-off point, taken as AGL (level ground: the plan says nothing of the terrain); ``amsl``
+    needs the ground elevation (m AMSL) of the area to become AGL.
+
+    Raises
+    ------
+    InputError
+        An AMSL altitude without ``ground_elevation_m``: the frames cannot be compared.
+    """
+    best: tuple[float, str] | None = None
+    n = len(area.plan_altitudes)
+    # Items are named by their 1-based place among the plan's items (the home position apart).
+    for alt, frame, k in area.plan_altitudes:
+        if frame == AltitudeFrame.AMSL.value:
+            if ground_elevation_m is None:
+                raise InputError(
+                    f"{area.where}: item {k + 1} flies at {alt:g} m AMSL, which cannot be compared with "
+                    "--altitude (above ground) or the height limits without --ground-elevation"
+                )
+            h, how = alt - ground_elevation_m, f"{alt:g} m AMSL - ground {ground_elevation_m:g} m"
+        elif frame == AltitudeFrame.TERRAIN.value:
+            h, how = alt, f"{alt:g} m above terrain"
+        else:
+            h, how = alt, f"{alt:g} m above take-off, taken as above ground"
+        if best is None or h > best[0]:
+            best = (h, f"{area.where} item {k + 1} of {n}: {how}")
+    return best
 
 
 def _plan_parser(where: str, data: bytes | str | dict):
