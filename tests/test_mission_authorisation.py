@@ -251,3 +251,76 @@ def test_pdra_scopes() -> None:
     assert not _checks(sparse)["PDRA-G03"].applies  # 50 m is above its 30 m
     for k in ("PDRA-S01", "PDRA-S02", "PDRA-G02"):
         assert "Article 11" in PDRA_SOURCES[k] and "ED Decision" in PDRA_SOURCES[k]
+
+
+# Every numeric scope limit of the STS/PDRA table at its boundary: (scenario, requirements,
+# UA (dimension m, MTOM g, speed m/s)) just inside, then just outside the limit. A VLOS flight
+# is one within --vlos-distance; BVLOS beyond it.
+_BV = dict(vlos_distance_m=100.0, population_density=100.0)
+_UA = (0.9, 6300.0, 23.0)
+_KE_EDGE = (0.9, 2000.0, (2 * 34e3 / 2.0) ** 0.5)  # exactly 34 kJ
+SCOPE_EDGES = [
+    ("STS-02", dict(range_m=1000.0, **_BV), dict(range_m=1000.1, **_BV), "C6"),
+    ("STS-02", dict(range_m=2000.0, observers=1, **_BV), dict(range_m=2000.1, observers=1, **_BV), "C6"),
+    (
+        "STS-02",
+        dict(range_m=900.0, altitude_m=120.0, **_BV),
+        dict(range_m=900.0, altitude_m=120.1, **_BV),
+        "C6",
+    ),
+    ("STS-01", dict(range_m=50.0, altitude_m=120.0), dict(range_m=50.0, altitude_m=120.1), "C5"),
+    ("PDRA-S02", dict(range_m=1000.0, **_BV), dict(range_m=1000.1, **_BV), None),
+    (
+        "PDRA-S02",
+        dict(range_m=900.0, altitude_m=149.9, **_BV),
+        dict(range_m=900.0, altitude_m=150.0, **_BV),
+        None,
+    ),
+    ("PDRA-S01", dict(range_m=50.0, altitude_m=149.9), dict(range_m=50.0, altitude_m=150.0), None),
+    (
+        "PDRA-G01",
+        dict(range_m=900.0, altitude_m=149.9, **_BV),
+        dict(range_m=900.0, altitude_m=150.0, **_BV),
+        None,
+    ),
+    (
+        "PDRA-G03",
+        dict(range_m=900.0, altitude_m=30.0, **_BV),
+        dict(range_m=900.0, altitude_m=30.01, **_BV),
+        None,
+    ),
+]
+
+
+@pytest.mark.parametrize(("sid", "inside", "outside", "cls"), SCOPE_EDGES)
+def test_scenario_scope_limits_at_their_boundary(sid, inside, outside, cls) -> None:
+    def applies(req_kw: dict, ua=_UA) -> bool:
+        op = derive_operation(Requirements(**req_kw))
+        dim, m, v = ua
+        return next(
+            x for x in eu_scenarios(op, eu_class=cls, mtom_g=m, dimension_m=dim, speed_ms=v) if x.id == sid
+        ).applies
+
+    assert applies(inside) and not applies(outside)
+
+
+@pytest.mark.parametrize("sid", ["PDRA-G01", "PDRA-G02", "PDRA-G03", "PDRA-S01", "PDRA-S02"])
+def test_ua_limits_of_the_pdras_at_their_boundary(sid) -> None:
+    kw = dict(range_m=900.0, altitude_m=25.0, **_BV)
+    if sid == "PDRA-S01":
+        kw = dict(range_m=50.0, altitude_m=25.0)
+    if sid == "PDRA-G02":
+        kw["airspace"] = "atypical"
+    op = derive_operation(Requirements(**kw))
+
+    def applies(dim: float, m: float, v: float) -> bool:
+        return next(
+            x for x in eu_scenarios(op, eu_class=None, mtom_g=m, dimension_m=dim, speed_ms=v) if x.id == sid
+        ).applies
+
+    assert applies(3.0, 2000.0, 10.0) and not applies(3.01, 2000.0, 10.0)  # 3 m dimension
+    if sid in ("PDRA-G01", "PDRA-G02", "PDRA-G03"):  # 34 kJ typical kinetic energy
+        dim, m, v = _KE_EDGE
+        assert applies(dim, m, v) and not applies(dim, m, v * 1.0001)
+    if sid == "PDRA-S02":  # 25 kg MTOM
+        assert applies(1.0, 25e3, 5.0) and not applies(1.0, 25e3 + 1.0, 5.0)

@@ -13,7 +13,9 @@ FAA Part 107 (over people under Subpart D, night, waivers).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -383,166 +385,228 @@ PDRA_SOURCES = {
 }
 
 
+@dataclass(frozen=True)
+class Limit:
+    """One scope condition of a scenario: ``fact`` (of the operation and UA, see
+    :func:`scenario_facts`) ``test`` ``value``, else the scenario does not apply, ``why``
+    (formatted with the facts) saying so.
+
+    ``test`` is ``==``, ``!=``, ``<=``, ``<``, ``in`` or ``not in``; ``<=obs`` compares with
+    ``value[1]`` when airspace observers are employed, else ``value[0]``.
+    """
+
+    fact: str
+    test: str
+    value: Any
+    why: str
+
+    def met(self, facts: dict[str, Any]) -> bool:
+        """Whether ``facts`` satisfy the condition."""
+        x = facts[self.fact]
+        if self.test == "<=obs":
+            return bool(x <= self.value[1 if facts["observers"] > 0 else 0])
+        return bool(_TESTS[self.test](x, self.value))
+
+
+_TESTS: dict[str, Callable[[Any, Any], bool]] = {
+    "==": lambda x, v: x == v,
+    "!=": lambda x, v: x != v,
+    "<=": lambda x, v: x <= v,
+    "<": lambda x, v: x < v,
+    "in": lambda x, v: x in v,
+    "not in": lambda x, v: x not in v,
+}
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """An EU standard scenario or PDRA: its scope (section (a)) as :class:`Limit` rows, the
+    conditions that are not inputs (listed with every check) and its document."""
+
+    id: str
+    limits: tuple[Limit, ...]
+    also: tuple[str, ...]
+    source: str
+
+
+# Scope conditions shared by several scenarios.
+def _needs_vlos(sid: str) -> Limit:
+    return Limit("vlos", "==", True, f"{sid} is VLOS")
+
+
+def _needs_bvlos(sid: str, note: str = "") -> Limit:
+    return Limit("vlos", "==", False, f"{sid} is BVLOS{note}")
+
+
+def _range_1_2km(sid: str) -> Limit:
+    """STS-02 / PDRA-S02: 1 km from the remote pilot, 2 km with airspace observers."""
+    return Limit(
+        "max_distance_m",
+        "<=obs",
+        (1000.0, 2000.0),
+        "{max_distance_m:g} m from the pilot, " + sid + " allows 1 km (2 km with airspace observers)",
+    )
+
+
+_DIM_3M = Limit("dimension_m", "<=", 3.0, "dimension {dimension_m:g} m > 3 m")
+_KE_34KJ = Limit("kinetic_energy_j", "<=", 34e3, "kinetic energy {kinetic_energy_kj:.1f} kJ > 34 kJ")
+_SPARSE = Limit("sparse", "==", True, "not a sparsely populated area")
+_NOT_ASSEMBLIES = Limit("over_people", "!=", "assemblies", "over assemblies")
+_LOW_MANNED = Limit(
+    "airspace",
+    "not in",
+    ("airport-bcd", "airport-efg", "tmz"),
+    "airspace {airspace}: not a low probability of encountering manned aircraft",
+)
+_CONTROLLED_GROUND = "needs a controlled ground area under the UA"
+_LOW_MANNED_ALSO = "needs a low probability of encountering manned aircraft"
+
+#: The EU standard scenarios and PDRAs whose scope :func:`eu_scenarios` checks, each row with
+#: its limits and document (:data:`PDRA_SOURCES`).
+SCENARIOS: tuple[Scenario, ...] = (
+    Scenario(
+        "STS-01",
+        (
+            _needs_vlos("STS-01"),
+            Limit("eu_class", "==", "C5", "UA class {eu_class_name}, STS-01 needs C5"),
+            Limit("height_m", "<=", EU_MAX_HEIGHT_M, "above 120 m"),
+            _NOT_ASSEMBLIES,
+        ),
+        (_CONTROLLED_GROUND,),
+        PDRA_SOURCES["STS-01"],
+    ),
+    Scenario(
+        "STS-02",
+        (
+            _needs_bvlos("STS-02", " (a VLOS flight needs none)"),
+            Limit("eu_class", "==", "C6", "UA class {eu_class_name}, STS-02 needs C6"),
+            _range_1_2km("STS-02"),
+            _SPARSE,
+            Limit("height_m", "<=", EU_MAX_HEIGHT_M, "above 120 m"),
+        ),
+        (_CONTROLLED_GROUND,),
+        PDRA_SOURCES["STS-02"],
+    ),
+    Scenario(
+        "PDRA-G01",
+        (
+            _needs_bvlos("PDRA-G01"),
+            _DIM_3M,
+            _KE_34KJ,
+            _SPARSE,
+            Limit("height_m", "<", 150.0, "not below 150 m"),
+            Limit("airspace", "in", ("uncontrolled", "atypical"), "not in uncontrolled airspace"),
+        ),
+        (),
+        PDRA_SOURCES["PDRA-G01"],
+    ),
+    # PDRA-S01: STS-01's operation without the C5 label.
+    Scenario(
+        "PDRA-S01",
+        (
+            _needs_vlos("PDRA-S01"),
+            _DIM_3M,
+            Limit("height_m", "<", 150.0, "not below 150 m AGL"),
+            Limit("over_people", "!=", "assemblies", "over assemblies (the ground area must be controlled)"),
+            _LOW_MANNED,
+        ),
+        ("needs a controlled ground area under the UA (may be in a populated area)", _LOW_MANNED_ALSO),
+        PDRA_SOURCES["PDRA-S01"],
+    ),
+    # PDRA-S02: STS-02's operation without the C6 label.
+    Scenario(
+        "PDRA-S02",
+        (
+            _needs_bvlos("PDRA-S02", " (a VLOS flight needs none)"),
+            _DIM_3M,
+            Limit("mtom_g", "<=", 25e3, "MTOM {mtom_kg:.1f} kg > 25 kg"),
+            _range_1_2km("PDRA-S02"),
+            _SPARSE,
+            Limit("height_m", "<", 150.0, "not below 150 m AGL"),
+            _LOW_MANNED,
+        ),
+        ("needs a controlled ground area entirely in a sparsely populated area", _LOW_MANNED_ALSO),
+        PDRA_SOURCES["PDRA-S02"],
+    ),
+    # PDRA-G02: BVLOS in reserved/segregated airspace (ARC-a).
+    Scenario(
+        "PDRA-G02",
+        (
+            _needs_bvlos("PDRA-G02"),
+            _DIM_3M,
+            _KE_34KJ,
+            _SPARSE,
+            Limit(
+                "airspace",
+                "==",
+                "atypical",
+                "airspace {airspace}: PDRA-G02 needs reserved or segregated airspace (ARC-a)",
+            ),
+        ),
+        ("within the direct C2 link's radio line of sight",),
+        PDRA_SOURCES["PDRA-G02"],
+    ),
+    # PDRA-G03: linear inspections close to the surface (atypical, very low level) — the
+    # primary text was not reached: scope from a secondary summary, flagged in its source.
+    Scenario(
+        "PDRA-G03",
+        (
+            _needs_bvlos("PDRA-G03"),
+            _DIM_3M,
+            _KE_34KJ,
+            _SPARSE,
+            Limit(
+                "height_m",
+                "<=",
+                PDRA_G03_MAX_HEIGHT_M,
+                "{height_m:g} m above the surface: PDRA-G03 flies at most " + f"{PDRA_G03_MAX_HEIGHT_M:g} m",
+            ),
+        ),
+        ("pre-programmed flight within the direct C2 link's range",),
+        PDRA_SOURCES["PDRA-G03"],
+    ),
+)
+
+
+def scenario_facts(
+    op: Operation, *, eu_class: str | None, mtom_g: float, dimension_m: float, speed_ms: float
+) -> dict[str, Any]:
+    """The facts the :class:`Limit` rows read: the operation's and one UA's (typical kinetic
+    energy ½·m·v² at the UA's maximum speed, J)."""
+    ke = 0.5 * mtom_g / 1000.0 * speed_ms**2
+    return {
+        "vlos": op.visibility == "VLOS",
+        "eu_class": eu_class,
+        "eu_class_name": eu_class or "none",
+        "height_m": op.height_m,
+        "over_people": op.over_people,
+        "max_distance_m": op.max_distance_m,
+        "observers": op.observers,
+        "sparse": DENSITY_CLASSES[op.population] < SPARSE_DENSITY,
+        "airspace": op.airspace,
+        "dimension_m": dimension_m,
+        "kinetic_energy_j": ke,
+        "kinetic_energy_kj": ke / 1e3,
+        "mtom_g": mtom_g,
+        "mtom_kg": mtom_g / 1e3,
+    }
+
+
 def eu_scenarios(
     op: Operation, *, eu_class: str | None, mtom_g: float, dimension_m: float, speed_ms: float
 ) -> tuple[ScenarioCheck, ...]:
     """Which EU standard scenarios (STS-01, STS-02) and PDRAs (G01, S01, S02, G02, G03) fit the
-    operation with one UA; each check names its document (:data:`PDRA_SOURCES`).
+    operation with one UA: every :data:`SCENARIOS` row evaluated on :func:`scenario_facts`.
 
     Only the scope of each PDRA is checked (its section (a)); conditions that are not inputs
     (a controlled ground area, a low probability of meeting manned aircraft, the C2 range) are
     listed with the check.
     """
-    ke = 0.5 * mtom_g / 1000.0 * speed_ms**2
-    sparse = DENSITY_CLASSES[op.population] < SPARSE_DENSITY
+    facts = scenario_facts(op, eu_class=eu_class, mtom_g=mtom_g, dimension_m=dimension_m, speed_ms=speed_ms)
     out = []
-    why = []
-    if op.visibility != "VLOS":
-        why.append("STS-01 is VLOS")
-    if eu_class != "C5":
-        why.append(f"UA class {eu_class or 'none'}, STS-01 needs C5")
-    if op.height_m > EU_MAX_HEIGHT_M:
-        why.append("above 120 m")
-    if op.over_people == "assemblies":
-        why.append("over assemblies")
-    out.append(
-        ScenarioCheck(
-            "STS-01",
-            not why,
-            (*why, "needs a controlled ground area under the UA"),
-            PDRA_SOURCES["STS-01"],
-        )
-    )
-    why = []
-    if op.visibility == "VLOS":
-        why.append("STS-02 is BVLOS (a VLOS flight needs none)")
-    if eu_class != "C6":
-        why.append(f"UA class {eu_class or 'none'}, STS-02 needs C6")
-    if op.max_distance_m > (2000.0 if op.observers > 0 else 1000.0):
-        why.append(
-            f"{op.max_distance_m:g} m from the pilot, STS-02 allows 1 km (2 km with airspace observers)"
-        )
-    if not sparse:
-        why.append("not a sparsely populated area")
-    if op.height_m > EU_MAX_HEIGHT_M:
-        why.append("above 120 m")
-    out.append(
-        ScenarioCheck(
-            "STS-02",
-            not why,
-            (*why, "needs a controlled ground area under the UA"),
-            PDRA_SOURCES["STS-02"],
-        )
-    )
-    why = []
-    if op.visibility == "VLOS":
-        why.append("PDRA-G01 is BVLOS")
-    if dimension_m > 3.0:
-        why.append(f"dimension {dimension_m:g} m > 3 m")
-    if ke > 34e3:
-        why.append(f"kinetic energy {ke / 1e3:.1f} kJ > 34 kJ")
-    if not sparse:
-        why.append("not a sparsely populated area")
-    if op.height_m >= 150.0:
-        why.append("not below 150 m")
-    if op.airspace not in ("uncontrolled", "atypical"):
-        why.append("not in uncontrolled airspace")
-    out.append(ScenarioCheck("PDRA-G01", not why, tuple(why), PDRA_SOURCES["PDRA-G01"]))
-    # PDRA-S01: STS-01's operation without the C5 label.
-    why = []
-    if op.visibility != "VLOS":
-        why.append("PDRA-S01 is VLOS")
-    if dimension_m > 3.0:
-        why.append(f"dimension {dimension_m:g} m > 3 m")
-    if op.height_m >= 150.0:
-        why.append("not below 150 m AGL")
-    if op.over_people == "assemblies":
-        why.append("over assemblies (the ground area must be controlled)")
-    if op.airspace in ("airport-bcd", "airport-efg", "tmz"):
-        why.append(f"airspace {op.airspace}: not a low probability of encountering manned aircraft")
-    out.append(
-        ScenarioCheck(
-            "PDRA-S01",
-            not why,
-            (
-                *why,
-                "needs a controlled ground area under the UA (may be in a populated area)",
-                "needs a low probability of encountering manned aircraft",
-            ),
-            PDRA_SOURCES["PDRA-S01"],
-        )
-    )
-    # PDRA-S02: STS-02's operation without the C6 label.
-    why = []
-    if op.visibility == "VLOS":
-        why.append("PDRA-S02 is BVLOS (a VLOS flight needs none)")
-    if dimension_m > 3.0:
-        why.append(f"dimension {dimension_m:g} m > 3 m")
-    if mtom_g > 25e3:
-        why.append(f"MTOM {mtom_g / 1e3:.1f} kg > 25 kg")
-    if op.max_distance_m > (2000.0 if op.observers > 0 else 1000.0):
-        why.append(
-            f"{op.max_distance_m:g} m from the pilot, PDRA-S02 allows 1 km (2 km with airspace observers)"
-        )
-    if not sparse:
-        why.append("not a sparsely populated area")
-    if op.height_m >= 150.0:
-        why.append("not below 150 m AGL")
-    if op.airspace in ("airport-bcd", "airport-efg", "tmz"):
-        why.append(f"airspace {op.airspace}: not a low probability of encountering manned aircraft")
-    out.append(
-        ScenarioCheck(
-            "PDRA-S02",
-            not why,
-            (
-                *why,
-                "needs a controlled ground area entirely in a sparsely populated area",
-                "needs a low probability of encountering manned aircraft",
-            ),
-            PDRA_SOURCES["PDRA-S02"],
-        )
-    )
-    # PDRA-G02: BVLOS in reserved/segregated airspace (ARC-a).
-    why = []
-    if op.visibility == "VLOS":
-        why.append("PDRA-G02 is BVLOS")
-    if dimension_m > 3.0:
-        why.append(f"dimension {dimension_m:g} m > 3 m")
-    if ke > 34e3:
-        why.append(f"kinetic energy {ke / 1e3:.1f} kJ > 34 kJ")
-    if not sparse:
-        why.append("not a sparsely populated area")
-    if op.airspace != "atypical":
-        why.append(f"airspace {op.airspace}: PDRA-G02 needs reserved or segregated airspace (ARC-a)")
-    out.append(
-        ScenarioCheck(
-            "PDRA-G02",
-            not why,
-            (*why, "within the direct C2 link's radio line of sight"),
-            PDRA_SOURCES["PDRA-G02"],
-        )
-    )
-    # PDRA-G03: linear inspections close to the surface (atypical, very low level) — the
-    # primary text was not reached: scope from a secondary summary, flagged in its source.
-    why = []
-    if op.visibility == "VLOS":
-        why.append("PDRA-G03 is BVLOS")
-    if dimension_m > 3.0:
-        why.append(f"dimension {dimension_m:g} m > 3 m")
-    if ke > 34e3:
-        why.append(f"kinetic energy {ke / 1e3:.1f} kJ > 34 kJ")
-    if not sparse:
-        why.append("not a sparsely populated area")
-    if op.height_m > PDRA_G03_MAX_HEIGHT_M:
-        why.append(f"{op.height_m:g} m above the surface: PDRA-G03 flies at most {PDRA_G03_MAX_HEIGHT_M:g} m")
-    out.append(
-        ScenarioCheck(
-            "PDRA-G03",
-            not why,
-            (*why, "pre-programmed flight within the direct C2 link's range"),
-            PDRA_SOURCES["PDRA-G03"],
-        )
-    )
+    for sc in SCENARIOS:
+        why = tuple(lim.why.format(**facts) for lim in sc.limits if not lim.met(facts))
+        out.append(ScenarioCheck(sc.id, not why, (*why, *sc.also), sc.source))
     return tuple(out)
 
 

@@ -762,6 +762,18 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
                 # A plan's footprint: the route widened by the buffer, by default the flight
                 # height (the 1:1 ground-risk-buffer rule, EASA AMC1 Art. 11 Annex A A.5.2.4).
                 area = parse_area_document(content, where, buffer_m=buffer if buffer else req.altitude_m)
+                if not buffer:
+                    # ... by the height the plan itself flies when that is higher.
+                    from dataclasses import replace
+
+                    from uasnav.mission.zones import plan_height
+
+                    try:
+                        got = plan_height(area, ground_elevation_m=req.ground_elevation_m)
+                    except InputError:
+                        got = None  # select() refuses the plan with the reason
+                    if got is not None and got[0] > area.buffer_m:
+                        area = replace(area, buffer_m=got[0])
             elif buffer is None:
                 # A polygon is the area itself; a point (take-off) or a line is widened by the
                 # largest pilot distance, the farthest the UA goes from it.
