@@ -1,6 +1,6 @@
 """SORA tables at every boundary, against the tables as printed in the primary documents
 (SORA 2.5: EASA AMC1 Article 11, Issue 1 Amendment 3, ED Decision 2025/018/R — pages below;
-SORA 2.0: JARUS JAR-DEL-WG6-D.04, not re-read this session).
+SORA 2.0: JARUS JAR-DEL-WG6-D.04, primary text not reached in sessions 23-24).
 
 The expected values are written out here as the documents print them (row by row), separately
 from the encoding in uasnav.mission.sora, and every boundary is probed on both sides: a

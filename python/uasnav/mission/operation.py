@@ -354,11 +354,11 @@ PDRA_G03_MAX_HEIGHT_M = 30.0
 PDRA_SOURCES = {
     "STS-01": (
         "(EU) 2019/947 Annex Appendix 1, UAS.STS-01.010/020, inserted by (EU) 2020/639 (OJ L 150, "
-        "13.5.2020); primary text not re-read this session, no page"
+        "13.5.2020); primary text not reached (sessions 23-24), no page"
     ),
     "STS-02": (
         "(EU) 2019/947 Annex Appendix 1, UAS.STS-02.010/020, inserted by (EU) 2020/639 (OJ L 150, "
-        "13.5.2020); primary text not re-read this session, no page"
+        "13.5.2020); primary text not reached (sessions 23-24), no page"
     ),
     "PDRA-G01": (
         "AMC2 Article 11 of (EU) 2019/947, PDRA-G01 v1.3 (edition September 2023, ED Decision "
@@ -377,7 +377,8 @@ PDRA_SOURCES = {
         "2023/012/R), scope (a)(1)-(5); EASA Easy Access Rules online (HTML, no page)"
     ),
     "PDRA-G03": (
-        "PDRA-G03 (AMC to Article 11 of (EU) 2019/947): PRIMARY TEXT NOT REACHED; scope (<= 3 m, "
+        "PDRA-G03 (AMC to Article 11 of (EU) 2019/947; EASA's PDRA list names it 'Linear "
+        "inspections, agricultural works'): PRIMARY TEXT NOT REACHED; scope (<= 3 m, "
         "<= 34 kJ, BVLOS, sparsely populated, atypical air at <= 30 m above the surface, "
         "pre-programmed, within C2 range) from a secondary summary (eudroneport.com, 'PDRA G-03'), "
         "to be checked against the EASA text"

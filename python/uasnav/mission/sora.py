@@ -7,7 +7,7 @@ check every table boundary against the values below.
 
 Sources
 -------
-``[AMC-2.5]`` — SORA 2.5, checked against its primary text in this session:
+``[AMC-2.5]`` — SORA 2.5, checked against its primary text in session 23:
     EASA, "Acceptable Means of Compliance and Guidance Material to Regulation (EU) 2019/947 —
     Issue 1, Amendment 3", Annex to ED Decision 2025/018/R; AMC1 Article 11 "Specific
     operations risk assessment (SORA) (source: JARUS SORA v2.5)", edition September 2025.
@@ -33,15 +33,32 @@ Sources
 ``[SORA-2.0]`` — SORA 2.0: JARUS, "JARUS guidelines on SORA", edition 2.0, JAR-DEL-WG6-D.04,
     30 January 2019 (the basis of EASA's earlier AMC1 Article 11, ED Decision 2019/021/R):
     Table 2 (iGRC), Table 3 (mitigations), Figure 4 (ARC), Table 4 (TMPR), Table 5 (SAIL),
-    Table 6 (OSOs). **The primary text could not be reached in this session** (neither the JARUS
-    PDF nor EASA's 2019 AMC), so no page numbers are given for 2.0: the values are the earlier
-    transcription, unchanged, and where 2.0 and 2.5 share a table (SAIL, TMPR, the OSOs other
-    than #04) they agree with ``[AMC-2.5]``.
+    Table 6 (OSOs). **The tables' primary text could not be reached** (sessions 23 and 24), so no
+    page numbers are given for 2.0: the values are the earlier transcription, unchanged, and
+    where 2.0 and 2.5 share a table (SAIL, TMPR, the OSOs other than #04) they agree with
+    ``[AMC-2.5]``. What session 24 did reach, and why it is not enough:
+
+    * JARUS's publication page "JAR doc 06 SORA (package)", 6 March 2019
+      (jarus-rpas.org/content/jar-doc-06-sora-package): the main body is edition 2.0, Annexes B–E
+      edition 1.0 — it confirms the edition, not the tables;
+    * JARUS SORA Annex C, "Strategic Mitigation Collision Risk Assessment", JAR-DEL-WG6-D.04
+      edition 1.0, 30.01.2019 (public copy on pdfslide.us): title page and contents only;
+    * EASA Easy Access Rules online, "Annex C to AMC1 to Article 11", ED Decision 2023/012/R (the
+      SORA-2.0-based AMC): sections C.1–C.3 only (HTML, no pages).
+    The search tool returns the beginning of a stored page and the GitHub index holds no text of
+    the 2.0 main body or of EASA's 2019–2024 AMC1 Article 11 — only secondary encodings, which
+    disagree with each other and are not used. Unverified 2.0 tables: Table 2 (iGRC, incl. the
+    700 J / 34 kJ / 1084 kJ columns), Table 3 (M1/M2/M3 and the column floor), Figure 4 (ARC),
+    Table 4 (TMPR), Table 5 (SAIL), Table 6 (OSO robustness).
 
 ARC height split: 500 ft AGL (152.4 m). ``[AMC-2.5]`` Figure 6 could not be read, but the same
 text speaks of "operations below 500 ft AGL" for the low TMPR (S.4.6.4(c), p. 36) and pairs
 500 ft with 152 m in its grid-size Table 4 (p. 28); some secondary encodings use 150 m for 2.5
-(JARUS Annex C Table C.1, not reached). The two differ by 2.4 m.
+(JARUS Annex C Table C.1, not reached). The two differ by 2.4 m. ED Decision 2025/018/R carries
+no Annex C of its own (checked in session 24: its Annex B ends on p. 95 and Annex E begins on
+p. 96), so the EU adoption of 2.5 gives no strategic-mitigation table to check the 150 m value
+or the Annex C reduction limits against; ``residual_arc_of`` labels any claim beyond S.4.5.4 an
+Annex C claim to be substantiated.
 
 The flow is the SORA's steps: #2 iGRC → #3 final GRC (mitigations, floor = the column's
 controlled-ground-area value) → #4 initial ARC → #5 residual ARC (strategic mitigations: given
@@ -115,7 +132,7 @@ MITIGATIONS25: dict[str, dict[str, int | None]] = {
 # --- SORA 2.0 ------------------------------------------------------------------------------
 
 #: SORA 2.0 Table 2 columns: (max characteristic dimension m, typical kinetic energy J)
-#: — [SORA-2.0] (primary text not reached this session: no page).
+#: — [SORA-2.0] (primary text not reached in sessions 23-24: no page).
 IGRC20_COLUMNS: tuple[tuple[float, float], ...] = (
     (1.0, 700.0),
     (3.0, 34e3),
@@ -166,7 +183,7 @@ TMPR: dict[str, str] = {"a": "none", "b": "low", "c": "medium", "d": "high"}
 SAILS = ("I", "II", "III", "IV", "V", "VI")
 # OSO robustness per SAIL I..VI: O optional (2.0) / not required (2.5 "NR"), L low, M medium,
 # H high.
-#: SORA 2.0 Table 6 (24 OSOs) — [SORA-2.0] (not re-read this session: no page).
+#: SORA 2.0 Table 6 (24 OSOs) — [SORA-2.0] (primary text not reached in sessions 23-24: no page).
 OSO20: dict[str, tuple[str, str]] = {
     "OSO#01": ("Operator is competent and/or proven", "OLMHHH"),
     "OSO#02": ("UAS manufactured by competent and/or proven entity", "OOLMHH"),
@@ -439,7 +456,7 @@ def residual_arc_of(
     False) may lower the initial ARC by one class but never to ARC-a ([AMC-2.5] S.4.5.4,
     p. 34). Any other lower claim is an Annex C strategic-mitigation claim (operational
     restrictions or airspace structure) the operator must substantiate: it is accepted and
-    labelled so; Annex C's own reduction limits were not reached in this session and are not
+    labelled so; Annex C's own reduction limits were not reached (sessions 23-24) and are not
     checked.
     """
     if initial not in ARCS:
