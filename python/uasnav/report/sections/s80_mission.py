@@ -296,9 +296,40 @@ def _operation_section(w: SectionWriter, res) -> None:
                 )
                 + ". No ADS-B, TAWS or BLOS link is necessary for a rural VLOS flight below 120 m. "
                 + "Each UA is held to the VLOS distance of its size (EASA AMC1 Art. 11 Annex A "
-                + "A.5.2.5: min(327 CD + 20 m rotorcraft, 490 CD + 30 m fixed wing; 1500 m)): "
-                + f"{sum(r.test == 'vlos-distance' for r in vlos.rejections)} UAS too small to be "
-                + "kept in sight at 300 m are rejected."
+                + "A.5.2.5: min(327 CD + 20 m rotorcraft, 490 CD + 30 m fixed wing; 1500 m)), so "
+                + "the operation follows the UA: those too small to be kept in sight at 300 m are "
+                + "flown BVLOS in the specific category and ranked after the configurations that "
+                + "need no authorisation (table below)."
+            ),
+        )
+        w.table(
+            [
+                "operation",
+                "category",
+                "UAS",
+                "in sight up to (m)",
+                "best configuration",
+                "score",
+                "SAIL",
+                "rank",
+            ],
+            [
+                [
+                    o.visibility,
+                    o.category,
+                    len(o.uas),
+                    o.vlos_distance_m,
+                    f"{o.best.uas} + {o.best.camera}" if o.best else "none feasible",
+                    o.best.score if o.best else None,
+                    (o.best.sail if o.best else None) or "-",
+                    o.rank if o.rank is not None else f"> {len(vlos.ranking)}",
+                ]
+                for o in vlos.operations
+            ],
+            caption=(
+                "The operations the UAS imply at 300 m, each with its best configuration: the "
+                "operation (and so the category and the equipment) follows the distance at which "
+                "each UA can be kept in sight, not the best candidate's."
             ),
         )
     s = sel.sora
