@@ -447,6 +447,7 @@ class _Branch:
     notes: list[str]
     scores: ScoreMatrix
     best: RankedPair | None = None
+    uas_ids: tuple[str, ...] = ()
 
     def choice(self, ranking: list[RankedPair], of_branch: list[int], index: int) -> OperationChoice:
         """This branch as an :class:`OperationChoice`."""
@@ -462,8 +463,6 @@ class _Branch:
             self.best,
             rank_no,
         )
-
-    uas_ids: tuple[str, ...] = ()
 
 
 def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _Branch:
