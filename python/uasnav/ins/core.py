@@ -31,9 +31,9 @@ from uasnav import _core
 from uasnav.atomicfile import atomic_open
 from uasnav.attitude import quat_to_euler
 from uasnav.errors import InputError
+from uasnav.ins.magnetic import resolve_declination
 from uasnav.io.navdata import Flight
 from uasnav.stationary import detect_static
-from uasnav.ins.magnetic import resolve_declination
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
