@@ -54,7 +54,8 @@ class Comparison:
     Attributes are RMS and 95th percentiles (p95) of the magnitudes: horizontal and vertical
     position (m), velocity (m/s, 3-D), roll/pitch (deg, RMS per axis and of both) and yaw
     (deg; p95 of roll/pitch over both axes' magnitudes). ``vertical_bias_m`` is the mean
-    vertical difference (the autopilot may use another datum); ``n`` the number of compared samples; ``reference`` its name.
+    vertical difference (the autopilot may use another datum); ``n`` the number of compared
+    samples; ``reference`` its name.
     """
 
     horizontal_rms_m: float
