@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -224,3 +225,39 @@ def test_declination_from_the_log_or_the_magnetic_model(shared_data) -> None:  #
         yaw[decl] = ev.compare(r, f.reference, t_range=(84.0, 238.0)).yaw_rms_deg
     assert r.summary["declination_deg"] == pytest.approx(12.39, abs=0.01)
     assert yaw[None] < 0.75 * yaw[0.0], yaw
+
+
+def _dataflash_without(src: Path, dst: Path, drop: set[str]) -> int:
+    """Copy a DataFlash log record by record (lengths from its FMT records), leaving out the
+    message types ``drop``; returns how many records were left out."""
+    data = src.read_bytes()
+    lengths, names = {128: 89}, {}
+    out, i, dropped = bytearray(), 0, 0
+    while i + 3 <= len(data):
+        t = data[i + 2]
+        if data[i] != 0xA3 or data[i + 1] != 0x95 or t not in lengths:
+            i += 1
+            continue
+        rec = data[i : i + lengths[t]]
+        if t == 128:  # FMT: type, length, name
+            lengths[rec[3]], names[rec[3]] = rec[4], rec[5:9].rstrip(b"\0").decode()
+        if names.get(t) in drop:
+            dropped += 1
+        else:
+            out += rec
+        i += lengths[t]
+    dst.write_bytes(bytes(out))
+    return dropped
+
+
+def test_dataflash_without_gps_or_imu_is_a_named_error(shared_data, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """log171 with its GPS (or its IMU) records removed: the reader and `uasnav nav` fail with
+    one error line naming the missing message."""
+    src = shared_data / "logs" / "ardupilot_log171.bin"
+    no_gps, no_imu = tmp_path / "nogps.bin", tmp_path / "noimu.bin"
+    assert _dataflash_without(src, no_gps, {"GPS"}) > 1000
+    assert _dataflash_without(src, no_imu, {"IMU", "IMU2", "IMU3"}) > 10000
+    runner = CliRunner()
+    for path, what in ((no_gps, "column 'GPS': no GPS message"), (no_imu, "no IMU/IMU2/IMU3 messages")):
+        r = runner.invoke(main, ["nav", str(path)])
+        assert r.exit_code == 1 and what in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
