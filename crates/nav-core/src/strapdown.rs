@@ -350,18 +350,31 @@ pub(crate) fn joseph_update<T: Real, const M: usize>(
     // S = HPHᵀ + R — exact for any K, so it keeps the Joseph form's tolerance of an inexact gain,
     // but costs M-row products (≈ 3.8k multiply-adds for M = 6) instead of two dense 15×15
     // products (≈ 9.5k).
+    // K·S·Kᵀ is symmetric: only its upper triangle is formed, and the result is written
+    // mirrored (exactly symmetric, as the old explicit symmetrisation made it).
     let khp = k * g.hp;
-    let p_new = *p - khp - khp.transpose() + (k * g.s) * kt;
-    let p_sym = (p_new + p_new.transpose()) * lit::<T>(0.5);
+    let ks = k * g.s;
+    let mut p_new = *p;
+    for j in 0..N_STATES {
+        for i in 0..=j {
+            let mut ksk = T::zero();
+            for m in 0..M {
+                ksk += ks[(i, m)] * kt[(m, j)];
+            }
+            let x = (p[(i, j)] + p[(j, i)]) * lit::<T>(0.5) - khp[(i, j)] - khp[(j, i)] + ksk;
+            p_new[(i, j)] = x;
+            p_new[(j, i)] = x;
+        }
+    }
     for i in 0..N_STATES {
-        let d = p_sym[(i, i)];
+        let d = p_new[(i, i)];
         if !(num_traits::Float::is_finite(d) && d > T::zero()) {
             return Err(NavError::NotPositiveDefinite {
                 what: "state covariance P",
             });
         }
     }
-    *p = p_sym;
+    *p = p_new;
     Ok(dx)
 }
 
