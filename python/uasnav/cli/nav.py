@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from uasnav.cli._common import FINITE, POSITIVE, OutputPath, check_outputs, echo_json
+from uasnav.cli._common import FINITE, POSITIVE, OutputPath, Real, check_outputs, echo_json
 
 
 def _outages(values: tuple[str, ...]) -> tuple[tuple[float, float], ...]:
@@ -82,6 +82,15 @@ def _durations(text: str | None) -> list[float]:
 @click.option(
     "--end", "t_end", type=FINITE, default=None, help="Use the log up to this time (s), e.g. before a crash."
 )
+@click.option(
+    "--declination",
+    "declination",
+    type=Real(-180.0, 180.0),
+    default=None,
+    metavar="DEG",
+    help="Magnetic declination (degrees, east positive) for the magnetometer heading; default: "
+    "the log's (COMPASS_DEC / EKF2_MAG_DECL), else the World Magnetic Model on the log's date.",
+)
 @click.option("--hal", "hal", type=POSITIVE, default=None, help="Horizontal alert limit (m).")
 @click.option("--val", "val", type=POSITIVE, default=None, help="Vertical alert limit (m).")
 @click.option("--out", "out_path", type=OutputPath(), help="Write TRACK.csv.")
@@ -103,6 +112,7 @@ def command(
     sweep: str | None,
     t_start: float | None,
     t_end: float | None,
+    declination: float | None,
     hal: float | None,
     val: float | None,
     out_path: str | None,
@@ -152,6 +162,7 @@ def command(
         "model": model,
         "hal_m": hal,
         "val_m": val,
+        "declination_deg": declination,
     }
     cfg = ins.InsConfig.for_logged_imu(**base) if logged else ins.InsConfig(**base)
     result = ins.run(flight, cfg.replace(gnss_outages=outage_list))
@@ -159,6 +170,10 @@ def command(
         "log": str(log),
         "imu": flight.meta.get("imu"),
         "imu_rate_hz": flight.imu.sample_rate,
+        "declination": {
+            "deg": result.summary["declination_deg"],
+            "source": result.summary["declination_source"],
+        },
         "summary": result.summary,
         "excluded_fixes": result.excluded_fixes,
         "alerts": result.alerts,
@@ -207,6 +222,7 @@ def _print_text(log: str, flight: Any, result: Any, report: dict[str, Any]) -> N
         f"resets {s['gnss_resets']}; ZUPT {s['static_updates']}, baro {s['baro_updates']}, "
         f"alerts {s['alerts']}"
     )
+    click.echo(f"magnetic declination {s['declination_deg']:+.2f}° ({s['declination_source']})")
     ref = report.get("reference")
     if isinstance(ref, dict) and "horizontal_rms_m" in ref:
         nan = float("nan")

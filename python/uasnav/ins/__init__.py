@@ -17,7 +17,7 @@ Examples
 True
 """
 
-from uasnav.ins import evaluate
+from uasnav.ins import evaluate, magnetic
 from uasnav.ins.core import FIX_STATUS, TRACK_COLUMNS, InsConfig, InsResult, integrity_thresholds, run
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 
@@ -33,5 +33,6 @@ __all__ = [
     "Trajectory",
     "evaluate",
     "integrity_thresholds",
+    "magnetic",
     "run",
 ]

@@ -31,6 +31,7 @@ from uasnav import _core
 from uasnav.atomicfile import atomic_open
 from uasnav.attitude import quat_to_euler
 from uasnav.errors import InputError
+from uasnav.ins.magnetic import resolve_declination
 from uasnav.io.navdata import Flight
 from uasnav.stationary import detect_static
 
@@ -147,6 +148,13 @@ class InsConfig:
     static_updates : bool
         ZUPT/ZARU when the static detector fires and GNSS speed is below ``static_max_speed_m_s``
         (on the ground: hovering is not static, and the GLRT rejects its vibration).
+    declination_deg : float or None
+        Magnetic declination (degrees, east positive): the magnetometer heading aiding uses
+        true heading = magnetic heading + declination. ``None`` (default): the log's own
+        (ArduPilot ``COMPASS_DEC`` when auto-declination is off, PX4 ``EKF2_MAG_DECL``), else
+        the World Magnetic Model at the first fix on the log's GPS date, else 0 — see
+        :func:`uasnav.ins.magnetic.resolve_declination`; ``InsResult.summary`` reports the value
+        and its source.
     decimation : int
         Keep one output row every ``decimation`` IMU samples.
     extra : dict
@@ -173,6 +181,7 @@ class InsConfig:
     static_max_speed_m_s: float = 0.3
     use_baro: bool = True
     use_mag: bool = True
+    declination_deg: float | None = None
     decimation: int = 1
     discretisation: Literal["first_order", "second_order"] = "first_order"
     extra: dict[str, float] = field(default_factory=dict)
@@ -541,6 +550,13 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         gyro0 = np.zeros(3)
     stationary = _static_mask(flight, cfg)
     core_cfg = cfg.core_dict()
+    declination_deg, declination_source = resolve_declination(flight, cfg.declination_deg)
+    if "declination_rad" in cfg.extra:  # an explicit nav-core key wins
+        declination_deg, declination_source = (
+            math.degrees(core_cfg["declination_rad"]),
+            "extra['declination_rad']",
+        )
+    core_cfg["declination_rad"] = math.radians(declination_deg)
     baro = flight.baro if cfg.use_baro else None
     mag = flight.mag if cfg.use_mag else None
     llh = np.ascontiguousarray(np.column_stack([np.radians(g.lat), np.radians(g.lon), g.alt]))
@@ -607,6 +623,8 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         "static_updates": int(out["static_updates"]),
         "baro_updates": int(out["baro_updates"]),
         "mag_updates": int(out["mag_updates"]),
+        "declination_deg": declination_deg,
+        "declination_source": declination_source,
         "course_reset": bool(out["course_reset"]),
         "imu_gaps": int(out["imu_gaps"]),
         "gnss_resets": int(out["gnss_resets"]),

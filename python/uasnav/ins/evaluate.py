@@ -53,8 +53,9 @@ class Comparison:
 
     Attributes are RMS and 95th percentiles (p95) of the magnitudes: horizontal and vertical
     position (m), velocity (m/s, 3-D), roll/pitch (deg, RMS per axis and of both) and yaw
-    (deg). ``vertical_bias_m`` is the mean vertical difference (the autopilot may use another
-    datum); ``n`` the number of compared samples; ``reference`` its name.
+    (deg; p95 of roll/pitch over both axes' magnitudes). ``vertical_bias_m`` is the mean
+    vertical difference (the autopilot may use another datum); ``n`` the number of compared
+    samples; ``reference`` its name.
     """
 
     horizontal_rms_m: float
@@ -71,6 +72,8 @@ class Comparison:
     n: int
     reference: str
     t_span: tuple[float, float] = (0.0, 0.0)
+    roll_pitch_p95_deg: float | None = None
+    yaw_p95_deg: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """Plain dict for JSON."""
@@ -105,7 +108,7 @@ def compare(result: InsResult, ref: Trajectory, *, t_range: tuple[float, float] 
         rv = np.column_stack([np.interp(t, ref.t, ref.vel[:, i]) for i in range(3)])
         dv = np.linalg.norm(result.vel[k] - rv, axis=1)
         vel_rms, vel_p95 = _rms(dv), float(np.percentile(dv, 95))
-    roll = pitch = rp = yaw = None
+    roll = pitch = rp = yaw = rp95 = yaw95 = None
     if ref.euler_deg is not None:
         # Interpolate angles through their unit vectors (yaw wraps).
         ang = np.radians(ref.euler_deg)
@@ -121,6 +124,8 @@ def compare(result: InsResult, ref: Trajectory, *, t_range: tuple[float, float] 
         roll, pitch = _rms(de[:, 0]), _rms(de[:, 1])
         rp = _rms(de[:, :2])
         yaw = _rms(de[:, 2])
+        rp95 = float(np.percentile(np.abs(de[:, :2]), 95))
+        yaw95 = float(np.percentile(np.abs(de[:, 2]), 95))
     return Comparison(
         horizontal_rms_m=_rms(hz),
         horizontal_p95_m=float(np.percentile(hz, 95)),
@@ -136,6 +141,8 @@ def compare(result: InsResult, ref: Trajectory, *, t_range: tuple[float, float] 
         n=int(k.sum()),
         reference=ref.name,
         t_span=(float(lo), float(hi)),
+        roll_pitch_p95_deg=rp95,
+        yaw_p95_deg=yaw95,
     )
 
 

@@ -301,6 +301,37 @@ def _strictly_increasing(t: FloatArray) -> NDArray[np.bool_]:
     return keep
 
 
+def _dataflash_declination_meta(path: Any, gp: dict[str, FloatArray], first: int) -> dict[str, Any]:
+    """``declination_deg``/``declination_source`` from ``PARM`` ``COMPASS_DEC`` (radians) when
+    the autopilot used it (``COMPASS_AUTODEC`` 0: with auto-declination on it takes its own
+    table's value at run time and the logged parameter is not that value), and ``utc_year``
+    (decimal year) from the ``GPS`` week and time of week of fix ``first``."""
+    from pathlib import Path
+
+    from uasnav.ins.magnetic import decimal_year, gps_week_ms_to_utc
+    from uasnav.io._mavlink import messages, reading
+
+    p = Path(path)
+    params: dict[str, float] = {}
+    with reading(p) as (conn, _):
+        for m in messages(conn, ["PARM"], p, "DataFlash"):
+            name = str(m.Name).rstrip("\x00")
+            if name in ("COMPASS_DEC", "COMPASS_AUTODEC"):
+                params[name] = float(m.Value)  # the last value logged wins
+    meta: dict[str, Any] = {}
+    dec = params.get("COMPASS_DEC")
+    if dec is not None and math.isfinite(dec) and params.get("COMPASS_AUTODEC", 0.0) == 0.0:
+        meta["declination_deg"] = math.degrees(dec)
+        meta["declination_source"] = "log: PARM COMPASS_DEC (COMPASS_AUTODEC = 0)"
+    week = gp.get("GWk", gp.get("Week"))
+    tow = gp.get("GMS", gp.get("TimeMS"))
+    if week is not None and tow is not None:
+        w, ms = float(week[first]), float(tow[first])
+        if math.isfinite(w) and math.isfinite(ms) and 1000 < w < 10000 and 0 <= ms < 604_800_000:
+            meta["utc_year"] = decimal_year(gps_week_ms_to_utc(w, ms))
+    return meta
+
+
 def read_dataflash_nav(path: str | Any, imu: str | None = None) -> Flight:
     """Navigation data of an ArduPilot DataFlash log: every IMU (``IMU``/``IMU2``/``IMU3``
     with temperature), ``GPS`` (fixes with ``Status`` ≥ 3; time from its ``T`` field, the
@@ -412,7 +443,12 @@ def read_dataflash_nav(path: str | Any, imu: str | None = None) -> Flight:
         mag,
         reference=ref,
         imus=imus,
-        meta={"source": str(path), "format": "ardupilot-dataflash", "imu": key},
+        meta={
+            "source": str(path),
+            "format": "ardupilot-dataflash",
+            "imu": key,
+            **_dataflash_declination_meta(path, gp, int(ok[0])),
+        },
     )
 
 
@@ -561,8 +597,31 @@ def read_ulog_nav(path: str | Any) -> Flight:
         mag,
         reference=ref,
         imus={"IMU": imu},
-        meta={"source": str(p), "format": "px4-ulog", "imu": "IMU"},
+        meta={"source": str(p), "format": "px4-ulog", "imu": "IMU", **_ulog_declination_meta(ulog, g, sel)},
     )
+
+
+def _ulog_declination_meta(ulog: Any, g: dict[str, FloatArray], sel: NDArray[np.intp]) -> dict[str, Any]:
+    """``declination_deg`` from the parameter ``EKF2_MAG_DECL`` (degrees) when non-zero (PX4
+    saves the declination it used there), and ``utc_year`` from the GNSS ``time_utc_usec``."""
+    import datetime as _dt
+
+    from uasnav.ins.magnetic import decimal_year
+
+    meta: dict[str, Any] = {}
+    dec = ulog.initial_parameters.get("EKF2_MAG_DECL")
+    if dec is not None and math.isfinite(float(dec)) and float(dec) != 0.0:
+        meta["declination_deg"] = float(dec)
+        meta["declination_source"] = "log: parameter EKF2_MAG_DECL"
+    utc = g.get("time_utc_usec")
+    if utc is not None:
+        u = utc[sel]
+        u = u[np.isfinite(u) & (u > 1e15)]  # after 2001: a real UTC time
+        if u.size:
+            meta["utc_year"] = decimal_year(
+                _dt.datetime(1970, 1, 1) + _dt.timedelta(microseconds=float(u[0]))
+            )
+    return meta
 
 
 def read_csv_nav(path: str | Any, gnss: GnssData) -> Flight:
