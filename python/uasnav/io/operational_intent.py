@@ -158,7 +158,7 @@ def parse_f3548(source: object, parse_type: type) -> Any:
 
     try:
         return _reader(parse_type)(source)
-    except Exception:  # noqa: BLE001 - the library decides, and words the error
+    except Exception:  # the library decides, and words the error
         return ImplicitDict.parse(source, parse_type)  # type: ignore[arg-type]
 
 
@@ -194,7 +194,10 @@ def _finite(x: float, path: str, lo: float, hi: float, unit: str) -> float:
     return v
 
 
-def check_volume(v: Any, path: str, deferred: list[tuple[str, list[tuple[float, float]]]] | None = None) -> None:
+_Deferred = list[tuple[str, list[tuple[float, float]]]]
+
+
+def check_volume(v: Any, path: str, deferred: _Deferred | None = None) -> None:
     """The F3548 rules of one ``Volume4D`` that its types do not enforce (see module).
 
     With ``deferred``, the polygon's crossing-edges test is not run but appended there as
@@ -248,7 +251,7 @@ def check_volume(v: Any, path: str, deferred: list[tuple[str, list[tuple[float, 
         raise jc.fail(path, "time_start is not before time_end")
 
 
-def _check_edges(polygons: list[tuple[str, list[tuple[float, float]]]]) -> None:
+def _check_edges(polygons: _Deferred) -> None:
     """Raise for the first polygon whose edges cross (shapely validity, vectorised)."""
     if not polygons:
         return
@@ -261,7 +264,8 @@ def _check_edges(polygons: list[tuple[str, list[tuple[float, float]]]]) -> None:
     )
     bad = np.flatnonzero(~shapely.is_valid(shapely.polygons(rings)))
     if bad.size:
-        raise jc.fail(f"{polygons[bad[0]][0]}.volume.outline_polygon", "edges cross (F3548: edges may not cross)")
+        path = polygons[bad[0]][0]
+        raise jc.fail(f"{path}.volume.outline_polygon", "edges cross (F3548: edges may not cross)")
 
 
 def check_details(details: Any, where: str = "") -> None:
@@ -271,7 +275,7 @@ def check_details(details: Any, where: str = "") -> None:
     vols = details.get("volumes") or []
     if not vols:
         raise jc.fail(f"{pre}volumes", "an operational intent needs at least one volume")
-    deferred: list[tuple[str, list[tuple[float, float]]]] = []
+    deferred: _Deferred = []
     try:
         for key in ("volumes", "off_nominal_volumes"):
             for k, v in enumerate(details.get(key) or []):
