@@ -586,6 +586,9 @@ pub struct SpaceTimeIndex<'a> {
     delays: std::sync::OnceLock<DelayIndex>,
 }
 
+/// First window of the departure-delay search, s (widened ×4 until it holds the answer).
+const INITIAL_DELAY_WINDOW_S: f64 = 900.0;
+
 /// Most start-time buckets.
 const MAX_BUCKETS: usize = 1 << 16;
 
@@ -974,12 +977,31 @@ impl<'a> SpaceTimeIndex<'a> {
     ///
     /// Each volume of the intent reads only the volumes of its cells that start within the
     /// window [its start − the cell's longest duration, its end + `max_delay_s`] (and the
-    /// large volumes): the cost follows the traffic near the intent, not the data set. The
-    /// first call builds the delay index (by intent, and by cell in start-time order).
+    /// large volumes), first over a 900 s window of delays, widened ×4 only while the answer
+    /// may lie beyond it: the cost follows the traffic near the intent and the delay needed,
+    /// not the data set or `max_delay_s`. The first call builds the delay index (by intent,
+    /// and by cell in start-time order).
     pub fn earliest_delay(&self, intent: u32, max_delay_s: f64) -> Result<Option<f64>, IndexError> {
         if !(max_delay_s.is_finite() && max_delay_s >= 0.0) {
             return Err(IndexError::Parameter("max_delay_s must be finite and ≥ 0"));
         }
+        // search a short window first and widen it only if the answer may lie beyond: the
+        // delay found within a window W is the answer whenever it is < W (an interval that
+        // starts at or after W cannot cover it), so the cost follows the delay needed
+        let mut window = max_delay_s.min(INITIAL_DELAY_WINDOW_S);
+        loop {
+            let d = self.delay_within(intent, window);
+            if d < window || window >= max_delay_s {
+                return Ok(if d <= max_delay_s { Some(d) } else { None });
+            }
+            window = (window * 4.0).min(max_delay_s);
+        }
+    }
+
+    /// The smallest delay d ≥ 0 outside the union of the forbidden delay intervals that start
+    /// before `window` (the conflicts of the intent's volumes shifted by up to `window`).
+    fn delay_within(&self, intent: u32, window: f64) -> f64 {
+        let max_delay_s = window;
         let di = self.delay_index();
         let v = self.volumes;
         let g = &self.grid;
@@ -1052,7 +1074,7 @@ impl<'a> SpaceTimeIndex<'a> {
                 d = hi;
             }
         }
-        Ok(if d <= max_delay_s { Some(d) } else { None })
+        d
     }
 }
 
