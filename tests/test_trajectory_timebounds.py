@@ -139,7 +139,7 @@ def test_intent_contains_the_true_trajectory(model, runs):
     assert not _contained(b, r, 577.0)
 
 
-def test_intent_altitudes_and_refusals(model, runs, shared_data):
+def test_intent_altitudes_and_refusals(model, runs, shared_data, monkeypatch):
     from uasnav.io.plans import read_plan
 
     plan = read_plan(shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan")
@@ -155,8 +155,16 @@ def test_intent_altitudes_and_refusals(model, runs, shared_data):
     t0 = min(v.time_start.value.datetime for v in b.details.volumes)
     t1 = max(v.time_end.value.datetime for v in b.details.volumes)
     assert t0 == T0 and abs(t1 - (T0 + timedelta(seconds=b.eta_bounds_s[1]))) < timedelta(milliseconds=1)
-    with pytest.raises(InputError, match="never assumes N = 0"):
-        build_intent(plan, model, np.zeros(2), T0)
+    # N of the EGM96 grid when not given; refused (never N = 0) when no geoid grid is installed
+    from uasnav.utm import altitude
+
+    egm = build_intent(plan, model, np.zeros(2), T0)
+    n = altitude.geoid_heights(np.array([plan.home.lat_deg]), np.array([plan.home.lon_deg]))[0]
+    assert egm.volume_alt_w84.min() == pytest.approx(home + n - 10, abs=0.02)
+    with monkeypatch.context() as m:
+        m.setattr(altitude, "geoid_grid_path", lambda: None)
+        with pytest.raises(InputError, match="never assumes N = 0"):
+            build_intent(plan, model, np.zeros(2), T0)
     no_home = MissionPlan(items=plan.items, home=None, source="x")
     with pytest.raises(InputError, match="return to launch but the plan has no home"):
         build_intent(no_home, model, np.zeros(2), T0, geoid_height_m=47.4)
