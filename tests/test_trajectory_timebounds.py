@@ -139,7 +139,7 @@ def test_intent_contains_the_true_trajectory(model, runs):
     assert not _contained(b, r, 577.0)
 
 
-def test_intent_altitudes_and_refusals(model, runs, shared_data):
+def test_intent_altitudes_and_refusals(model, runs, shared_data, monkeypatch):
     from uasnav.io.plans import read_plan
 
     plan = read_plan(shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan")
@@ -155,8 +155,16 @@ def test_intent_altitudes_and_refusals(model, runs, shared_data):
     t0 = min(v.time_start.value.datetime for v in b.details.volumes)
     t1 = max(v.time_end.value.datetime for v in b.details.volumes)
     assert t0 == T0 and abs(t1 - (T0 + timedelta(seconds=b.eta_bounds_s[1]))) < timedelta(milliseconds=1)
-    with pytest.raises(InputError, match="never assumes N = 0"):
-        build_intent(plan, model, np.zeros(2), T0)
+    # N of the EGM96 grid when not given; refused (never N = 0) when no geoid grid is installed
+    from uasnav.utm import altitude
+
+    egm = build_intent(plan, model, np.zeros(2), T0)
+    n = altitude.geoid_heights(np.array([plan.home.lat_deg]), np.array([plan.home.lon_deg]))[0]
+    assert egm.volume_alt_w84.min() == pytest.approx(home + n - 10, abs=0.02)
+    with monkeypatch.context() as m:
+        m.setattr(altitude, "geoid_grid_path", lambda: None)
+        with pytest.raises(InputError, match="never assumes N = 0"):
+            build_intent(plan, model, np.zeros(2), T0)
     no_home = MissionPlan(items=plan.items, home=None, source="x")
     with pytest.raises(InputError, match="return to launch but the plan has no home"):
         build_intent(no_home, model, np.zeros(2), T0, geoid_height_m=47.4)
@@ -181,7 +189,9 @@ def test_cli_intent_then_deconflict(model, runs, shared_data, tmp_path):
     r = CliRunner().invoke(
         main, [*base, "--start", "2026-11-24T12:00:00Z", "--out", str(tmp_path / "a.json")]
     )
-    assert r.exit_code == 1 and "--geoid-height" in r.stderr and not (tmp_path / "a.json").exists()
+    # without --geoid-height: N of the EGM96 grid at each point (tests/test_geoid.py checks the grid)
+    assert r.exit_code == 0, r.output
+    egm = json.loads((tmp_path / "a.json").read_text())
     for name, start in (("a", "2026-11-24T12:00:00Z"), ("b", "2026-11-24T12:01:00Z")):
         r = CliRunner().invoke(
             main,
@@ -205,6 +215,20 @@ def test_cli_intent_then_deconflict(model, runs, shared_data, tmp_path):
     )
     (a,) = read_intents(tmp_path / "a.json")
     assert all(v.volume.altitude_lower.reference == "W84" for v in a.details.volumes)
+    from uasnav.utm.altitude import geoid_heights
+
+    for ve, v47 in zip(egm["volumes"], a.details.volumes, strict=True):
+        vol = ve["volume"]
+        pts = (
+            vol["outline_polygon"]["vertices"]
+            if "outline_polygon" in vol
+            else [vol["outline_circle"]["center"]]
+        )
+        n = geoid_heights(
+            np.array([np.mean([p["lat"] for p in pts])]), np.array([np.mean([p["lng"] for p in pts])])
+        )
+        for k in ("altitude_lower", "altitude_upper"):
+            assert vol[k]["value"] - v47.volume[k].value == pytest.approx(n[0] - 47.4, abs=0.02)
     gj = json.loads((tmp_path / "a.geojson").read_text())
     assert len(gj["features"]) == len(a.details.volumes) + 1
     # the same mission one minute later conflicts with itself; the delay frees it

@@ -1,4 +1,7 @@
-//! Times the phases of a search over synthetic intents: `cargo run --release --example phases -- 100000`.
+//! Times the phases of a search over synthetic intents:
+//! `cargo run --release -p utm-index --example phases -- N_INTENTS THREADS` (defaults 100000, 1):
+//! index build, encounter scan (conflicts), and the departure-delay search (max 86 400 s, the CLI default) of the
+//! later intent of up to 1000 conflicting intent pairs.
 use std::time::Instant;
 use utm_index::{synthetic::synthetic, Search, SpaceTimeIndex};
 
@@ -30,9 +33,8 @@ fn main() {
     let (t, c) = (Instant::now(), cpu_s());
     let idx = SpaceTimeIndex::with_threads(&v, Search::default(), threads)
         .unwrap_or_else(|e| panic!("{e}"));
-    let (entries, big) = idx.stats();
     println!(
-        "build ({entries} entries, {big} large): {:.3} s (main thread CPU {:.3} s)",
+        "build: {:.3} s (main thread CPU {:.3} s)",
         t.elapsed().as_secs_f64(),
         cpu_s() - c
     );
@@ -43,5 +45,40 @@ fn main() {
         enc.len(),
         t.elapsed().as_secs_f64(),
         cpu_s() - c
+    );
+    let (entries, big) = idx.stats();
+    let mut later: Vec<u32> = enc
+        .iter()
+        .map(|e| v.intent(e.a as usize).max(v.intent(e.b as usize)))
+        .collect();
+    later.sort_unstable();
+    later.dedup();
+    println!(
+        "{} conflicting volume pairs, {} distinct later intents; {entries} cell entries, {big} large",
+        enc.len(),
+        later.len()
+    );
+    later.truncate(1000);
+    let (t, c) = (Instant::now(), cpu_s());
+    let mut n_free = 0;
+    for &i in &later {
+        if let Ok(Some(_)) = idx.earliest_delay(i, 86_400.0) {
+            n_free += 1;
+        }
+    }
+    println!(
+        "delay search ({} intents, {n_free} freed within a day): {:.3} s (main thread CPU {:.3} s, first call builds the delay index)",
+        later.len(),
+        t.elapsed().as_secs_f64(),
+        cpu_s() - c
+    );
+    let (t, c) = (Instant::now(), cpu_s());
+    for &i in &later {
+        let _ = idx.earliest_delay(i, 86_400.0);
+    }
+    println!(
+        "delay search again: {:.3} ms per intent (main thread CPU {:.3} ms)",
+        t.elapsed().as_secs_f64() * 1e3 / later.len().max(1) as f64,
+        (cpu_s() - c) * 1e3 / later.len().max(1) as f64
     );
 }

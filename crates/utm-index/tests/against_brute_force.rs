@@ -145,3 +145,98 @@ fn parallel_build_equals_serial() {
         brute_force(&sub, &s).unwrap_or_else(|e| panic!("{e}"))
     );
 }
+
+/// A dense random set (2 000 volumes in 2 km × 1 h, sizes over two orders of magnitude, plus
+/// a few volumes spanning the whole area that the index keeps aside as large) spreads over
+/// many start-time buckets and cells: encounters equal brute force for several buffers, and
+/// every intent's earliest delay equals the delay computed from all pairs without the index.
+#[test]
+fn dense_set_with_large_volumes_equals_brute_force() {
+    let mut rng = utm_index::synthetic::SplitMix64::new(11);
+    let mut vols: Vec<Spec> = Vec::new();
+    for k in 0..2_000u32 {
+        let (cx, cy) = (rng.uniform(0.0, 2000.0), rng.uniform(0.0, 2000.0));
+        let r = if k % 500 == 7 {
+            4000.0 // spans the whole area: a large volume
+        } else {
+            (rng.uniform(0.0, 1.0f64)).powi(3) * 200.0 + 2.0
+        };
+        let n = 3 + (rng.next_u64() % 5) as usize;
+        let verts: Vec<[f64; 2]> = if rng.next_u64().is_multiple_of(4) {
+            vec![]
+        } else {
+            (0..n)
+                .map(|j| {
+                    let a =
+                        (j as f64 + 0.8 * rng.uniform(0.0, 1.0)) / n as f64 * std::f64::consts::TAU;
+                    let f = rng.uniform(0.3, 1.0);
+                    [cx + r * f * a.cos(), cy + r * f * a.sin()]
+                })
+                .collect()
+        };
+        let z = rng.uniform(0.0, 120.0);
+        let t = rng.uniform(0.0, 3600.0);
+        let dt = rng.uniform(1.0, 120.0);
+        vols.push((
+            k % 150,
+            verts,
+            [cx, cy, r],
+            [z, z + rng.uniform(1.0, 40.0)],
+            [t, t + dt],
+        ));
+    }
+    let set = build(&vols);
+    for s in [
+        Search::default(),
+        Search {
+            horizontal_m: 25.0,
+            vertical_m: 8.0,
+        },
+    ] {
+        let want = brute_force(&set, &s).unwrap_or_else(|e| panic!("{e}"));
+        let idx = SpaceTimeIndex::new(&set, s).unwrap_or_else(|e| panic!("{e}"));
+        assert!(idx.stats().1 >= 3, "large volumes: {:?}", idx.stats());
+        assert!(want.len() > 100, "{}", want.len());
+        assert_eq!(idx.encounters(1), want);
+    }
+    // earliest delays against the definition: union of the forbidden delay intervals of all
+    // spatially intersecting pairs (no index)
+    let idx = SpaceTimeIndex::new(&set, Search::default()).unwrap_or_else(|e| panic!("{e}"));
+    fn outline(v: &Spec) -> utm_index::geometry::Outline<'_> {
+        if v.1.is_empty() {
+            utm_index::geometry::Outline::Circle([v.2[0], v.2[1]], v.2[2])
+        } else {
+            utm_index::geometry::Outline::Polygon(&v.1)
+        }
+    }
+    for max in [600.0, 5000.0] {
+        for intent in 0..150u32 {
+            let mut forbidden: Vec<(f64, f64)> = Vec::new();
+            for b in vols.iter().filter(|v| v.0 == intent) {
+                for c in vols.iter().filter(|v| v.0 != intent) {
+                    let (lo, hi) = (c.4[0] - b.4[1], c.4[1] - b.4[0]);
+                    if hi <= 0.0 || lo >= max || b.3[0].max(c.3[0]) > b.3[1].min(c.3[1]) {
+                        continue;
+                    }
+                    if utm_index::geometry::outline_dist(outline(b), outline(c)) <= 0.0 {
+                        forbidden.push((lo, hi));
+                    }
+                }
+            }
+            forbidden.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            let mut d = 0.0f64;
+            for (lo, hi) in forbidden {
+                if lo >= d {
+                    break;
+                }
+                d = d.max(hi);
+            }
+            let want = if d <= max { Some(d) } else { None };
+            assert_eq!(
+                idx.earliest_delay(intent, max),
+                Ok(want),
+                "intent {intent}, max {max}"
+            );
+        }
+    }
+}

@@ -3,14 +3,24 @@
 h_W84 = H_AMSL + N, with N the geoid height (undulation) at the place, m. A plan's altitudes
 are relative to home (h = home AMSL + alt + N), AMSL (h = alt + N) or above terrain (refused:
 that needs a terrain model). N varies from −106 m to +85 m over the Earth: it is never assumed
-to be 0. uasnav ships no geoid model and no installed offline package provides one (the EGM96
-and EGM2008 grids are not on PyPI with their data), so N is the user's to give
-(``--geoid-height``, e.g. from GeographicLib's ``GeoidEval`` or the national geodetic agency).
+to be 0.
+
+N comes from the user (``geoid_height_m``, ``--geoid-height``: one value for the site, e.g. from
+a national geoid model) or, by default, from the EGM96 geoid at each route point: the 15′ grid
+``egm96_15.gtx`` that Debian's ``proj-data`` package installs (``/usr/share/proj``; the Makefile
+installs it), interpolated bilinearly by PROJ through ``pyproj`` (a ``vgridshift`` step). Against
+GeographicLib's ``GeoidEval`` (EGM96, 5′ grid, cubic) it agrees to 5 mm at Timbuktu and 2 mm at
+the grid's corners and centre (``tests/test_geoid.py``); EGM96 itself is good to about 0.5–1 m.
+Without the grid installed, N must be given, as before. (PyPI has no installable package with
+the data for this Python: ``egm96`` 0.1.0 is a stub and 0.3.0, which bundles the 5′ grid, needs
+Python ≥ 3.12; ``pygeodesy`` reads GeographicLib's ``.pgm`` grids but ships none.)
 """
 
 from __future__ import annotations
 
+import functools
 import math
+import os
 from collections.abc import Sequence
 
 import numpy as np
@@ -20,6 +30,74 @@ from uasnav.io.mission_plan import AltitudeFrame, RoutePoint
 
 #: Largest |N| on Earth (EGM2008 ranges from about −107 m to +86 m), with a margin.
 MAX_GEOID_HEIGHT_M = 120.0
+#: The geoid grid used when N is not given (PROJ's name for NGA's EGM96 15′ grid).
+GEOID_GRID = "egm96_15.gtx"
+#: What :func:`geoid_heights` evaluates, as reported to the user.
+GEOID_MODEL = "EGM96 (PROJ grid egm96_15.gtx, 15′, bilinear)"
+#: Where the grid is looked for, after pyproj's own data directories: Debian's proj-data.
+GEOID_DIRS = ("/usr/share/proj",)
+
+
+def geoid_grid_path() -> str | None:
+    """Path of the installed EGM96 grid (:data:`GEOID_GRID`), or None if none is installed."""
+    try:
+        import pyproj.datadir
+
+        dirs = [*pyproj.datadir.get_data_dir().split(os.pathsep), pyproj.datadir.get_user_data_dir()]
+    except Exception:  # pyproj missing or without data: only the system directories
+        dirs = []
+    for d in [*dirs, *GEOID_DIRS]:
+        p = os.path.join(d, GEOID_GRID)
+        if os.path.isfile(p):
+            return p
+    return None
+
+
+@functools.cache
+def _geoid_transformer(path: str) -> object:
+    from pyproj import Transformer
+
+    # vgridshift with multiplier +1 adds the grid value: z = 0 becomes N
+    return Transformer.from_pipeline(
+        "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad "
+        f"+step +proj=vgridshift +grids={path} +multiplier=1 "
+        "+step +proj=unitconvert +xy_in=rad +xy_out=deg"
+    )
+
+
+def geoid_model() -> str | None:
+    """:data:`GEOID_MODEL` if its grid is installed, else None."""
+    return GEOID_MODEL if geoid_grid_path() is not None else None
+
+
+def geoid_heights(lat_deg: np.ndarray, lon_deg: np.ndarray) -> np.ndarray:
+    """EGM96 geoid heights N (m above the WGS-84 ellipsoid) at WGS-84 positions (degrees).
+
+    Raises
+    ------
+    InputError
+        The grid is not installed, or a position is outside it / not finite.
+    """
+    path = geoid_grid_path()
+    if path is None:
+        raise InputError(
+            f"no geoid model installed: the EGM96 grid {GEOID_GRID} comes with Debian's proj-data "
+            "package (apt-get install proj-data)"
+        )
+    lat = np.asarray(lat_deg, dtype=float)
+    lon = np.asarray(lon_deg, dtype=float)
+    if not (np.all(np.isfinite(lat)) and np.all(np.isfinite(lon)) and np.all(np.abs(lat) <= 90)):
+        raise InputError("geoid height: latitudes/longitudes must be finite, |latitude| ≤ 90°")
+    try:
+        _, _, n = _geoid_transformer(path).transform(  # type: ignore[attr-defined]
+            lon, lat, np.zeros_like(lat), errcheck=True
+        )
+    except Exception as e:  # pyproj.exceptions.ProjError: outside the grid, unreadable grid
+        raise InputError(f"geoid height from {path}: {e}") from None
+    n = np.asarray(n, dtype=float)
+    if not np.all(np.isfinite(n)):
+        raise InputError(f"geoid height from {path}: no value at some positions")
+    return n
 
 
 def w84_altitudes(
@@ -31,11 +109,14 @@ def w84_altitudes(
 ) -> np.ndarray:
     """Ellipsoidal altitudes (m, W84) of route points.
 
+    ``geoid_height_m`` None: N of the EGM96 geoid at each point (:func:`geoid_heights`).
+
     Raises
     ------
     InputError
         A terrain-relative altitude; a relative altitude without the home AMSL altitude; any
-        altitude without the geoid height; a geoid height beyond ±120 m.
+        altitude without the geoid height when no geoid grid is installed; a geoid height beyond
+        ±120 m.
     """
     frames = {p.frame for p in points}
     if AltitudeFrame.TERRAIN in frames:
@@ -43,14 +124,24 @@ def w84_altitudes(
             f"{source}: altitudes above terrain cannot be converted to W84 without a terrain model"
         )
     if geoid_height_m is None:
-        raise InputError(
-            f"{source}: F3548 altitudes are WGS-84 ellipsoidal and the plan's are "
-            f"{' and '.join(sorted(f.value for f in frames))}: give the geoid height N at the site "
-            "(--geoid-height, m; W84 = AMSL + N); uasnav never assumes N = 0"
-        )
+        if geoid_grid_path() is None:
+            raise InputError(
+                f"{source}: F3548 altitudes are WGS-84 ellipsoidal and the plan's are "
+                f"{' and '.join(sorted(f.value for f in frames))}: give the geoid height N at the site "
+                "(--geoid-height, m; W84 = AMSL + N) or install the EGM96 grid (Debian package "
+                "proj-data); uasnav never assumes N = 0"
+            )
+        n = geoid_heights(np.array([p.lat_deg for p in points]), np.array([p.lon_deg for p in points]))
+        return _w84(points, home_amsl_m, n, source)
     if not (math.isfinite(geoid_height_m) and abs(geoid_height_m) <= MAX_GEOID_HEIGHT_M):
         raise InputError(f"geoid height {geoid_height_m!r} m is outside ±{MAX_GEOID_HEIGHT_M:g} m")
-    if AltitudeFrame.RELATIVE in frames and (home_amsl_m is None or not math.isfinite(home_amsl_m)):
+    return _w84(points, home_amsl_m, np.full(len(points), float(geoid_height_m)), source)
+
+
+def _w84(points: Sequence[RoutePoint], home_amsl_m: float | None, n: np.ndarray, source: str) -> np.ndarray:
+    if any(p.frame is AltitudeFrame.RELATIVE for p in points) and (
+        home_amsl_m is None or not math.isfinite(home_amsl_m)
+    ):
         raise InputError(
             f"{source}: relative altitudes need the home altitude above mean sea level: the plan has none "
             "(give --home-alt, m AMSL)"
@@ -58,8 +149,16 @@ def w84_altitudes(
     out = np.empty(len(points))
     for i, p in enumerate(points):
         base = home_amsl_m if (p.frame is AltitudeFrame.RELATIVE and home_amsl_m is not None) else 0.0
-        out[i] = base + p.alt_m + geoid_height_m
+        out[i] = base + p.alt_m + n[i]
     return out
 
 
-__all__ = ["MAX_GEOID_HEIGHT_M", "w84_altitudes"]
+__all__ = [
+    "GEOID_GRID",
+    "GEOID_MODEL",
+    "MAX_GEOID_HEIGHT_M",
+    "geoid_grid_path",
+    "geoid_heights",
+    "geoid_model",
+    "w84_altitudes",
+]
