@@ -21,7 +21,8 @@ import numpy as np
 
 from uasnav.trajectory.features import wind_vector
 from uasnav.trajectory.geometry import arc_length_along
-from uasnav.trajectory.predictor import PlanPrediction, TrajectoryPredictor
+from uasnav.trajectory.models import Predictor
+from uasnav.trajectory.predictor import PlanPrediction
 from uasnav.trajectory.samples import crossing_times
 from uasnav.trajectory.simulator import MultirotorParams, Telemetry, WindModel, simulate_flight
 from uasnav.trajectory.timebounds import DEFAULT_TAU_S, TimeBounds, score, widening
@@ -66,7 +67,7 @@ def random_plan(rng: np.random.Generator) -> np.ndarray:
     return np.array(pts)
 
 
-def simulate_run(predictor: TrajectoryPredictor, seed: int, cruise_ms: float | None = None) -> SimulatedRun:
+def simulate_run(predictor: Predictor, seed: int, cruise_ms: float | None = None) -> SimulatedRun:
     """One simulated run with its prediction (see module), at ``cruise_ms`` (default the
     model's speed): calibrate at the speed the missions will fly."""
     v = predictor.cruise_ms_ if cruise_ms is None else float(cruise_ms)
@@ -96,7 +97,7 @@ def simulate_run(predictor: TrajectoryPredictor, seed: int, cruise_ms: float | N
 
 
 def simulated_runs(
-    predictor: TrajectoryPredictor,
+    predictor: Predictor,
     n_runs: int,
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,

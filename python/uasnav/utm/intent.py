@@ -38,7 +38,7 @@ import numpy as np
 from uasnav.errors import InputError
 from uasnav.io.mission_plan import MissionPlan, RoutePoint, plan_cruise_speed, route_points
 from uasnav.io.operational_intent import parse_details, rfc3339
-from uasnav.trajectory.predictor import TrajectoryPredictor
+from uasnav.trajectory.models import Predictor
 from uasnav.trajectory.timebounds import DEFAULT_COVERAGE, widening
 from uasnav.utm.altitude import w84_altitudes
 
@@ -99,7 +99,7 @@ def _positive(x: float, name: str) -> float:
 
 def build_intent(
     plan: MissionPlan,
-    predictor: TrajectoryPredictor,
+    predictor: Predictor,
     wind_ne: np.ndarray,
     start: datetime,
     *,
@@ -119,7 +119,7 @@ def build_intent(
     Parameters
     ----------
     plan : MissionPlan
-    predictor : TrajectoryPredictor — fitted, with calibrated ``time_bounds_``.
+    predictor : KinematicPredictor or TrajectoryPredictor — fitted, with calibrated ``time_bounds_``.
     wind_ne : ndarray, shape (2,) — wind velocity (m/s, toward north/east).
     start : datetime — departure, time-zone aware.
     coverage : float — coverage of the time bounds.
