@@ -148,9 +148,10 @@ def test_intent_altitudes_and_refusals(model, runs, shared_data):
     # W84 = AMSL + N: relative 0 (ground) and 50 m ± the 10 m vertical buffer
     assert b.volume_alt_w84.min() == pytest.approx(home + 47.4 - 10)
     assert b.volume_alt_w84.max() == pytest.approx(home + 50 + 47.4 + 10)
-    # take-off at 2.5 m/s: 50 m in 20 s; the landing descends 50 m at 1.5 m/s
-    assert b.t_arrive_s[1] == pytest.approx(20.0)
-    assert b.t_arrive_s[-1] - b.t_arrive_s[-2] == pytest.approx(50 / 1.5)
+    # take-off at 2.5 m/s with 1 m/s² (trapezoid): 50 m in 50/2.5 + 2.5/1 s; the landing
+    # descends 50 m at 1.5 m/s in 50/1.5 + 1.5/1 s
+    assert b.t_arrive_s[1] == pytest.approx(50 / 2.5 + 2.5)
+    assert b.t_arrive_s[-1] - b.t_arrive_s[-2] == pytest.approx(50 / 1.5 + 1.5)
     assert b.eta_bounds_s[0] < b.eta_s < b.eta_bounds_s[1]
     t0 = min(v.time_start.value.datetime for v in b.details.volumes)
     t1 = max(v.time_end.value.datetime for v in b.details.volumes)

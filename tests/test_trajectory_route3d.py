@@ -1,0 +1,189 @@
+"""3D routes: element kinds and climb rate, the vertical closed form, the 3D simulator's truth,
+and operational intents that contain the simulated 3D flight (take-off, sloped legs, holds,
+landing) — with checks that the containment can fail."""
+
+from __future__ import annotations
+
+from datetime import datetime, timezone
+
+import numpy as np
+import pymap3d
+import pytest
+import shapely
+from scipy.stats import binom
+
+from uasnav.errors import InputError
+from uasnav.io.mission_plan import HomePosition, MissionItem, MissionPlan, route_points
+from uasnav.trajectory.calibration import calibrate, simulated_runs
+from uasnav.trajectory.route3d import ELEMENT_KINDS, Route3D, predict_route, vertical_time
+from uasnav.trajectory.route_sim import _vertical, simulate_route
+from uasnav.trajectory.simulator import VerticalLimits, phantom4_plans, simulate_flight
+from uasnav.trajectory.timebounds import TimeBounds
+from uasnav.utm.intent import build_intent
+
+T0 = datetime(2026, 11, 24, 12, 0, tzinfo=timezone.utc)
+HOME = (47.0, 8.0, 400.0)
+N = 47.0  # geoid height, m
+
+
+@pytest.fixture(scope="module")
+def model():
+    """The default (kinematic) model, calibrated on 40 simulated runs."""
+    from uasnav.experiments.trajectory import run_phantom4
+    from uasnav.trajectory.models import DEFAULT_METHOD, make_predictor
+
+    m = make_predictor(DEFAULT_METHOD).fit(run_phantom4(n_flights=4, n_train=3).train)
+    m.time_bounds_ = calibrate(simulated_runs(m, 40, seed=21))
+    return m
+
+
+def test_vertical_time_closed_form_and_simulated_move():
+    # trapezoid: 50 m at 2.5 m/s, 1 m/s² → 50/2.5 + 2.5 s; triangle: 2 m < v²/a → 2·√(2/1)
+    np.testing.assert_allclose(vertical_time([50.0, -2.0], 2.5, 1.0), [22.5, 2 * np.sqrt(2.0)])
+    with pytest.raises(InputError, match="> 0"):
+        vertical_time(1.0, 0.0, 1.0)
+    # the simulator's vertical move (acceleration-limited command, 0.3 s velocity loop) takes
+    # the closed-form time plus about one loop time constant
+    for dz, v in ((50.0, 2.5), (-30.0, 1.5)):
+        t, z = _vertical(0.0, dz, VerticalLimits(), 1.0, 0.02, 5)
+        assert z[-1] == dz
+        assert 0.0 < t[-1] - float(vertical_time(dz, v, 1.0)) < 1.5
+
+
+def _route() -> Route3D:
+    ne = np.array([[0, 0], [0, 0], [100, 0], [100, 80], [0, 80], [0, 80]], dtype=float)
+    alt = np.array([0, 30, 30, 50, 50, 0.0])
+    hold = np.array([0, 0, 10, 0, 5, 0.0])
+    return Route3D(ne, alt, hold, np.array([np.nan, np.nan, np.nan, 5.0, np.nan, np.nan]))
+
+
+def test_route_elements_kinds_climb_rate_and_times(model):
+    r = _route()
+    p = predict_route(model, r, np.zeros(2), 3.33)
+    el = p.elements
+    assert set(el.kind) == set(ELEMENT_KINDS)
+    # take-off and landing: the vertical closed form with the model's limits
+    assert el.kind[0] == "climb" and el.time_s[0] == pytest.approx(float(vertical_time(30, 2.5, 1.0)))
+    assert el.kind[-1] == "descent" and el.time_s[-1] == pytest.approx(float(vertical_time(50, 1.5, 1.0)))
+    # hovers last their hold time; arrival + hold = departure
+    np.testing.assert_allclose(el.time_s[el.kind == "hover"], [10.0, 5.0])
+    np.testing.assert_allclose(p.t_depart_s - p.t_arrive_s, r.hold_s)
+    # the sloped leg (20 m up over 80 m at 5 m/s) is capped by the climb limit: the climb-rate
+    # feature never exceeds 2.5 m/s, and the leg lasts at least the vertical move
+    sloped = (el.segment == 2) & (el.kind != "hover")
+    assert np.all(el.climb_rate_ms[sloped] <= 2.5 + 1e-9) and np.all(el.climb_rate_ms[sloped] > 0)
+    assert el.time_s[sloped].sum() >= float(vertical_time(20, 2.5, 1.0)) - 1e-9
+    assert el.dz_m[sloped].sum() == pytest.approx(20.0)
+    # element times add up to the ETA
+    assert el.time_s.sum() == pytest.approx(p.eta_s)
+    # the LVQ model times the same route's horizontal stretches with its own network
+    from uasnav.experiments.trajectory import run_phantom4
+
+    q = predict_route(run_phantom4(n_flights=4, n_train=3).predictor, r, np.zeros(2), 3.33)
+    assert set(q.elements.kind) == set(ELEMENT_KINDS) and q.eta_s == pytest.approx(p.eta_s, rel=0.1)
+
+
+def test_bad_routes():
+    with pytest.raises(InputError, match="at least 2 points"):
+        Route3D.flat(np.zeros((1, 2)))
+    ok = _route()
+    with pytest.raises(InputError, match="hold times"):
+        Route3D(ok.ne, ok.alt_m, -ok.hold_s - 1, ok.speed_ms)
+    with pytest.raises(InputError, match="speeds"):
+        Route3D(ok.ne, ok.alt_m, ok.hold_s, np.zeros(len(ok)))
+    with pytest.raises(InputError, match="shape"):
+        Route3D(ok.ne, ok.alt_m[:2], ok.hold_s, ok.speed_ms)
+
+
+def test_simulator_altitude_channel():
+    plan = phantom4_plans()["A"]
+    flat = simulate_flight(plan, seed=3)
+    # a level flight with an altitude profile is the 2D flight (no extra random draws)
+    level = simulate_flight(plan, seed=3, alt_m=np.full(plan.shape[0], 12.0))
+    np.testing.assert_array_equal(level.pos_ne, flat.pos_ne)
+    np.testing.assert_allclose(level.alt_m, 12.0)
+    # a steep climb: the vertical speed stays within the limit and the altitude is reached
+    alt = np.array([10.0, 10.0, 40.0, 40.0, 10.0])
+    vl = VerticalLimits(climb_ms=1.0, descent_ms=0.8)
+    up = simulate_flight(plan, seed=3, alt_m=alt, vertical=vl)
+    assert up.vz_ms.max() <= 1.0 + 1e-9 and up.vz_ms.min() >= -0.8 - 1e-9
+    assert abs(up.alt_m[-1] - 10.0) < 0.1 and up.alt_m.max() == pytest.approx(40.0, abs=0.5)
+    # the 30 m climb at ≤ 1 m/s makes that leg (45 m) slower than the level flight
+    assert up.t[-1] > flat.t[-1] + 10.0
+
+
+def _mission(rng: np.random.Generator) -> MissionPlan:
+    """Take-off, 2–4 waypoints (legs 40–150 m, altitude changes ±20 m, some holds), land."""
+    h = float(rng.uniform(20, 60))
+    items = [MissionItem(command=22, frame=3, alt_m=h)]
+    e = n = 0.0
+    heading = rng.uniform(0, 2 * np.pi)
+    for _ in range(int(rng.integers(2, 5))):
+        d = rng.uniform(40, 150)
+        e, n = e + d * np.sin(heading), n + d * np.cos(heading)
+        heading += np.radians(rng.uniform(-150, 150))
+        h = float(np.clip(h + rng.uniform(-20, 20), 15, 90))
+        lat, lon, _ = pymap3d.enu2geodetic(e, n, 0.0, HOME[0], HOME[1], 0.0)
+        hold = float(rng.choice([0.0, 0.0, rng.uniform(3, 15)]))
+        items.append(
+            MissionItem(16, 3, params=(hold, 0, 0, 0), lat_deg=float(lat), lon_deg=float(lon), alt_m=h)
+        )
+    items.append(MissionItem(command=21, frame=3, lat_deg=items[-1].lat_deg, lon_deg=items[-1].lon_deg))
+    return MissionPlan(items=tuple(items), home=HomePosition(*HOME), source="random 3D mission")
+
+
+def _truth_route(plan: MissionPlan, b) -> Route3D:
+    pts = route_points(plan)
+    return Route3D(
+        b.route_en[:, ::-1], b.route_alt_w84, np.array([p.hold_s for p in pts]), np.full(len(pts), np.nan)
+    )
+
+
+def _contained(b, t: np.ndarray, ne: np.ndarray, alt: np.ndarray) -> bool:
+    polys = [shapely.Polygon(o) for o in b.volume_outline_en]
+    live = [(lo, hi, za, zb) for (lo, hi), (za, zb) in zip(b.volume_time_s, b.volume_alt_w84, strict=True)]
+    for ti, p, z in zip(t, ne[:, ::-1], alt, strict=True):
+        pt = shapely.Point(p)
+        if not any(
+            lo <= ti <= hi and za <= z <= zb and poly.covers(pt)
+            for poly, (lo, hi, za, zb) in zip(polys, live, strict=True)
+        ):
+            return False
+    return True
+
+
+def test_intent_contains_the_simulated_3d_flight(model):
+    rng = np.random.default_rng(5)
+    n_runs, k = 60, 0
+    err = []
+    for i in range(n_runs):
+        plan = _mission(rng)
+        b = build_intent(plan, model, np.zeros(2), T0, geoid_height_m=N, cruise_ms=model.cruise_ms_)
+        route = _truth_route(plan, b)
+        tr = simulate_route(route, seed=100 + i, dt=0.05, rate_hz=5.0)
+        k += _contained(b, tr.t, tr.pos_ne, tr.alt_m)
+        err.append(abs(tr.t_reached_s[-1] - b.t_arrive_s[-1]) / tr.t_reached_s[-1])
+    # calibrated at 95 %: 60 runs consistent with ≥ 95 % (1 % binomial test)
+    assert binom.cdf(k, n_runs, 0.95) > 0.01, f"{k}/{n_runs} simulated 3D flights contained"
+    print(f"3D containment {k}/{n_runs}, median ETA error {100 * np.median(err):.2f} %")
+    assert np.median(err) < 0.06  # the 3D prediction itself: median mission-time error
+    # the check can fail: with near-zero bounds a plan flown much faster than predicted...
+    plan = _mission(np.random.default_rng(1))
+    keep, model.time_bounds_ = model.time_bounds_, TimeBounds(np.zeros(3) + 1e-6, tau_s=0.0)
+    try:
+        fast = build_intent(
+            plan, model, np.zeros(2), T0, geoid_height_m=N, coverage=0.5, cruise_ms=3 * model.cruise_ms_
+        )
+        # ...and climbs predicted four times faster than the vehicle climbs
+        quick = build_intent(
+            plan, model, np.zeros(2), T0, geoid_height_m=N, coverage=0.5, climb_ms=10.0, descent_ms=6.0
+        )
+    finally:
+        model.time_bounds_ = keep
+    b = build_intent(plan, model, np.zeros(2), T0, geoid_height_m=N)
+    tr = simulate_route(_truth_route(plan, b), seed=7, dt=0.05, rate_hz=5.0)
+    assert _contained(b, tr.t, tr.pos_ne, tr.alt_m)
+    assert not _contained(fast, tr.t, tr.pos_ne, tr.alt_m)
+    assert not _contained(quick, tr.t, tr.pos_ne, tr.alt_m)
+    # and the vertical check does not pass blindly: the flight 30 m higher is outside
+    assert not _contained(b, tr.t, tr.pos_ne, tr.alt_m + 30.0)
