@@ -14,7 +14,7 @@ from scipy.stats import binom
 
 from uasnav.errors import InputError
 from uasnav.io.mission_plan import HomePosition, MissionItem, MissionPlan, route_points
-from uasnav.trajectory.calibration import calibrate, simulated_runs
+from uasnav.trajectory.calibration import calibrate, covered, simulated_route_runs
 from uasnav.trajectory.route3d import ELEMENT_KINDS, Route3D, predict_route, vertical_time
 from uasnav.trajectory.route_sim import _vertical, simulate_route
 from uasnav.trajectory.simulator import VerticalLimits, phantom4_plans, simulate_flight
@@ -28,12 +28,12 @@ N = 47.0  # geoid height, m
 
 @pytest.fixture(scope="module")
 def model():
-    """The default (kinematic) model, calibrated on 40 simulated runs."""
+    """The default (kinematic) model, calibrated on 40 simulated 3D runs."""
     from uasnav.experiments.trajectory import run_phantom4
     from uasnav.trajectory.models import DEFAULT_METHOD, make_predictor
 
     m = make_predictor(DEFAULT_METHOD).fit(run_phantom4(n_flights=4, n_train=3).train)
-    m.time_bounds_ = calibrate(simulated_runs(m, 40, seed=21))
+    m.time_bounds_ = calibrate(simulated_route_runs(m, 40, seed=21))
     return m
 
 
@@ -187,3 +187,23 @@ def test_intent_contains_the_simulated_3d_flight(model):
     assert not _contained(quick, tr.t, tr.pos_ne, tr.alt_m)
     # and the vertical check does not pass blindly: the flight 30 m higher is outside
     assert not _contained(b, tr.t, tr.pos_ne, tr.alt_m + 30.0)
+
+
+def test_3d_time_bounds_cover_held_out_3d_runs(model):
+    test = simulated_route_runs(model, 40, seed=22)
+    # every run has every element kind's truth: vertical moves end at the reached altitude
+    # (truth within a few seconds of the closed form), a hover ends its hold after the vehicle
+    # reached the point
+    r = next(x for x in test if "hover" in set(x.prediction.elements.kind))
+    el = r.prediction.elements
+    assert {"climb", "descent", "leg", "hover"} <= set(el.kind)
+    dt_true = np.diff(r.t_true_s)
+    hov = el.kind == "hover"
+    at = el.segment[hov]
+    np.testing.assert_allclose(r.t_true_s[1:][hov], r.truth.t_reached_s[at] + r.route.hold_s[at])
+    vert = np.isin(el.kind, ["climb", "descent"])
+    assert np.all(np.abs(dt_true[vert] - el.time_s[vert]) < 3.0)
+    k = sum(covered(model.time_bounds_, x, 0.95) for x in test)
+    assert binom.cdf(k, 40, 0.95) > 0.01, f"{k}/40 held-out 3D runs covered"
+    # and coverage can fail: bounds of (almost) zero width cover no run
+    assert sum(covered(TimeBounds(np.zeros(3) + 1e-6, tau_s=0.0), x, 0.5) for x in test) == 0

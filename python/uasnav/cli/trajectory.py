@@ -369,9 +369,11 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # type: ignore[no-untyped-def]
-    """Calibrate the time bounds of a model (split-conformal on simulated runs with truth)."""
+    """Calibrate the time bounds of a model (split-conformal on simulated 3D runs with truth:
+    random routes with take-off, sloped legs, holds and landing, scored at every element)."""
     from uasnav.trajectory.calibration import calibrate as fit_bounds
-    from uasnav.trajectory.calibration import covered, simulated_runs
+    from uasnav.trajectory.calibration import covered
+    from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
     from uasnav.trajectory.timebounds import clopper_pearson
 
@@ -500,7 +502,7 @@ def intent(  # type: ignore[no-untyped-def]
     from uasnav.io.operational_intent import write_intent, write_intent_geojson
     from uasnav.io.plans import plan_cruise_speed, read_plan
     from uasnav.trajectory.calibration import calibrate as fit_bounds
-    from uasnav.trajectory.calibration import simulated_runs
+    from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
     from uasnav.utm.intent import build_intent
 

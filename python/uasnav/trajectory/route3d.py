@@ -122,6 +122,8 @@ class RouteElements:
     dz_m : ndarray — height change, m.
     time_s : ndarray — predicted time, s.
     climb_rate_ms : ndarray — Δz / t, m/s (0 for a hover).
+    stretch_s_end_m : ndarray — for a leg or turn, the arc length (m) from the start of its
+        horizontal stretch (the points between two stops) to the element's end; NaN otherwise.
     flagged : ndarray of bool — the predictor flagged the element (outside its training data).
     flags : list of list of str — the predictor's reasons.
     """
@@ -132,6 +134,7 @@ class RouteElements:
     dz_m: np.ndarray
     time_s: np.ndarray
     climb_rate_ms: np.ndarray
+    stretch_s_end_m: np.ndarray
     flagged: np.ndarray
     flags: list[list[str]]
 
@@ -231,7 +234,12 @@ def predict_route(
     t_arr = np.zeros(n)
     t_dep = np.zeros(n)
 
-    def add(kind: str, seg: int, length: float, dz_el: float, t: float, why: list[str]) -> None:
+    s_end: list[float] = []
+
+    def add(
+        kind: str, seg: int, length: float, dz_el: float, t: float, why: list[str], s_e: float = np.nan
+    ) -> None:
+        s_end.append(s_e)
         kinds.append(kind)
         segs.append(seg)
         lens.append(length)
@@ -288,7 +296,10 @@ def predict_route(
             # height change over the element's arc (a corner element spans two legs)
             z_a, z_b = np.interp([el.s_start_m[e], el.s_end_m[e]], s_wp, route.alt_m[i : j + 1])
             kind = "turn" if str(el.kind[e]) == "corner" else "leg"
-            add(kind, g, float(el.length_m[e]), float(z_b - z_a), float(t_el[e]), list(pred.flags[e]))
+            add(
+                kind, g, float(el.length_m[e]), float(z_b - z_a), float(t_el[e]), list(pred.flags[e]),
+                float(el.s_end_m[e]),
+            )  # fmt: skip
         hover(j)
         i = j
     time_s = np.array(times)
@@ -306,6 +317,7 @@ def predict_route(
         dz_m=dz_e,
         time_s=time_s,
         climb_rate_ms=np.where(time_s > 0, dz_e / np.maximum(time_s, 1e-12), 0.0),
+        stretch_s_end_m=np.array(s_end, dtype=float),
         flagged=flagged,
         flags=flags,
     )

@@ -18,19 +18,27 @@ import numpy as np
 
 from uasnav.errors import NumericalError
 from uasnav.trajectory.route3d import SAME_HEIGHT_M, SAME_PLACE_M, Route3D
-from uasnav.trajectory.simulator import MultirotorParams, VerticalLimits, WindModel, simulate_flight
+from uasnav.trajectory.simulator import (
+    MultirotorParams,
+    Telemetry,
+    VerticalLimits,
+    WindModel,
+    simulate_flight,
+)
 
 
 @dataclass(frozen=True)
 class RouteTruth:
     """The simulated flight of a route: samples of time (s), position (north/east m), altitude
     (m, the route's frame), and the time each route point was reached (s; departure after a
-    hold is ``t_reached_s + hold``)."""
+    hold is ``t_reached_s + hold``). ``stretches`` holds each horizontal stretch flown: (first
+    point i, last point j, its start time s, its telemetry from that start)."""
 
     t: np.ndarray
     pos_ne: np.ndarray
     alt_m: np.ndarray
     t_reached_s: np.ndarray
+    stretches: tuple[tuple[int, int, float, Telemetry], ...] = ()
 
 
 def _vertical(
@@ -80,6 +88,7 @@ def simulate_route(
     t_now = 0.0
     ts, ps, zs = [np.zeros(1)], [route.ne[:1].copy()], [route.alt_m[:1].copy()]
     reached = np.zeros(n)
+    stretches: list[tuple[int, int, float, Telemetry]] = []
 
     def hold(i: int) -> None:
         nonlocal t_now
@@ -123,6 +132,7 @@ def simulate_route(
             vertical=vl,
         )
         assert tel.alt_m is not None
+        stretches.append((i, j, t_now, tel))
         ts.append(t_now + tel.t[1:]), ps.append(tel.pos_ne[1:]), zs.append(tel.alt_m[1:])
         # the stretch's inner points: reached when the track passes closest to them
         for q in range(i + 1, j):
@@ -131,7 +141,7 @@ def simulate_route(
         reached[j] = t_now
         hold(j)
         i = j
-    return RouteTruth(np.concatenate(ts), np.concatenate(ps), np.concatenate(zs), reached)
+    return RouteTruth(np.concatenate(ts), np.concatenate(ps), np.concatenate(zs), reached, tuple(stretches))
 
 
 __all__ = ["RouteTruth", "simulate_route"]
