@@ -16,7 +16,6 @@ def build(w: SectionWriter) -> None:
     from uasnav.experiments import utm
     from uasnav.experiments.trajectory import run_phantom4
     from uasnav.plotting import new_figure
-
     from uasnav.trajectory.models import DEFAULT_METHOD, make_predictor, method_of
 
     w.progress("utm: training the predictor")
