@@ -207,3 +207,35 @@ def test_3d_time_bounds_cover_held_out_3d_runs(model):
     assert binom.cdf(k, 40, 0.95) > 0.01, f"{k}/40 held-out 3D runs covered"
     # and coverage can fail: bounds of (almost) zero width cover no run
     assert sum(covered(TimeBounds(np.zeros(3) + 1e-6, tau_s=0.0), x, 0.5) for x in test) == 0
+
+
+def test_measured_climb_rate_and_element_table_columns():
+    import pyarrow as pa
+
+    from uasnav.trajectory.element_table import ELEMENT_SCHEMA, from_table, to_rows
+    from uasnav.trajectory.samples import measure_elements
+
+    # a straight 200 m leg climbing 20 m: the simulated truth climbs 0.1 m per metre flown
+    plan = np.array([[0.0, 0.0], [200.0, 0.0]])
+    tel = simulate_flight(plan, seed=4, alt_m=np.array([10.0, 30.0]))
+    _, s = measure_elements(plan, tel.t, tel.pos_ne, tel.vel_ne, np.zeros(2), 3.33, alt_m=tel.alt_m)
+    speed = s.length_m / s.t_real_s
+    inner = slice(2, -2)  # away from the ends, where the altitude loop lags the ramp
+    np.testing.assert_allclose(s.climb_rate_ms[inner], 0.1 * speed[inner], rtol=0.1)
+    with pytest.raises(InputError, match="altitude shape"):
+        measure_elements(plan, tel.t, tel.pos_ne, tel.vel_ne, np.zeros(2), 3.33, alt_m=tel.alt_m[:-1])
+    # the element table carries the kind and the climb rate, and reads back exactly
+    table = pa.Table.from_pylist(to_rows(s, 10.0), schema=ELEMENT_SCHEMA)
+    assert set(table.column("element_kind").to_pylist()) == {"leg"}
+    back, _ = from_table(table)
+    np.testing.assert_array_equal(back.climb_rate_ms, s.climb_rate_ms)
+    # corners are turns; a flight without altitude has NaN climb rates
+    tel2 = simulate_flight(phantom4_plans()["A"], seed=4)
+    _, s2 = measure_elements(tel2.plan_ne, tel2.t, tel2.pos_ne, tel2.vel_ne, np.zeros(2), 3.33)
+    rows = to_rows(s2, 10.0)
+    assert {r["element_kind"] for r in rows} == {"leg", "turn"} and all(
+        np.isnan(r["climb_rate_ms"]) for r in rows
+    )
+    # tables written before the two columns existed still read
+    old = table.drop_columns(["element_kind", "climb_rate_ms"])
+    assert from_table(old)[0].climb_rate_ms is None
