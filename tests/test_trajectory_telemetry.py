@@ -174,6 +174,11 @@ def test_cli_csv_flight_with_plan(tmp_path):
         ["trajectory", "predict", "--model", str(model), "--plan", str(plan_csv), "--wind", "0@0", "--json"],
     )
     assert r.exit_code == 0 and json.loads(r.output)["method"] == "kinematic", r.output
+    # the LVQ network's options select it; with the kinematic method named they are refused
+    r = CliRunner().invoke(main, [*args, "--prototypes", "16", "--out", str(model), "--json"])
+    assert r.exit_code == 0 and json.loads(r.stdout)["method"] == "lvq", r.output
+    r = CliRunner().invoke(main, [*args, "--method", "kinematic", "--algorithm", "glvq", "--out", str(model)])
+    assert r.exit_code == 2 and "--algorithm apply to --method lvq only" in r.output
     # the thesis' LVQ, selected by name
     args += ["--method", "lvq"]
     r = CliRunner().invoke(main, [*args, "--out", str(model), "--json"])

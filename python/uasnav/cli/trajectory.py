@@ -123,13 +123,22 @@ def train(
 
     --method kinematic (default: the most accurate by leave-one-run-out on real flights) keeps
     the logs' autopilot limits (WPNAV_*, MPC_*) and the flights' speed; --method lvq trains the
-    thesis' LVQ network (--algorithm, --prototypes).
+    thesis' LVQ network (--algorithm, --prototypes; giving either selects it).
     """
     from uasnav.trajectory.element_table import training_samples
     from uasnav.trajectory.kinematic import KinematicPredictor
     from uasnav.trajectory.predictor import TrajectoryPredictor
 
     check_outputs([*flights, plan], {"--out": out})
+    # the LVQ network's own options select it when no method is named
+    src = click.get_current_context().get_parameter_source
+    lvq_opts = [
+        f"--{n}" for n in ("algorithm", "prototypes") if src(n) == click.core.ParameterSource.COMMANDLINE
+    ]
+    if lvq_opts and method != "lvq":
+        if src("method") == click.core.ParameterSource.COMMANDLINE:
+            raise click.UsageError(f"{', '.join(lvq_opts)} apply to --method lvq only")
+        method = "lvq"
     wind = parse_wind(wind_text) if wind_text else None
     from uasnav.trajectory.baselines import class_method_reason
 
