@@ -101,7 +101,8 @@ def _limits_source(flights: Sequence[str], lim: AutopilotLimits) -> str:
     if not lim.source:
         return "defaults"
     logs = [Path(f).name for f in flights if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg")]
-    return f"{', '.join(lim.source)} from {logs[0] if logs else 'log'}; others defaults"
+    rest = "" if {"accel_ms2", "climb_ms", "descent_ms"} <= set(lim.source) else "; others defaults"
+    return f"{', '.join(lim.source)} from {logs[0] if logs else 'log'}{rest}"
 
 
 @command.command("train")
