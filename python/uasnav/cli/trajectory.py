@@ -585,6 +585,13 @@ def intent(  # type: ignore[no-untyped-def]
         "descent_ms": descent_rate,
         "limits_from_log": from_log,
     }
+    if b.route_prediction is not None:
+        el = b.route_prediction.elements
+        # the 3D elements by kind: how many, and their predicted time (s)
+        summary["elements"] = {
+            str(k): {"count": int((el.kind == k).sum()), "time_s": float(el.time_s[el.kind == k].sum())}
+            for k in ("leg", "turn", "climb", "descent", "hover")
+        }
     if as_json:
         echo_json(summary)
         return

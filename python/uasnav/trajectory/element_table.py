@@ -185,7 +185,7 @@ def training_samples(
     """
     from uasnav.trajectory.flights import flight_samples
 
-    logs = [x for x in inputs if not is_element_dataset(x)]
+    logs = [os.fspath(x) for x in inputs if not is_element_dataset(x)]
     parts: list[ElementSamples] = []
     n_runs = 0
     if logs:

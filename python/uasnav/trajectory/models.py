@@ -28,7 +28,10 @@ METHODS: dict[str, type[KinematicPredictor] | type[TrajectoryPredictor]] = {
 #: The default method: the most accurate by leave-one-run-out on the real flights measured.
 DEFAULT_METHOD = "kinematic"
 
-_FORMATS = {kinematic.MODEL_FORMAT: KinematicPredictor, predictor.MODEL_FORMAT: TrajectoryPredictor}
+_FORMATS: dict[str, type[KinematicPredictor] | type[TrajectoryPredictor]] = {
+    kinematic.MODEL_FORMAT: KinematicPredictor,
+    predictor.MODEL_FORMAT: TrajectoryPredictor,
+}
 
 
 def method_of(model: Predictor) -> str:

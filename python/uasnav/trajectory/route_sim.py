@@ -52,7 +52,8 @@ def _vertical(
     for step in range(int(10_000 / dt)):
         rem = (z1 - z) * sign
         if rem < 0.02 and abs(vz) < 0.05:
-            ts.append(step * dt), zs.append(z1)
+            ts.append(step * dt)
+            zs.append(z1)
             return np.array(ts), np.array(zs)
         # braking curve toward the target, limited by the speed and acceleration limits
         cmd = sign * min(v_max, np.sqrt(2.0 * vl.accel_z_ms2 * max(rem, 0.0)))
@@ -62,7 +63,8 @@ def _vertical(
         cmd = float(np.clip(cmd, cmd_prev - d, cmd_prev + d))
         cmd_prev = cmd
         if step % every == 0:
-            ts.append(step * dt), zs.append(z)
+            ts.append(step * dt)
+            zs.append(z)
         vz += (cmd - vz) * dt / vl.tau_z_s
         z += vz * dt
     raise NumericalError(f"simulated vertical move {z0:g} → {z1:g} m did not end")
@@ -90,13 +92,18 @@ def simulate_route(
     reached = np.zeros(n)
     stretches: list[tuple[int, int, float, Telemetry]] = []
 
+    def add(t: np.ndarray, ne: np.ndarray, z: np.ndarray) -> None:
+        ts.append(t)
+        ps.append(ne)
+        zs.append(z)
+
     def hold(i: int) -> None:
         nonlocal t_now
         h = float(route.hold_s[i])
         if h > 0:
             k = max(int(h * rate_hz), 1)
             tt = t_now + np.linspace(0.0, h, k + 1)[1:]
-            ts.append(tt), ps.append(np.repeat(ps[-1][-1:], k, axis=0)), zs.append(np.full(k, zs[-1][-1]))
+            add(tt, np.repeat(ps[-1][-1:], k, axis=0), np.full(k, zs[-1][-1]))
             t_now += h
 
     hold(0)
@@ -106,11 +113,7 @@ def simulate_route(
             if abs(dz[i]) > SAME_HEIGHT_M:
                 scale = float(np.clip(1.0 + rng.normal(0.0, prm.speed_sigma_frac), 0.5, 1.5))
                 tt, zz = _vertical(float(zs[-1][-1]), float(route.alt_m[i + 1]), vl, scale, dt, every)
-                (
-                    ts.append(t_now + tt[1:]),
-                    zs.append(zz[1:]),
-                    ps.append(np.repeat(ps[-1][-1:], tt.size - 1, axis=0)),
-                )
+                add(t_now + tt[1:], np.repeat(ps[-1][-1:], tt.size - 1, axis=0), zz[1:])
                 t_now += float(tt[-1])
             reached[i + 1] = t_now
             hold(i + 1)
@@ -133,7 +136,7 @@ def simulate_route(
         )
         assert tel.alt_m is not None
         stretches.append((i, j, t_now, tel))
-        ts.append(t_now + tel.t[1:]), ps.append(tel.pos_ne[1:]), zs.append(tel.alt_m[1:])
+        add(t_now + tel.t[1:], tel.pos_ne[1:], tel.alt_m[1:])
         # the stretch's inner points: reached when the track passes closest to them
         for q in range(i + 1, j):
             reached[q] = t_now + float(tel.t[np.hypot(*(tel.pos_ne - route.ne[q]).T).argmin()])

@@ -39,7 +39,7 @@ from uasnav.errors import InputError
 from uasnav.io.mission_plan import MissionPlan, RoutePoint, plan_cruise_speed, route_points
 from uasnav.io.operational_intent import parse_details, rfc3339
 from uasnav.trajectory.models import Predictor
-from uasnav.trajectory.route3d import Route3D, predict_route
+from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route
 from uasnav.trajectory.timebounds import DEFAULT_COVERAGE
 from uasnav.utm.altitude import w84_altitudes
 
@@ -73,6 +73,8 @@ class IntentBuild:
         ``start``) ranges of each volume.
     coverage : float
     flags : list of list of str — the predictor's flags per horizontal element.
+    route_prediction : RoutePrediction or None — the 3D elements (legs, turns, climbs,
+        descents, hovers) and their times.
     """
 
     details: Any
@@ -90,6 +92,7 @@ class IntentBuild:
     volume_time_s: np.ndarray
     coverage: float
     flags: list[list[str]]
+    route_prediction: RoutePrediction | None = None
 
 
 def _positive(x: float, name: str) -> float:
@@ -254,6 +257,7 @@ def build_intent(
         volume_time_s=np.array(times).reshape(-1, 2),
         coverage=coverage,
         flags=flags,
+        route_prediction=rp,
     )
 
 
