@@ -250,3 +250,66 @@ def test_measured_climb_rate_and_element_table_columns():
     # tables written before the two columns existed still read
     old = table.drop_columns(["element_kind", "climb_rate_ms"])
     assert from_table(old)[0].climb_rate_ms is None
+
+
+def test_cli_predict_route_matches_the_intent(model, shared_data, tmp_path):
+    import json
+
+    from click.testing import CliRunner
+
+    from uasnav.cli import main
+
+    mpath = tmp_path / "m.json"
+    model.save(mpath)
+    plan = str(shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan")
+    base = ["trajectory", "predict", "--model", str(mpath), "--plan", plan, "--wind", "3@45", "--route"]
+    r = CliRunner().invoke(main, [*base, "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout)
+    kinds = [e["kind"] for e in out["elements"]]
+    assert out["method"] == "kinematic" and kinds[0] == "climb" and kinds[-1] == "descent" and "leg" in kinds
+    assert out["elements"][0]["climb_rate_ms"] == pytest.approx(50 / (50 / 2.5 + 2.5))
+    assert sum(e["time_s"] for e in out["elements"]) == pytest.approx(out["eta_s"])
+    # the same route timing as the operational intent's
+    i = CliRunner().invoke(
+        main,
+        ["trajectory", "intent", "--model", str(mpath), "--plan", plan, "--wind", "3@45", "--start",
+         "2026-11-24T12:00:00Z", "--geoid-height", "47.4", "--out", str(tmp_path / "i.json"), "--json"],
+    )  # fmt: skip
+    assert i.exit_code == 0, i.output
+    intent = json.loads(i.stdout)
+    assert intent["eta_s"] == pytest.approx(out["eta_s"])
+    np.testing.assert_allclose(intent["waypoint_times_s"], out["arrive_s"])
+    text = CliRunner().invoke(main, base)
+    assert text.exit_code == 0 and "climb" in text.output and "ETA" in text.output
+    bad = CliRunner().invoke(main, [*base, "--required", "0,1"])
+    assert bad.exit_code == 2 and "--required" in bad.output
+    # a local (north/east) plan has no geodetic route
+    csv = tmp_path / "p.csv"
+    csv.write_text("north,east\n0,0\n100,0\n")
+    r = CliRunner().invoke(
+        main, ["trajectory", "predict", "--model", str(mpath), "--plan", str(csv), "--wind", "0@0", "--route"]
+    )
+    assert r.exit_code == 1 and "no geodetic route" in r.output
+
+
+def test_route_from_plan_frames_and_refusals():
+    from uasnav.trajectory.route3d import route_from_plan
+
+    def wp(n: float, alt: float, frame: int = 3, cmd: int = 16, hold: float = 0.0) -> MissionItem:
+        lat, lon, _ = pymap3d.enu2geodetic(0.0, n, 0.0, HOME[0], HOME[1], 0.0)
+        return MissionItem(
+            cmd, frame, params=(hold, 0, 0, 0), lat_deg=float(lat), lon_deg=float(lon), alt_m=alt
+        )
+
+    # relative 30 m then AMSL 450 m at a home 400 m AMSL: a 20 m climb on the second leg
+    mixed = MissionPlan(items=(wp(0, 30.0), wp(100, 450.0, frame=0)), home=HomePosition(*HOME), source="m")
+    r = route_from_plan(mixed)
+    np.testing.assert_allclose(r.alt_m, [430.0, 450.0])
+    np.testing.assert_allclose(r.ne[-1], [100.0, 0.0], atol=0.01)
+    with pytest.raises(InputError, match="mixed and no home altitude"):
+        route_from_plan(MissionPlan(items=mixed.items, home=None, source="m"))
+    with pytest.raises(InputError, match="terrain"):
+        route_from_plan(MissionPlan(items=(wp(0, 30.0, frame=10), wp(100, 30.0, frame=10)), source="t"))
+    with pytest.raises(InputError, match="unlimited loiter"):
+        route_from_plan(MissionPlan(items=(wp(0, 30.0), wp(100, 30.0, cmd=17)), source="l"))

@@ -199,13 +199,26 @@ def train(
 @click.option("--speed", type=POSITIVE, help="Commanded speed (m/s); default the model's.")
 @click.option("--required", help="4D plan: required time (s from start) at each waypoint, T0,T1,….")
 @click.option("--tolerance", type=NON_NEGATIVE, default=5.0, show_default=True, help="4D time tolerance (s).")
+@click.option(
+    "--route",
+    "route3d",
+    is_flag=True,
+    help="Time the plan's 3D route: take-off, legs, turns, climbs, descents, holds, landing.",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_json):  # type: ignore[no-untyped-def]
+def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3d, as_json):  # type: ignore[no-untyped-def]
     """Per-element times, ETA and 4D waypoint times of PLAN (CSV lat,lon,alt or north,east).
 
     With --required, also checks the 4D plan's feasibility: each waypoint reached within
-    --tolerance of its required time (exit code 0 either way; see "feasible").
+    --tolerance of its required time (exit code 0 either way; see "feasible"). With --route,
+    the plan's whole 3D route (a geodetic mission plan) element by element, each with its kind
+    (leg, turn, climb, descent, hover) and climb rate; vertical limits from a kinematic model.
     """
+    if route3d:
+        if required is not None:
+            raise click.UsageError("--required applies to the horizontal plan, not with --route")
+        _predict_route(model_path, plan_path, wind_text, speed, as_json)
+        return
     from uasnav.trajectory.models import load_model, method_of
     from uasnav.trajectory.plans import read_plan
 
@@ -242,6 +255,42 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
         f"ETA {p.eta_s:.1f} s ({method_of(model)} model); waypoint times (s): "
         + ", ".join(f"{x:.1f}" for x in p.waypoint_times_s)
     )
+
+
+def _predict_route(
+    model_path: str, plan_path: str, wind_text: str, speed: float | None, as_json: bool
+) -> None:
+    """``predict --route``: the 3D elements of a geodetic plan."""
+    from uasnav.io.plans import plan_cruise_speed, read_plan
+    from uasnav.trajectory.models import load_model, method_of
+    from uasnav.trajectory.route3d import predict_route, route_from_plan
+
+    wind = parse_wind(wind_text)
+    model = load_model(model_path)
+    plan = read_plan(plan_path)
+    route = route_from_plan(plan)
+    v = speed or plan_cruise_speed(plan) or model.cruise_ms_
+    p = predict_route(model, route, wind, v)
+    rows = p.elements.rows()
+    if as_json:
+        echo_json(
+            {
+                "method": method_of(model),
+                "eta_s": p.eta_s,
+                "arrive_s": p.t_arrive_s,
+                "depart_s": p.t_depart_s,
+                "elements": rows,
+            }
+        )
+        return
+    click.echo(f"{'#':>3} {'kind':8} {'seg':>4} {'L m':>6} {'dz m':>6} {'climb m/s':>9} {'t s':>7}")
+    for r in rows:
+        mark = "  *low confidence: " + "; ".join(r["flags"]) if r["flags"] else ""
+        click.echo(
+            f"{r['element']:>3} {r['kind']:8} {r['segment']:>4} {r['length_m']:6.1f} {r['dz_m']:6.1f} "
+            f"{r['climb_rate_ms']:9.2f} {r['time_s']:7.2f}{mark}"
+        )
+    click.echo(f"ETA {p.eta_s:.1f} s ({method_of(model)} model, {len(route)} route points)")
 
 
 def _log_limits(flights: Sequence[str]) -> AutopilotLimits:

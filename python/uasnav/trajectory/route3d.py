@@ -26,11 +26,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from uasnav.errors import InputError
 from uasnav.trajectory.timebounds import FLAG_WIDENING
+
+if TYPE_CHECKING:
+    from uasnav.io.mission_plan import MissionPlan
 
 #: Element kinds of a 3D route.
 ELEMENT_KINDS = ("leg", "turn", "climb", "descent", "hover")
@@ -97,6 +101,45 @@ class Route3D:
     def dz_m(self) -> np.ndarray:
         """Height change of each segment, shape (n − 1,), m."""
         return np.diff(self.alt_m)
+
+
+def route_from_plan(plan: MissionPlan, home_amsl_m: float | None = None) -> Route3D:
+    """The 3D route of a geodetic mission plan (:func:`uasnav.io.mission_plan.route_points`:
+    take-off from the ground, waypoints with holds, ``DO_CHANGE_SPEED``, landing) in the local
+    north/east frame of its first point; altitudes in metres above mean sea level when the plan
+    mixes relative and AMSL items (``home_amsl_m``, else the plan's home), else in the plan's
+    one frame (only differences matter for the timing).
+
+    Raises :class:`InputError` for altitudes above terrain (no terrain model), mixed frames
+    without a home altitude, and unbounded holds (an unlimited loiter, a loiter of N turns).
+    """
+    from uasnav.io.mission_plan import AltitudeFrame, route_points
+    from uasnav.trajectory.geometry import geodetic_to_local
+
+    pts = route_points(plan)
+    for p in pts:
+        if not math.isfinite(p.hold_s):
+            what = "an unlimited loiter" if p.hold_s == math.inf else "a loiter of N turns (time unknown)"
+            raise InputError(f"{plan.source}: item {p.item}: {what} has no predictable end")
+    frames = {p.frame for p in pts}
+    if AltitudeFrame.TERRAIN in frames:
+        raise InputError(f"{plan.source}: altitudes above terrain need a terrain model to be timed")
+    alt = np.array([p.alt_m for p in pts], dtype=float)
+    if len(frames) > 1:
+        home = home_amsl_m if home_amsl_m is not None else (plan.home.alt_amsl_m if plan.home else None)
+        if home is None:
+            raise InputError(f"{plan.source}: relative and AMSL altitudes mixed and no home altitude")
+        alt = np.array(
+            [a + home if p.frame == AltitudeFrame.RELATIVE else a for a, p in zip(alt, pts, strict=True)]
+        )
+    lat = np.array([p.lat_deg for p in pts])
+    lon = np.array([p.lon_deg for p in pts])
+    ne = geodetic_to_local(lat, lon, np.zeros(lat.size))[:, :2]
+    speeds, v = [], math.nan
+    for i, p in enumerate(pts):  # a speed change holds until the next one
+        v = p.speed_ms if p.speed_ms is not None and i > 0 else v
+        speeds.append(v)
+    return Route3D(ne, alt, np.array([p.hold_s for p in pts]), np.array(speeds))
 
 
 def vertical_time(dz_m: np.ndarray | float, speed_ms: float, accel_ms2: float) -> np.ndarray:
@@ -330,5 +373,6 @@ __all__ = [
     "RouteElements",
     "RoutePrediction",
     "predict_route",
+    "route_from_plan",
     "vertical_time",
 ]
