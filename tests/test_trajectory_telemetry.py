@@ -164,6 +164,23 @@ def test_cli_csv_flight_with_plan(tmp_path):
         "--wind",
         "2.78@22.5",
     ]
+    # the default method is the kinematic point mass: no classifier, so no warning
+    r = CliRunner().invoke(main, [*args, "--out", str(model), "--json"])
+    assert r.exit_code == 0 and r.stderr == "", r.output
+    info = json.loads(r.stdout)
+    assert info["method"] == "kinematic" and info["limits"]["source"] == "defaults"
+    r = CliRunner().invoke(
+        main,
+        ["trajectory", "predict", "--model", str(model), "--plan", str(plan_csv), "--wind", "0@0", "--json"],
+    )
+    assert r.exit_code == 0 and json.loads(r.output)["method"] == "kinematic", r.output
+    # the LVQ network's options select it; with the kinematic method named they are refused
+    r = CliRunner().invoke(main, [*args, "--prototypes", "16", "--out", str(model), "--json"])
+    assert r.exit_code == 0 and json.loads(r.stdout)["method"] == "lvq", r.output
+    r = CliRunner().invoke(main, [*args, "--method", "kinematic", "--algorithm", "glvq", "--out", str(model)])
+    assert r.exit_code == 2 and "--algorithm apply to --method lvq only" in r.output
+    # the thesis' LVQ, selected by name
+    args += ["--method", "lvq"]
     r = CliRunner().invoke(main, [*args, "--out", str(model), "--json"])
     assert r.exit_code == 0, r.output
     from uasnav.trajectory.geometry import discretise

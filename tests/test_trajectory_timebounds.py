@@ -33,6 +33,12 @@ def model() -> TrajectoryPredictor:
     return run_phantom4(n_flights=6, n_train=4).predictor
 
 
+def run_phantom4_train():
+    from uasnav.experiments.trajectory import run_phantom4
+
+    return run_phantom4(n_flights=4, n_train=3).train
+
+
 @pytest.fixture(scope="module")
 def runs(model):
     cal = simulated_runs(model, N_CAL, seed=11)
@@ -148,9 +154,10 @@ def test_intent_altitudes_and_refusals(model, runs, shared_data, monkeypatch):
     # W84 = AMSL + N: relative 0 (ground) and 50 m ± the 10 m vertical buffer
     assert b.volume_alt_w84.min() == pytest.approx(home + 47.4 - 10)
     assert b.volume_alt_w84.max() == pytest.approx(home + 50 + 47.4 + 10)
-    # take-off at 2.5 m/s: 50 m in 20 s; the landing descends 50 m at 1.5 m/s
-    assert b.t_arrive_s[1] == pytest.approx(20.0)
-    assert b.t_arrive_s[-1] - b.t_arrive_s[-2] == pytest.approx(50 / 1.5)
+    # take-off at 2.5 m/s with 1 m/s² (trapezoid): 50 m in 50/2.5 + 2.5/1 s; the landing
+    # descends 50 m at 1.5 m/s in 50/1.5 + 1.5/1 s
+    assert b.t_arrive_s[1] == pytest.approx(50 / 2.5 + 2.5)
+    assert b.t_arrive_s[-1] - b.t_arrive_s[-2] == pytest.approx(50 / 1.5 + 1.5)
     assert b.eta_bounds_s[0] < b.eta_s < b.eta_bounds_s[1]
     t0 = min(v.time_start.value.datetime for v in b.details.volumes)
     t1 = max(v.time_end.value.datetime for v in b.details.volumes)
@@ -337,6 +344,10 @@ def test_cli_intent_limits_from_log(model, shared_data, tmp_path):
 
     default = run()
     assert (default["climb_ms"], default["descent_ms"], default["limits_from_log"]) == (2.5, 1.5, [])
+    # the 3D elements by kind: the take-off climbs 50 m, the landing descends 50 m
+    assert default["method"] == "lvq" and default["elements"]["leg"]["count"] > 0
+    assert default["elements"]["climb"] == {"count": 1, "time_s": pytest.approx(50 / 2.5 + 2.5)}
+    assert default["elements"]["descent"] == {"count": 1, "time_s": pytest.approx(50 / 1.5 + 1.5)}
     logged = run("--limits-from", log)
     assert (logged["climb_ms"], logged["descent_ms"]) == (4.0, 3.0)
     assert {"climb_ms", "descent_ms"} <= set(logged["limits_from_log"])
@@ -345,3 +356,12 @@ def test_cli_intent_limits_from_log(model, shared_data, tmp_path):
     assert explicit["climb_ms"] == 1.0 and "climb_ms" not in explicit["limits_from_log"]
     r = CliRunner().invoke(main, [*base, "--out", str(tmp_path / "j.json"), "--limits-from", str(plan)])
     assert r.exit_code == 1 and "no autopilot parameters" in r.output
+    # a kinematic model carries its vehicle's vertical limits into the intent
+    from uasnav.trajectory.kinematic import KinematicPredictor
+
+    kin = KinematicPredictor(climb_ms=1.0, descent_ms=0.5).fit(run_phantom4_train())
+    kin.time_bounds_ = model.time_bounds_
+    kin.save(mpath)
+    k = run()
+    assert (k["method"], k["climb_ms"], k["descent_ms"]) == ("kinematic", 1.0, 0.5)
+    assert k["elements"]["climb"]["time_s"] == pytest.approx(50 / 1.0 + 1.0)

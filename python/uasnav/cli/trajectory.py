@@ -49,7 +49,8 @@ def parse_wind(text: str) -> np.ndarray:
 
 @click.group("trajectory")
 def command() -> None:
-    """Trajectory prediction with LVQ networks: element times, ETA and 4D waypoint times."""
+    """Trajectory prediction (kinematic point mass with the autopilot's limits, or the thesis'
+    LVQ networks): element times, ETA, 4D waypoint times, time bounds, operational intents."""
 
 
 _common_opts = [
@@ -82,6 +83,28 @@ def _apply(opts):  # type: ignore[no-untyped-def]
     return deco
 
 
+def _method_option(f):  # type: ignore[no-untyped-def]
+    from uasnav.trajectory.models import DEFAULT_METHOD, METHODS
+
+    return click.option(
+        "--method",
+        type=click.Choice(list(METHODS)),
+        default=DEFAULT_METHOD,
+        show_default=True,
+        help="Predictor: kinematic point mass with the autopilot's limits (most accurate by "
+        "leave-one-run-out on real flights) or the thesis' LVQ network.",
+    )(f)
+
+
+def _limits_source(flights: Sequence[str], lim: AutopilotLimits) -> str:
+    """Which limits came from which log, for the model file."""
+    if not lim.source:
+        return "defaults"
+    logs = [Path(f).name for f in flights if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg")]
+    rest = "" if {"accel_ms2", "climb_ms", "descent_ms"} <= set(lim.source) else "; others defaults"
+    return f"{', '.join(lim.source)} from {logs[0] if logs else 'log'}{rest}"
+
+
 @command.command("train")
 @click.argument("flights", nargs=-1, required=True, type=click.Path())
 @click.option("--out", "out", required=True, type=OutputPath(), help="Model JSON to write.")
@@ -91,14 +114,32 @@ def _apply(opts):  # type: ignore[no-untyped-def]
     "--prototypes", type=click.IntRange(1), default=256, show_default=True, help="Competitive neurons S¹."
 )
 @click.option("--seed", type=SEED, default=0, show_default=True)
+@_method_option
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, prototypes, seed, as_json):  # type: ignore[no-untyped-def]
+def train(
+    flights, out, plan, speed, wind_text, segment, max_gap, algorithm, prototypes, seed, method, as_json
+):  # type: ignore[no-untyped-def]
     """Train a model on the flown elements of FLIGHT... (.tlog, .bin, .ulg, .csv, or element
-    datasets .parquet from `uasnav fleet elements`) and write it."""
+    datasets .parquet from `uasnav fleet elements`) and write it.
+
+    --method kinematic (default: the most accurate by leave-one-run-out on real flights) keeps
+    the logs' autopilot limits (WPNAV_*, MPC_*) and the flights' speed; --method lvq trains the
+    thesis' LVQ network (--algorithm, --prototypes; giving either selects it).
+    """
     from uasnav.trajectory.element_table import training_samples
+    from uasnav.trajectory.kinematic import KinematicPredictor
     from uasnav.trajectory.predictor import TrajectoryPredictor
 
     check_outputs([*flights, plan], {"--out": out})
+    # the LVQ network's own options select it when no method is named
+    src = click.get_current_context().get_parameter_source
+    lvq_opts = [
+        f"--{n}" for n in ("algorithm", "prototypes") if src(n) == click.core.ParameterSource.COMMANDLINE
+    ]
+    if lvq_opts and method != "lvq":
+        if src("method") == click.core.ParameterSource.COMMANDLINE:
+            raise click.UsageError(f"{', '.join(lvq_opts)} apply to --method lvq only")
+        method = "lvq"
     wind = parse_wind(wind_text) if wind_text else None
     from uasnav.trajectory.baselines import class_method_reason
 
@@ -107,27 +148,46 @@ def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, pro
     with warnings_after_success():
         # flight logs and/or element datasets (.parquet, e.g. from `uasnav fleet elements`)
         all_s, n_runs = training_samples(flights, plan, speed, wind, segment, max_gap)
-        why = class_method_reason(all_s.cell, "populated feature cells")
-        with warnings.catch_warnings():
-            # said once below in our words (the rule `evaluate` reports as "not applicable")
-            # instead of scikit-learn's "number of unique classes is greater than 50%"
-            warnings.filterwarnings("ignore", message="The number of unique classes", category=UserWarning)
-            model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
+        why = None
+        model: KinematicPredictor | TrajectoryPredictor
+        if method == "lvq":
+            why = class_method_reason(all_s.cell, "populated feature cells")
+            with warnings.catch_warnings():
+                # said once below in our words (the rule `evaluate` reports as "not applicable")
+                # instead of scikit-learn's "number of unique classes is greater than 50%"
+                warnings.filterwarnings(
+                    "ignore", message="The number of unique classes", category=UserWarning
+                )
+                model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
+        else:
+            lim = _log_limits(flights)
+            model = KinematicPredictor(
+                segment, lim.accel_ms2 or 1.0, lim.climb_ms or 2.5, lim.descent_ms or 1.5,
+                limits_source=_limits_source(flights, lim),
+            ).fit(all_s)  # fmt: skip
     if why is not None:
         click.echo(f"warning: {why}", err=True)
     model.save(out)
     info = {
         "model": out,
+        "method": method,
         "n_runs": n_runs,
         "n_elements": len(all_s),
         "n_classes": int((model.count_table_ > 0).sum()),
         "cruise_ms": model.cruise_ms_,
     }
+    if isinstance(model, KinematicPredictor):
+        info["limits"] = {
+            "accel_ms2": model.accel_ms2,
+            "climb_ms": model.climb_ms,
+            "descent_ms": model.descent_ms,
+            "source": model.limits_source,
+        }
     if as_json:
         echo_json(info)
     else:
         click.echo(
-            f"trained on {info['n_elements']} elements of {info['n_runs']} run(s), "
+            f"trained {method} model on {info['n_elements']} elements of {info['n_runs']} run(s), "
             f"{info['n_classes']} populated classes → {out}"
         )
 
@@ -139,20 +199,33 @@ def train(flights, out, plan, speed, wind_text, segment, max_gap, algorithm, pro
 @click.option("--speed", type=POSITIVE, help="Commanded speed (m/s); default the model's.")
 @click.option("--required", help="4D plan: required time (s from start) at each waypoint, T0,T1,….")
 @click.option("--tolerance", type=NON_NEGATIVE, default=5.0, show_default=True, help="4D time tolerance (s).")
+@click.option(
+    "--route",
+    "route3d",
+    is_flag=True,
+    help="Time the plan's 3D route: take-off, legs, turns, climbs, descents, holds, landing.",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_json):  # type: ignore[no-untyped-def]
+def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3d, as_json):  # type: ignore[no-untyped-def]
     """Per-element times, ETA and 4D waypoint times of PLAN (CSV lat,lon,alt or north,east).
 
     With --required, also checks the 4D plan's feasibility: each waypoint reached within
-    --tolerance of its required time (exit code 0 either way; see "feasible").
+    --tolerance of its required time (exit code 0 either way; see "feasible"). With --route,
+    the plan's whole 3D route (a geodetic mission plan) element by element, each with its kind
+    (leg, turn, climb, descent, hover) and climb rate; vertical limits from a kinematic model.
     """
+    if route3d:
+        if required is not None:
+            raise click.UsageError("--required applies to the horizontal plan, not with --route")
+        _predict_route(model_path, plan_path, wind_text, speed, as_json)
+        return
+    from uasnav.trajectory.models import load_model, method_of
     from uasnav.trajectory.plans import read_plan
-    from uasnav.trajectory.predictor import TrajectoryPredictor
 
     # options first, files second: a typo in an option is reported before any file is read
     wind = parse_wind(wind_text)
     req = parse_float_list(required, "--required") if required else None
-    model = TrajectoryPredictor.load(model_path)
+    model = load_model(model_path)
     plan_ne, _ = read_plan(plan_path)
     p = model.predict(plan_ne, wind, speed)
     feas = None
@@ -160,7 +233,12 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
         feas = model.feasibility(plan_ne, np.array(req), wind, tolerance, speed)
     rows = p.element_rows()
     if as_json:
-        out = {"eta_s": p.eta_s, "waypoint_times_s": p.waypoint_times_s, "elements": rows}
+        out = {
+            "method": method_of(model),
+            "eta_s": p.eta_s,
+            "waypoint_times_s": p.waypoint_times_s,
+            "elements": rows,
+        }
         if feas is not None:
             out["feasible"] = feas.feasible
             out["waypoint_ok"] = feas.ok
@@ -174,8 +252,45 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, as_jso
             f"{r['theta_w_deg']:6.1f} {r['dv_ms']:7.2f} {r['time_s']:7.2f}{mark}"
         )
     click.echo(
-        f"ETA {p.eta_s:.1f} s; waypoint times (s): " + ", ".join(f"{x:.1f}" for x in p.waypoint_times_s)
+        f"ETA {p.eta_s:.1f} s ({method_of(model)} model); waypoint times (s): "
+        + ", ".join(f"{x:.1f}" for x in p.waypoint_times_s)
     )
+
+
+def _predict_route(
+    model_path: str, plan_path: str, wind_text: str, speed: float | None, as_json: bool
+) -> None:
+    """``predict --route``: the 3D elements of a geodetic plan."""
+    from uasnav.io.plans import plan_cruise_speed, read_plan
+    from uasnav.trajectory.models import load_model, method_of
+    from uasnav.trajectory.route3d import predict_route, route_from_plan
+
+    wind = parse_wind(wind_text)
+    model = load_model(model_path)
+    plan = read_plan(plan_path)
+    route = route_from_plan(plan)
+    v = speed or plan_cruise_speed(plan) or model.cruise_ms_
+    p = predict_route(model, route, wind, v)
+    rows = p.elements.rows()
+    if as_json:
+        echo_json(
+            {
+                "method": method_of(model),
+                "eta_s": p.eta_s,
+                "arrive_s": p.t_arrive_s,
+                "depart_s": p.t_depart_s,
+                "elements": rows,
+            }
+        )
+        return
+    click.echo(f"{'#':>3} {'kind':8} {'seg':>4} {'L m':>6} {'dz m':>6} {'climb m/s':>9} {'t s':>7}")
+    for r in rows:
+        mark = "  *low confidence: " + "; ".join(r["flags"]) if r["flags"] else ""
+        click.echo(
+            f"{r['element']:>3} {r['kind']:8} {r['segment']:>4} {r['length_m']:6.1f} {r['dz_m']:6.1f} "
+            f"{r['climb_rate_ms']:9.2f} {r['time_s']:7.2f}{mark}"
+        )
+    click.echo(f"ETA {p.eta_s:.1f} s ({method_of(model)} model, {len(route)} route points)")
 
 
 def _log_limits(flights: Sequence[str]) -> AutopilotLimits:
@@ -247,8 +362,12 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             else {"applicable": False, "reason": e.reason}
             for e in errors
         }
+        from uasnav.trajectory.models import DEFAULT_METHOD
+
         out = {
             "methods": table,
+            # the method `train` fits by default (chosen by this leave-one-run-out measurement)
+            "default_method": {"kinematic": "kinematic point mass", "lvq": "LVQ (thesis)"}[DEFAULT_METHOD],
             "n_runs": len(fs),
             "n_elements": fs.n_elements,
             # the kinematic models' limits: from the logs' parameters, else the stated defaults
@@ -309,14 +428,16 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # type: ignore[no-untyped-def]
-    """Calibrate the time bounds of a model (split-conformal on simulated runs with truth)."""
+    """Calibrate the time bounds of a model (split-conformal on simulated 3D runs with truth:
+    random routes with take-off, sloped legs, holds and landing, scored at every element)."""
     from uasnav.trajectory.calibration import calibrate as fit_bounds
-    from uasnav.trajectory.calibration import covered, simulated_runs
-    from uasnav.trajectory.predictor import TrajectoryPredictor
+    from uasnav.trajectory.calibration import covered
+    from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
+    from uasnav.trajectory.models import load_model, method_of
     from uasnav.trajectory.timebounds import clopper_pearson
 
     check_outputs([model_path], {"--out": out})
-    model = TrajectoryPredictor.load(model_path)
+    model = load_model(model_path)
     with click.progressbar(
         length=runs + test_runs, label="simulated runs", file=click.get_text_stream("stderr")
     ) as bar:
@@ -324,7 +445,13 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
         test = simulated_runs(model, test_runs, seed=2 * seed + 1, progress=lambda i, n: bar.update(1))
     model.time_bounds_ = fit_bounds(cal, source=f"{runs} simulated runs, seed {seed}")
     q = model.time_bounds_.quantile(coverage)
-    res = {"runs": runs, "coverage": coverage, "quantile": q, "tau_s": model.time_bounds_.tau_s}
+    res = {
+        "method": method_of(model),
+        "runs": runs,
+        "coverage": coverage,
+        "quantile": q,
+        "tau_s": model.time_bounds_.tau_s,
+    }
     if test_runs:
         k = sum(covered(model.time_bounds_, r, coverage) for r in test)
         lo, hi = clopper_pearson(k, test_runs)
@@ -334,7 +461,8 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
         echo_json(res)
         return
     click.echo(
-        f"time bounds: ±{q:.3f}·(t + {model.time_bounds_.tau_s:g} s) at {coverage:.0%} coverage, {runs} runs"
+        f"{res['method']} model, time bounds: ±{q:.3f}·(t + {model.time_bounds_.tau_s:g} s) at "
+        f"{coverage:.0%} coverage, {runs} runs"
     )
     if test_runs:
         click.echo(
@@ -385,8 +513,20 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
 )
 @click.option("--home-alt", type=Real(-1000.0, 9000.0), help="Home altitude AMSL (m) if the plan has none.")
 @click.option("--speed", type=POSITIVE, help="Horizontal speed (m/s); default the plan's, else the model's.")
-@click.option("--climb-rate", type=POSITIVE, default=2.5, show_default=True, help="Climb speed (m/s).")
-@click.option("--descent-rate", type=POSITIVE, default=1.5, show_default=True, help="Descent speed (m/s).")
+@click.option(
+    "--climb-rate",
+    type=POSITIVE,
+    default=2.5,
+    show_default=True,
+    help="Climb speed (m/s); a kinematic model's own limit unless given.",
+)
+@click.option(
+    "--descent-rate",
+    type=POSITIVE,
+    default=1.5,
+    show_default=True,
+    help="Descent speed (m/s); a kinematic model's own limit unless given.",
+)
 @click.option(
     "--limits-from",
     "limits_log",
@@ -422,14 +562,14 @@ def intent(  # type: ignore[no-untyped-def]
     from uasnav.io.operational_intent import write_intent, write_intent_geojson
     from uasnav.io.plans import plan_cruise_speed, read_plan
     from uasnav.trajectory.calibration import calibrate as fit_bounds
-    from uasnav.trajectory.calibration import simulated_runs
-    from uasnav.trajectory.predictor import TrajectoryPredictor
+    from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
+    from uasnav.trajectory.models import load_model, method_of
     from uasnav.utm.intent import build_intent
 
     wind = parse_wind(wind_text)
     start = parse_time(start_text, "--start")
     check_outputs([model_path, plan_path], {"--out": out, "--geojson": geojson})
-    model = TrajectoryPredictor.load(model_path)
+    model = load_model(model_path)
     plan = read_plan(plan_path)
     from_log: list[str] = []
     if limits_log:
@@ -448,6 +588,15 @@ def intent(  # type: ignore[no-untyped-def]
             descent_rate, from_log = lim.descent_ms, [*from_log, "descent_ms"]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
+    from uasnav.trajectory.kinematic import KinematicPredictor
+
+    if isinstance(model, KinematicPredictor):
+        # a kinematic model carries the vertical limits of the vehicle it was trained on
+        src = click.get_current_context().get_parameter_source
+        if src("climb_rate") != click.core.ParameterSource.COMMANDLINE and "climb_ms" not in from_log:
+            climb_rate = model.climb_ms
+        if src("descent_rate") != click.core.ParameterSource.COMMANDLINE and "descent_ms" not in from_log:
+            descent_rate = model.descent_ms
     if model.time_bounds_ is None:
         with click.progressbar(
             length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
@@ -474,6 +623,7 @@ def intent(  # type: ignore[no-untyped-def]
             [(float(x), float(y), float(z)) for x, y, z in zip(la, lo, b.route_alt_w84, strict=True)],
         )
     summary = {
+        "method": method_of(model),
         "volumes": len(b.details.volumes),
         "eta_s": b.eta_s,
         "eta_bounds_s": list(b.eta_bounds_s),
@@ -485,6 +635,13 @@ def intent(  # type: ignore[no-untyped-def]
         "descent_ms": descent_rate,
         "limits_from_log": from_log,
     }
+    if b.route_prediction is not None:
+        el = b.route_prediction.elements
+        # the 3D elements by kind: how many, and their predicted time (s)
+        summary["elements"] = {
+            str(k): {"count": int((el.kind == k).sum()), "time_s": float(el.time_s[el.kind == k].sum())}
+            for k in ("leg", "turn", "climb", "descent", "hover")
+        }
     if as_json:
         echo_json(summary)
         return

@@ -6,8 +6,8 @@ a deconfliction example with a resolved conflict.
    :mod:`uasnav.trajectory.calibration`); coverage is then counted on ``n_test`` held-out
    simulated runs (every element boundary at once) with a Clopper–Pearson interval.
 2. **Intent.** A 3D mission (take-off, a survey pattern with a climb and a hold, return and
-   landing) at a fictional site becomes an F3548 intent; the horizontal truth is simulated
-   and checked against the volumes.
+   landing) at a fictional site becomes an F3548 intent; the 3D truth is simulated
+   (:func:`uasnav.trajectory.route_sim.simulate_route`) and checked against the volumes.
 3. **Deconfliction.** A second mission crossing the first departs a little later; the index
    finds the conflict and the smallest departure delay that clears it, and the delayed
    intent is checked conflict-free.
@@ -25,12 +25,20 @@ from datetime import datetime, timedelta, timezone
 
 import numpy as np
 
-from uasnav.io.mission_plan import HomePosition, MissionItem, MissionPlan
+from uasnav.io.mission_plan import HomePosition, MissionItem, MissionPlan, route_points
 from uasnav.io.operational_intent import NamedIntent
-from uasnav.trajectory.calibration import SimulatedRun, calibrate, covered, simulated_runs
+from uasnav.trajectory.calibration import (
+    SimulatedRouteRun,
+    calibrate,
+    covered,
+    simulated_route_runs,
+    simulated_runs,
+)
 from uasnav.trajectory.features import wind_vector
-from uasnav.trajectory.predictor import TrajectoryPredictor
-from uasnav.trajectory.simulator import MultirotorParams, WindModel, simulate_flight
+from uasnav.trajectory.models import Predictor
+from uasnav.trajectory.route3d import Route3D
+from uasnav.trajectory.route_sim import simulate_route
+from uasnav.trajectory.simulator import MultirotorParams, VerticalLimits, WindModel
 from uasnav.trajectory.timebounds import clopper_pearson
 from uasnav.utm.deconflict import Conflict, deconflict
 from uasnav.utm.intent import IntentBuild, build_intent
@@ -80,6 +88,7 @@ class UtmResult:
     conflict: Conflict | None
     conflicts_after_delay: int
     n_volumes: int
+    truth_alt_w84: np.ndarray | None = None
 
 
 def _item(cmd: int, e: float, n: float, alt: float, hold: float = 0.0) -> MissionItem:
@@ -128,16 +137,18 @@ def crossing_mission() -> MissionPlan:
 
 
 def time_bound_coverage(
-    model: TrajectoryPredictor,
+    model: Predictor,
     n_cal: int,
     n_test: int,
     coverage: float = 0.95,
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
-) -> tuple[Coverage, list[SimulatedRun]]:
-    """Calibrate ``model.time_bounds_`` on ``n_cal`` runs and count coverage on ``n_test``."""
-    cal = simulated_runs(model, n_cal, seed=2 * seed + 1, progress=progress)
-    test = simulated_runs(model, n_test, seed=2 * seed + 2)
+) -> tuple[Coverage, list[SimulatedRouteRun]]:
+    """Calibrate ``model.time_bounds_`` on ``n_cal`` simulated 3D runs (take-off, sloped legs,
+    holds, landing: :func:`~uasnav.trajectory.calibration.simulated_route_runs`) and count
+    coverage on ``n_test`` held-out ones."""
+    cal = simulated_route_runs(model, n_cal, seed=2 * seed + 1, progress=progress)
+    test = simulated_route_runs(model, n_test, seed=2 * seed + 2)
     model.time_bounds_ = calibrate(cal, source=f"{n_cal} simulated runs, seed {seed}")
     k = sum(covered(model.time_bounds_, r, coverage) for r in test)
     half = []
@@ -152,7 +163,7 @@ def time_bound_coverage(
 
 
 def real_coverage(
-    model: TrajectoryPredictor, path: str, coverage: float = 0.95, n_cal: int = 200, seed: int = 0
+    model: Predictor, path: str, coverage: float = 0.95, n_cal: int = 200, seed: int = 0
 ) -> tuple[int, int, tuple[float, float]]:
     """Runs of a real telemetry log (with its mission) whose element-boundary times all lie in
     bounds calibrated on ``n_cal`` simulated runs at the log's commanded speed: (k, n,
@@ -198,7 +209,7 @@ def _contained(b: IntentBuild, t: np.ndarray, en: np.ndarray, alt_w84: np.ndarra
 
 
 def run(
-    model: TrajectoryPredictor,
+    model: Predictor,
     seed: int = 0,
     quick: bool = False,
     progress: Callable[[int, int], None] | None = None,
@@ -209,23 +220,19 @@ def run(
     wind = wind_vector(*WIND)
     mission = survey_mission()
     b = build_intent(mission, model, wind, START, geoid_height_m=GEOID_HEIGHT_M)
-    # horizontal truth: the survey flown by the simulator (take-off and landing are vertical)
-    moving = np.concatenate([[True], np.hypot(*np.diff(b.route_en, axis=0).T) > 0.01])
-    route = b.route_en[moving][:, ::-1]
-    tel = simulate_flight(
-        route, params=MultirotorParams(cruise_ms=3.33), wind=WindModel(*WIND), seed=seed, dt=0.05
+    # truth: the survey flown in 3D by the simulator (take-off, legs, the climb, the hold,
+    # return, landing) with the model's vertical limits
+    pts = route_points(mission)
+    route = Route3D(
+        b.route_en[:, ::-1], b.route_alt_w84, np.array([p.hold_s for p in pts]), np.full(len(pts), np.nan)
     )
-    # horizontal flight starts at the top of the climb (route point 1); the simulator has no
-    # holds: its time is shifted by the 10 s hold after its closest approach to waypoint 2
-    hold_at = int(np.hypot(*(tel.pos_ne - route[2]).T).argmin())
-    t_truth = tel.t + float(b.t_arrive_s[1]) + np.where(np.arange(tel.t.size) > hold_at, 10.0, 0.0)
-    truth_en = tel.pos_ne[:, ::-1]
-    # the autopilot follows the planned altitude profile along the route (climb on leg 3)
-    from uasnav.trajectory.geometry import arc_length_along
-
-    z_route = b.route_alt_w84[[1, *np.flatnonzero(moving)[1:].tolist()]]
-    s_route = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(route, axis=0).T))])
-    z_truth = np.interp(arc_length_along(route, tel.pos_ne), s_route, z_route)
+    vl = VerticalLimits(
+        climb_ms=float(getattr(model, "climb_ms", 2.5)), descent_ms=float(getattr(model, "descent_ms", 1.5))
+    )
+    tr = simulate_route(
+        route, params=MultirotorParams(cruise_ms=3.33), wind=WindModel(*WIND), vertical=vl, seed=seed
+    )
+    t_truth, truth_en, z_truth = tr.t, tr.pos_ne[:, ::-1], tr.alt_m
     contained = _contained(b, t_truth, truth_en, z_truth)
     other = crossing_mission()
     ob = build_intent(other, model, wind, START + timedelta(seconds=30), geoid_height_m=GEOID_HEIGHT_M)
@@ -237,7 +244,9 @@ def run(
         v = volume_arrays(intents)
         later = v.names.index(conflict.later)
         after = len(deconflict(v.shifted(later, conflict.delay_s + 1e-3)).conflicts)
-    return UtmResult(cov, mission, b, truth_en, t_truth, contained, ob, conflict, after, res.n_volumes)
+    return UtmResult(
+        cov, mission, b, truth_en, t_truth, contained, ob, conflict, after, res.n_volumes, z_truth
+    )
 
 
 __all__ = [

@@ -10,7 +10,8 @@ The format follows the extension (:data:`PLAN_READERS`): QGroundControl ``.plan`
 Mission Planner ``.waypoints`` / ``.txt`` (``QGC WPL 110``), uasnav's plan ``.csv``
 (``lat,lon[,alt]`` or ``north,east``), KML (``.kml``: a LineString or Point placemarks) and
 GeoJSON (``.geojson``: a LineString or Points, with an explicit ``altitude_frame``), and the
-plan embedded in a log (``.tlog`` MISSION_ITEM(_INT), ``.bin`` DataFlash CMD). Writers
+plan embedded in a log (``.tlog`` MISSION_ITEM(_INT), ``.bin`` DataFlash CMD, ``.ulg`` PX4
+``navigator_mission_item``). Writers
 are atomic and round-trip their own format item for item (KML and GeoJSON: the positioned
 waypoints only). The model (items, altitude frames, command kinds, home position, speed changes,
 loiter times) is :mod:`uasnav.io.mission_plan`; :func:`plan_route` turns a plan into the
@@ -48,6 +49,7 @@ from uasnav.io.plan_formats.kml import read_kml, write_kml
 from uasnav.io.plan_formats.logs import read_dataflash_plan, read_tlog_plan
 from uasnav.io.plan_formats.qgc import read_qgc_plan, write_qgc_plan
 from uasnav.io.plan_formats.source import MAX_PLAN_BYTES
+from uasnav.io.plan_formats.ulog import read_ulog_plan
 from uasnav.io.plan_formats.wpl import read_wpl, write_wpl
 
 #: Extension → reader.
@@ -60,6 +62,7 @@ PLAN_READERS: dict[str, Callable[[str | os.PathLike[str]], MissionPlan]] = {
     ".geojson": read_geojson,
     ".tlog": read_tlog_plan,
     ".bin": read_dataflash_plan,
+    ".ulg": read_ulog_plan,
 }
 #: Extension → writer.
 PLAN_WRITERS: dict[str, Callable[[MissionPlan, str | os.PathLike[str]], None]] = {

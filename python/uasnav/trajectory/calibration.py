@@ -7,6 +7,12 @@ commanded speed. The prediction uses the run's *nominal* wind (what a planner kn
 forecast), the truth is the simulated flight: the time its arc length along the plan first
 reaches each element boundary. Everything is deterministic from the seed.
 
+3D runs (:func:`simulated_route_runs`, what ``uasnav trajectory calibrate`` and the intents
+use): a random route with a take-off, sloped legs, holds and a landing
+(:func:`random_route`), flown by :func:`uasnav.trajectory.route_sim.simulate_route` with the
+predictor's vertical limits, scored at every 3D element boundary — so the calibrated bounds
+cover climbs, descents and hovers as well as the horizontal elements.
+
 The simulator steps at ``dt`` = 0.05 s here (the experiments use 0.02 s): calibration needs
 hundreds of runs, and the timing difference between the two steps (a few tenths of a percent)
 is far below the spread the bounds cover.
@@ -14,16 +20,25 @@ is far below the spread the bounds cover.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from uasnav.trajectory.features import wind_vector
 from uasnav.trajectory.geometry import arc_length_along
-from uasnav.trajectory.predictor import PlanPrediction, TrajectoryPredictor
+from uasnav.trajectory.models import Predictor
+from uasnav.trajectory.predictor import PlanPrediction
+from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route
+from uasnav.trajectory.route_sim import RouteTruth, simulate_route
 from uasnav.trajectory.samples import crossing_times
-from uasnav.trajectory.simulator import MultirotorParams, Telemetry, WindModel, simulate_flight
+from uasnav.trajectory.simulator import (
+    MultirotorParams,
+    Telemetry,
+    VerticalLimits,
+    WindModel,
+    simulate_flight,
+)
 from uasnav.trajectory.timebounds import DEFAULT_TAU_S, TimeBounds, score, widening
 
 #: Simulator step of the calibration runs, s.
@@ -66,7 +81,7 @@ def random_plan(rng: np.random.Generator) -> np.ndarray:
     return np.array(pts)
 
 
-def simulate_run(predictor: TrajectoryPredictor, seed: int, cruise_ms: float | None = None) -> SimulatedRun:
+def simulate_run(predictor: Predictor, seed: int, cruise_ms: float | None = None) -> SimulatedRun:
     """One simulated run with its prediction (see module), at ``cruise_ms`` (default the
     model's speed): calibrate at the speed the missions will fly."""
     v = predictor.cruise_ms_ if cruise_ms is None else float(cruise_ms)
@@ -96,7 +111,7 @@ def simulate_run(predictor: TrajectoryPredictor, seed: int, cruise_ms: float | N
 
 
 def simulated_runs(
-    predictor: TrajectoryPredictor,
+    predictor: Predictor,
     n_runs: int,
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
@@ -111,13 +126,121 @@ def simulated_runs(
     return out
 
 
-def calibrate(runs: list[SimulatedRun], tau_s: float = DEFAULT_TAU_S, source: str = "") -> TimeBounds:
+@dataclass(frozen=True)
+class SimulatedRouteRun:
+    """One 3D run: a random route (take-off, sloped legs, holds, landing), its prediction and
+    the truth at every element boundary (:mod:`uasnav.trajectory.route3d`).
+
+    Attributes
+    ----------
+    route : Route3D
+    wind_ne : ndarray, shape (2,) — nominal wind (m/s, toward).
+    prediction : RoutePrediction
+    t_pred_s, t_true_s, widening_s : ndarray, shape (m + 1,)
+        Predicted and true times (s) at the start and at each element's end, widening w (s).
+    truth : RouteTruth — the simulated flight.
+    """
+
+    route: Route3D
+    wind_ne: np.ndarray
+    prediction: RoutePrediction
+    t_pred_s: np.ndarray
+    t_true_s: np.ndarray
+    widening_s: np.ndarray
+    truth: RouteTruth
+
+
+def random_route(rng: np.random.Generator) -> Route3D:
+    """A random 3D route (north/east m, altitude m above the take-off point): a vertical
+    take-off to 15–60 m, a :func:`random_plan` whose waypoints change altitude by up to ±15 m
+    (half of them) and are held 3–15 s (one in three), and a vertical landing at the end."""
+    plan = random_plan(rng)
+    h = float(rng.uniform(15.0, 60.0))
+    alt = [h]
+    for _ in range(plan.shape[0] - 1):
+        step = float(rng.uniform(-15.0, 15.0)) if rng.random() < 0.5 else 0.0
+        alt.append(float(np.clip(alt[-1] + step, 10.0, 90.0)))
+    hold = np.where(rng.random(plan.shape[0]) < 1 / 3, rng.uniform(3.0, 15.0, plan.shape[0]), 0.0)
+    hold[0] = 0.0
+    ne = np.vstack([plan[:1], plan, plan[-1:]])
+    return Route3D(ne, np.array([0.0, *alt, 0.0]), np.array([0.0, *hold, 0.0]), np.full(ne.shape[0], np.nan))
+
+
+def simulate_route_run(predictor: Predictor, seed: int, cruise_ms: float | None = None) -> SimulatedRouteRun:
+    """One simulated 3D run (see :class:`SimulatedRouteRun`), at ``cruise_ms`` (default the
+    model's speed) with the predictor's vertical limits (a kinematic model's own, else
+    ArduPilot's defaults) flown by the simulator too."""
+    v = predictor.cruise_ms_ if cruise_ms is None else float(cruise_ms)
+    rng = np.random.default_rng(seed)
+    route = random_route(rng)
+    speed, from_deg = float(rng.uniform(0.0, 8.0)), float(rng.uniform(0.0, 360.0))
+    vl = VerticalLimits(
+        climb_ms=float(getattr(predictor, "climb_ms", 2.5)),
+        descent_ms=float(getattr(predictor, "descent_ms", 1.5)),
+        accel_z_ms2=float(getattr(predictor, "accel_z_ms2", 1.0)),
+    )
+    truth = simulate_route(
+        route,
+        params=MultirotorParams(cruise_ms=v),
+        wind=WindModel(speed_ms=speed, from_deg=from_deg),
+        vertical=vl,
+        seed=int(rng.integers(2**31)),
+        dt=CALIBRATION_DT_S,
+    )
+    w_ne = wind_vector(speed, from_deg)
+    pred = predict_route(predictor, route, w_ne, v)
+    el = pred.elements
+    # the truth at each element's end: crossing times of the horizontal stretches' arc length,
+    # arrival at the top/bottom of a vertical move, departure after a hold
+    stretch_of = {}
+    for i, j, t0, tel in truth.stretches:
+        s_true = arc_length_along(route.ne[i : j + 1], tel.pos_ne)
+        total = float(np.hypot(*np.diff(route.ne[i : j + 1], axis=0).T).sum())
+        for g in range(i, j):
+            stretch_of[g] = (tel, s_true, t0, total)
+    t_true = [0.0]
+    for e in range(len(el)):
+        g = int(el.segment[e])
+        if el.kind[e] in ("leg", "turn"):
+            tel, s_true, t0, total = stretch_of[g]
+            # the vehicle stops at the stretch's end: "reached" within 0.5 m (position noise)
+            target = min(float(el.stretch_s_end_m[e]), total - 0.5)
+            t_true.append(t0 + float(crossing_times(tel.t, s_true, np.array([target]))[0]))
+        elif el.kind[e] == "hover":
+            t_true.append(float(truth.t_reached_s[g] + route.hold_s[g]))
+        else:
+            t_true.append(float(truth.t_reached_s[g + 1]))
+    t_pred = np.concatenate([[0.0], np.cumsum(el.time_s)])
+    return SimulatedRouteRun(
+        route, w_ne, pred, t_pred, np.array(t_true), widening(el.time_s, el.flagged), truth
+    )
+
+
+def simulated_route_runs(
+    predictor: Predictor,
+    n_runs: int,
+    seed: int = 0,
+    progress: Callable[[int, int], None] | None = None,
+    cruise_ms: float | None = None,
+) -> list[SimulatedRouteRun]:
+    """``n_runs`` 3D runs, run i from seed ``seed·100003 + i``."""
+    out = []
+    for i in range(n_runs):
+        out.append(simulate_route_run(predictor, seed * 100_003 + i, cruise_ms))
+        if progress is not None:
+            progress(i + 1, n_runs)
+    return out
+
+
+def calibrate(
+    runs: Sequence[SimulatedRun | SimulatedRouteRun], tau_s: float = DEFAULT_TAU_S, source: str = ""
+) -> TimeBounds:
     """Time bounds from calibration runs (one score per run)."""
     scores = np.array([score(r.t_true_s, r.t_pred_s, r.widening_s, tau_s) for r in runs])
     return TimeBounds(scores, tau_s, source or f"{len(runs)} simulated runs")
 
 
-def covered(bounds: TimeBounds, run: SimulatedRun, coverage: float) -> bool:
+def covered(bounds: TimeBounds, run: SimulatedRun | SimulatedRouteRun, coverage: float) -> bool:
     """Whether the run's true times lie within the bounds at every element boundary."""
     lo, hi = bounds.band(run.t_pred_s, run.widening_s, coverage)
     return bool(np.all((run.t_true_s >= lo) & (run.t_true_s <= hi)))
@@ -125,10 +248,14 @@ def covered(bounds: TimeBounds, run: SimulatedRun, coverage: float) -> bool:
 
 __all__ = [
     "CALIBRATION_DT_S",
+    "SimulatedRouteRun",
     "SimulatedRun",
     "calibrate",
     "covered",
     "random_plan",
+    "random_route",
+    "simulate_route_run",
     "simulate_run",
+    "simulated_route_runs",
     "simulated_runs",
 ]

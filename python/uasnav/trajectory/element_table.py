@@ -19,7 +19,12 @@ t_real_s        float64   measured time (s)
 v_init_ms       float64   measured entry speed (m/s)
 v_ref_ms        float64   commanded (cruise) speed (m/s)
 dv_ms           float64   ΔV = L/t − V_ref (m/s)
+element_kind    string    3D element kind (:data:`uasnav.trajectory.route3d.ELEMENT_KINDS`):
+                          ``leg`` or ``turn`` for the measured horizontal elements
+climb_rate_ms   float64   measured climb rate Δaltitude / t (m/s, up; NaN without altitude)
 =============== ========= ==============================================================
+
+The last two columns are optional when reading (tables written before they existed).
 
 :func:`to_rows` / :func:`from_table` convert both ways exactly (float64 throughout);
 :func:`read_element_dataset` reads a Parquet file or dataset directory of such rows (e.g. the
@@ -56,8 +61,12 @@ ELEMENT_SCHEMA = pa.schema(
         pa.field("v_init_ms", pa.float64()),
         pa.field("v_ref_ms", pa.float64()),
         pa.field("dv_ms", pa.float64()),
+        pa.field("element_kind", pa.string()),
+        pa.field("climb_rate_ms", pa.float64()),
     ]
 )
+#: Columns a table may lack (written before they existed).
+OPTIONAL_COLUMNS = ("element_kind", "climb_rate_ms")
 
 
 def to_rows(samples: ElementSamples, segment_m: float) -> list[dict[str, Any]]:
@@ -69,6 +78,11 @@ def to_rows(samples: ElementSamples, segment_m: float) -> list[dict[str, Any]]:
         "length_m": samples.length_m, "t_real_s": samples.t_real_s, "v_init_ms": samples.v_init_ms,
         "v_ref_ms": samples.v_ref_ms, "dv_ms": samples.dv_ms,
     }  # fmt: skip
+    # 3D element kind of the horizontal elements: corners are turns (geometry.KINDS index 0)
+    cols["element_kind"] = np.where(f.kind == 0, "turn", "leg")
+    cols["climb_rate_ms"] = (
+        np.full(len(samples), np.nan) if samples.climb_rate_ms is None else samples.climb_rate_ms
+    )
     lists = {k: np.asarray(v).tolist() for k, v in cols.items()}
     return [{"segment_m": float(segment_m), **{k: lists[k][i] for k in lists}} for i in range(len(samples))]
 
@@ -82,7 +96,7 @@ def from_table(table: pa.Table, run_key: Sequence[str] = ("run",)) -> tuple[Elem
     InputError
         Missing columns, no rows, or elements cut with different segment lengths.
     """
-    missing = [n for n in ELEMENT_SCHEMA.names if n not in table.column_names]
+    missing = [n for n in ELEMENT_SCHEMA.names if n not in table.column_names and n not in OPTIONAL_COLUMNS]
     if missing:
         raise InputError(f"element table: missing column(s) {', '.join(missing)}")
     if table.num_rows == 0:
@@ -108,6 +122,7 @@ def from_table(table: pa.Table, run_key: Sequence[str] = ("run",)) -> tuple[Elem
         dv_ms=col("dv_ms"),
         flight=flight,
         element=col("element", int),
+        climb_rate_ms=col("climb_rate_ms") if "climb_rate_ms" in table.column_names else None,
     )
     return samples, float(seg[0])
 
@@ -170,7 +185,7 @@ def training_samples(
     """
     from uasnav.trajectory.flights import flight_samples
 
-    logs = [x for x in inputs if not is_element_dataset(x)]
+    logs = [os.fspath(x) for x in inputs if not is_element_dataset(x)]
     parts: list[ElementSamples] = []
     n_runs = 0
     if logs:

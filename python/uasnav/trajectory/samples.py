@@ -41,6 +41,9 @@ class ElementSamples:
         Flight index.
     element : ndarray of int, shape (m,)
         Element index within its plan.
+    climb_rate_ms : ndarray, shape (m,), or None
+        Measured climb rate over the element, Δaltitude / t_real (m/s, up; NaN where the
+        flight had no altitude); None if no flight had one.
     """
 
     features: Features
@@ -51,6 +54,7 @@ class ElementSamples:
     dv_ms: np.ndarray
     flight: np.ndarray
     element: np.ndarray
+    climb_rate_ms: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.length_m.size)
@@ -74,6 +78,7 @@ class ElementSamples:
             dv_ms=self.dv_ms[mask],
             flight=self.flight[mask],
             element=self.element[mask],
+            climb_rate_ms=None if self.climb_rate_ms is None else self.climb_rate_ms[mask],
         )
 
     @staticmethod
@@ -100,6 +105,9 @@ class ElementSamples:
             dv_ms=cat(lambda p: p.dv_ms),
             flight=cat(lambda p: p.flight),
             element=cat(lambda p: p.element),
+            climb_rate_ms=None
+            if all(p.climb_rate_ms is None for p in parts)
+            else cat(lambda p: np.full(len(p), np.nan) if p.climb_rate_ms is None else p.climb_rate_ms),
         )
 
 
@@ -130,6 +138,7 @@ def measure_elements(
     flight: int = 0,
     end_tolerance_m: float = 1.0,
     max_gap_s: float = 5.0,
+    alt_m: np.ndarray | None = None,
 ) -> tuple[Elements, ElementSamples]:
     """Cut one flight along ``plan_ne`` into elements and measure each (module notes).
 
@@ -151,6 +160,8 @@ def measure_elements(
     max_gap_s : float
         Telemetry gaps longer than this inside an element make it unmeasurable: such elements
         are dropped (and counted in the raised error if none is left).
+    alt_m : ndarray, shape (k,), optional
+        Altitude (m, up, any fixed reference): each element's climb rate is measured too.
 
     Raises
     ------
@@ -204,6 +215,13 @@ def measure_elements(
     speed = np.hypot(vel[:, 0], vel[:, 1])
     v_init = np.interp(t0, t, speed)
     f = features(el.heading1_deg, el.turn_deg, el.kind, np.asarray(wind_ne, dtype=float))
+    climb = None
+    if alt_m is not None:
+        z = np.asarray(alt_m, dtype=float)
+        if z.shape != t.shape:
+            raise InputError(f"altitude shape {z.shape} differs from the time's {t.shape}")
+        with np.errstate(invalid="ignore", divide="ignore"):
+            climb = np.where(ok, (np.interp(t1, t, z) - np.interp(t0, t, z)) / np.where(ok, dt, 1.0), np.nan)
     idx = np.flatnonzero(ok)
     samples = ElementSamples(
         features=f,
@@ -214,6 +232,7 @@ def measure_elements(
         dv_ms=np.where(ok, length / np.where(ok, dt, 1.0) - cruise_ms, np.nan),
         flight=np.full(length.size, flight, dtype=int),
         element=np.arange(length.size),
+        climb_rate_ms=climb,
     ).subset(idx)
     return el, samples
 

@@ -91,6 +91,30 @@ class Telemetry:
     wind_ne: np.ndarray
     cruise_ms: float
     meta: dict = field(default_factory=dict)
+    #: Altitude (m, up, the plan's vertical frame) and vertical speed (m/s, up) of each sample,
+    #: for a flight with an altitude profile (``alt_m`` given to :func:`simulate_flight`).
+    alt_m: np.ndarray | None = None
+    vz_ms: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class VerticalLimits:
+    """The autopilot's vertical limits (ArduPilot ``WPNAV_SPEED_UP``, ``WPNAV_SPEED_DN``,
+    ``WPNAV_ACCEL_Z``; PX4 ``MPC_Z_VEL_MAX_UP/DN``, ``MPC_ACC_UP/DOWN_MAX``), defaults ArduPilot's.
+
+    Attributes
+    ----------
+    climb_ms, descent_ms : vertical speed limits up / down (> 0), m/s.
+    accel_z_ms2 : vertical acceleration limit, m/s².
+    kp_z_per_s : altitude-error gain of the vertical velocity command, 1/s.
+    tau_z_s : time constant of the vertical velocity loop, s.
+    """
+
+    climb_ms: float = 2.5
+    descent_ms: float = 1.5
+    accel_z_ms2: float = 1.0
+    kp_z_per_s: float = 1.0
+    tau_z_s: float = 0.3
 
 
 def _corner_speed(cruise: float, turn_deg: float) -> float:
@@ -107,11 +131,23 @@ def simulate_flight(
     pos_noise_m: float = 0.05,
     vel_noise_ms: float = 0.03,
     max_time_s: float | None = None,
+    alt_m: np.ndarray | None = None,
+    leg_speed_ms: np.ndarray | None = None,
+    vertical: VerticalLimits | None = None,
 ) -> Telemetry:
     """Fly ``plan_ne`` (north/east m) from rest at its first waypoint to rest at its last.
 
     Returns the telemetry sampled at ``rate_hz``. Raises :class:`InputError` for a bad plan
     and :class:`~uasnav.errors.NumericalError` if the vehicle does not arrive in time.
+
+    With ``alt_m`` (shape (n,), m up) the vehicle also flies the altitude profile, as
+    ArduPilot's waypoint controller does on a sloped leg: the altitude target moves along the
+    leg with the along-track progress, the vertical velocity command (slope × along-track speed
+    plus ``kp_z``·altitude error) is limited to ``vertical.climb_ms``/``descent_ms`` and its
+    change to ``vertical.accel_z_ms2``, and the along-track speed is capped so that the leg's
+    slope never asks for more than the vertical limit. ``leg_speed_ms`` (shape (n − 1,), m/s)
+    sets each leg's commanded speed (``DO_CHANGE_SPEED``; NaN = the cruise speed). Neither
+    draws random numbers: without them a flight is identical to the 2D one.
     """
     from uasnav.errors import NumericalError
 
@@ -125,8 +161,30 @@ def simulate_flight(
     tang = d / seg_len[:, None]
     turns = [0.0] + [float(signed_angle_deg(d[k - 1], d[k])) for k in range(1, n_wp - 1)] + [180.0]
     speed_this_flight = max(wm.speed_ms + rng.normal(0.0, wm.flight_speed_sigma_ms), 0.0)
-    cruise = prm.cruise_ms * float(np.clip(1.0 + rng.normal(0.0, prm.speed_sigma_frac), 0.5, 1.5))
-    v_corner = [_corner_speed(cruise, turns[k]) if k < n_wp - 1 else 0.0 for k in range(n_wp)]
+    scale = float(np.clip(1.0 + rng.normal(0.0, prm.speed_sigma_frac), 0.5, 1.5))
+    cruise = prm.cruise_ms * scale
+    # per-leg commanded speed (the flight's spread applies to every leg)
+    v_leg = np.full(n_wp - 1, cruise)
+    if leg_speed_ms is not None:
+        ls = np.asarray(leg_speed_ms, dtype=float)
+        if ls.shape != (n_wp - 1,) or np.any(ls[np.isfinite(ls)] <= 0):
+            raise InputError(f"leg_speed_ms needs {n_wp - 1} speeds > 0 (NaN = cruise), got {ls}")
+        v_leg = np.where(np.isfinite(ls), ls * scale, cruise)
+    vl = vertical or VerticalLimits()
+    z_wp = None
+    if alt_m is not None:
+        z_wp = np.asarray(alt_m, dtype=float)
+        if z_wp.shape != (n_wp,) or not np.isfinite(z_wp).all():
+            raise InputError(f"alt_m needs {n_wp} finite altitudes, got shape {z_wp.shape}")
+        slope = np.diff(z_wp) / seg_len
+        # the along-track speed at which the leg's slope asks for exactly the vertical limit
+        v_slope = np.where(slope > 0, vl.climb_ms, vl.descent_ms) / np.maximum(np.abs(slope), 1e-12)
+        v_leg = np.minimum(v_leg, v_slope)
+    v_corner = [
+        _corner_speed(min(v_leg[k - 1], v_leg[k]), turns[k]) if 0 < k < n_wp - 1 else 0.0 for k in range(n_wp)
+    ]
+    if leg_speed_ms is None and z_wp is None:
+        v_corner = [_corner_speed(cruise, turns[k]) if k < n_wp - 1 else 0.0 for k in range(n_wp)]
     w_mean = wind_vector(speed_this_flight, wm.from_deg)
     a_max = STANDARD_GRAVITY * np.tan(np.radians(prm.tilt_max_deg))
     total = seg_len.sum()
@@ -139,8 +197,11 @@ def simulate_flight(
     gust = rng.normal(0.0, wm.gust_sigma_ms, 2)
     phi = np.exp(-dt / wm.gust_tau_s)
     k = 0
-    out_t, out_p, out_v = [], [], []
+    out_t, out_p, out_v, out_z, out_vz = [], [], [], [], []
     arrived = False
+    z = float(z_wp[0]) if z_wp is not None else 0.0
+    vz = 0.0
+    vz_cmd_prev = 0.0
     for step in range(n_steps):
         t = step * dt
         a_pt = p_plan[k]
@@ -158,7 +219,7 @@ def simulate_flight(
         elif remaining < 0.05 and np.hypot(*vel) < 0.05:
             arrived = True
         v_lim = np.sqrt(v_corner[k + 1] ** 2 + 2.0 * prm.a_brake_ms2 * max(remaining, 0.0))
-        v_along = min(cruise, v_lim)
+        v_along = min(v_leg[k], v_lim)
         if k == n_wp - 2 and remaining < 0:
             v_along = prm.k_xtrack_per_s * remaining
         v_cmd = v_along * tang[k] - prm.k_xtrack_per_s * cross
@@ -172,14 +233,30 @@ def simulate_flight(
         gust = phi * gust + np.sqrt(1 - phi**2) * wm.gust_sigma_ms * rng.normal(size=2)
         va = vel - (w_mean + gust)
         acc = a_cmd - prm.k_drag_per_m * np.hypot(*va) * va
+        if z_wp is not None:
+            frac = float(np.clip(along / seg_len[k], 0.0, 1.0))
+            z_target = z_wp[k] + frac * (z_wp[k + 1] - z_wp[k])
+            vz_cmd = slope[k] * max(v_along, 0.0) + vl.kp_z_per_s * (z_target - z)
+            vz_cmd = float(np.clip(vz_cmd, -vl.descent_ms, vl.climb_ms))
+            # acceleration-limited command (WPNAV_ACCEL_Z), then a first-order velocity loop
+            dv_max = vl.accel_z_ms2 * dt
+            vz_cmd = float(np.clip(vz_cmd, vz_cmd_prev - dv_max, vz_cmd_prev + dv_max))
+            vz_cmd_prev = vz_cmd
+            if arrived and abs(z_wp[-1] - z) > 0.05:
+                arrived = False  # a stop is a stop in altitude too
         if step % every == 0:
             out_t.append(t)
             out_p.append(pos.copy())
             out_v.append(vel.copy())
+            out_z.append(z)
+            out_vz.append(vz)
             if arrived:
                 break
         vel = vel + acc * dt
         pos = pos + vel * dt
+        if z_wp is not None:
+            vz += (vz_cmd - vz) * dt / vl.tau_z_s
+            z += vz * dt
     if not arrived:
         raise NumericalError(f"simulated vehicle did not reach the last waypoint within {t_end:.0f} s")
     t_arr = np.array(out_t)
@@ -198,6 +275,8 @@ def simulate_flight(
             "wind_from_deg": wm.from_deg,
             "speed_tracked_ms": cruise,
         },
+        alt_m=np.array(out_z) if z_wp is not None else None,
+        vz_ms=np.array(out_vz) if z_wp is not None else None,
     )
 
 
@@ -240,6 +319,7 @@ def phantom4_experiment(
 __all__ = [
     "MultirotorParams",
     "Telemetry",
+    "VerticalLimits",
     "WindModel",
     "phantom4_experiment",
     "phantom4_plans",

@@ -46,6 +46,8 @@ class FlownRun:
         Telemetry time over the run (s).
     pos_ne, vel_ne : ndarray, shape (k, 2)
         Local position (m) and ground velocity (m/s), north and east.
+    alt_m : ndarray, shape (k,), or None
+        Altitude of the telemetry (m, the log's reference).
     """
 
     seqs: list[int]
@@ -54,6 +56,7 @@ class FlownRun:
     t: FloatArray
     pos_ne: FloatArray
     vel_ne: FloatArray
+    alt_m: FloatArray | None = None
 
 
 def flown_runs(log: FlightLog, origin: tuple[float, float, float] | None = None) -> list[FlownRun]:
@@ -93,6 +96,7 @@ def flown_runs(log: FlightLog, origin: tuple[float, float, float] | None = None)
                 t=log.t[sel],
                 pos_ne=pos,
                 vel_ne=log.vel_ned[sel, :2],
+                alt_m=np.asarray(log.alt[sel], dtype=float),
             )
         )
     if not out:
@@ -136,6 +140,7 @@ def run_samples(
             flight=i,
             end_tolerance_m=tol,
             max_gap_s=max_gap_s,
+            alt_m=r.alt_m,
         )
         samples.append(s)
     return runs, samples

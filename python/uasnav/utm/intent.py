@@ -5,12 +5,12 @@ Steps:
 1. The plan's 3D route (:func:`uasnav.io.mission_plan.route_points`): take-off climb, waypoints
    with hold times, landing descent; altitudes converted to WGS-84 ellipsoidal heights
    (:func:`uasnav.utm.altitude.w84_altitudes`).
-2. Times: the horizontal legs by the trajectory predictor (LVQ element times, wind), climbs
-   and descents at the vertical speeds (ArduPilot's defaults ``WPNAV_SPEED_UP`` 2.5 m/s,
-   ``WPNAV_SPEED_DN`` 1.5 m/s), a leg that climbs while it moves taking the longer of the
-   two; holds and loiters added at their points; after a ``DO_CHANGE_SPEED`` the predicted
-   leg times are scaled by (prediction speed ÷ new speed) — first order: the elements' speed
-   changes ΔV stay those predicted at the first speed.
+2. Times: the route's 3D elements by :func:`uasnav.trajectory.route3d.predict_route` —
+   horizontal legs and turns by the trajectory predictor (kinematic point mass by default, or
+   LVQ), climbs and descents with the vertical limits (the kinematic model's own, from the
+   vehicle's log, else ArduPilot's defaults ``WPNAV_SPEED_UP`` 2.5 m/s, ``WPNAV_SPEED_DN``
+   1.5 m/s), a sloped leg no faster than its vertical limit allows, hovers for their hold
+   time, ``DO_CHANGE_SPEED`` legs at their own speed.
 3. Time bounds: the model's calibrated split-conformal band (:mod:`uasnav.trajectory.timebounds`)
    at the requested coverage, widened by the predictor's flagged elements.
 4. Volumes: each leg is cut into pieces of at most ``piece_m`` metres; a piece's volume is the
@@ -38,8 +38,9 @@ import numpy as np
 from uasnav.errors import InputError
 from uasnav.io.mission_plan import MissionPlan, RoutePoint, plan_cruise_speed, route_points
 from uasnav.io.operational_intent import parse_details, rfc3339
-from uasnav.trajectory.predictor import TrajectoryPredictor
-from uasnav.trajectory.timebounds import DEFAULT_COVERAGE, widening
+from uasnav.trajectory.models import Predictor
+from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route
+from uasnav.trajectory.timebounds import DEFAULT_COVERAGE
 from uasnav.utm.altitude import w84_altitudes
 
 DEFAULT_LATERAL_BUFFER_M = 15.0
@@ -72,6 +73,8 @@ class IntentBuild:
         ``start``) ranges of each volume.
     coverage : float
     flags : list of list of str — the predictor's flags per horizontal element.
+    route_prediction : RoutePrediction or None — the 3D elements (legs, turns, climbs,
+        descents, hovers) and their times.
     """
 
     details: Any
@@ -89,6 +92,7 @@ class IntentBuild:
     volume_time_s: np.ndarray
     coverage: float
     flags: list[list[str]]
+    route_prediction: RoutePrediction | None = None
 
 
 def _positive(x: float, name: str) -> float:
@@ -99,7 +103,7 @@ def _positive(x: float, name: str) -> float:
 
 def build_intent(
     plan: MissionPlan,
-    predictor: TrajectoryPredictor,
+    predictor: Predictor,
     wind_ne: np.ndarray,
     start: datetime,
     *,
@@ -119,7 +123,7 @@ def build_intent(
     Parameters
     ----------
     plan : MissionPlan
-    predictor : TrajectoryPredictor — fitted, with calibrated ``time_bounds_``.
+    predictor : KinematicPredictor or TrajectoryPredictor — fitted, with calibrated ``time_bounds_``.
     wind_ne : ndarray, shape (2,) — wind velocity (m/s, toward north/east).
     start : datetime — departure, time-zone aware.
     coverage : float — coverage of the time bounds.
@@ -165,46 +169,25 @@ def build_intent(
     lat0, lon0 = float(lat[0]), float(lon[0])
     e, n, _ = pymap3d.geodetic2enu(lat, lon, 0.0, lat0, lon0, 0.0)
     en = np.column_stack([e, n])
-    # horizontal route: points at distinct places
     step = np.hypot(*np.diff(en, axis=0).T)
-    moves = step > SAME_PLACE_M
-    hidx = np.concatenate([[0], np.cumsum(moves)])
-    keep = np.concatenate([[True], moves])
-    route_ne = en[keep][:, ::-1]
-    flags: list[list[str]] = []
     v_ref = float(cruise_ms or plan_cruise_speed(plan) or predictor.cruise_ms_)
-    if route_ne.shape[0] >= 2:
-        pred = predictor.predict(route_ne, np.asarray(wind_ne, dtype=float), v_ref)
-        t_wp = pred.waypoint_times_s
-        el = pred.elements
-        s_knots = np.concatenate([[el.s_start_m[0]], el.s_end_m])
-        s_wp = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(route_ne, axis=0).T))])
-        w_wp = np.interp(s_wp, s_knots, widening(pred.time_s, pred.low_confidence))
-        flags = pred.flags
-    else:
-        t_wp = np.zeros(1)
-        w_wp = np.zeros(1)
-    m = len(pts)
-    t_arr = np.zeros(m)
-    w = w_wp[hidx]
-    # DO_CHANGE_SPEED: the leg into a point flies the latest speed set before that point; the
-    # predicted leg time is scaled by v_ref / v (first-order: the element dynamics stay those of
-    # v_ref), unless the caller fixed the speed (cruise_ms)
-    v_leg = np.full(m, v_ref)
+    # DO_CHANGE_SPEED: the leg into a point flies the latest speed set before that point,
+    # unless the caller fixed the speed (cruise_ms)
+    speeds = np.full(len(pts), np.nan)
     if cruise_ms is None:
-        v = v_ref
+        v = np.nan
         for i, p in enumerate(pts):
             v = p.speed_ms if p.speed_ms is not None and i > 0 else v
-            v_leg[i] = v
-    for i in range(m - 1):
-        th = float(t_wp[hidx[i + 1]] - t_wp[hidx[i]]) * v_ref / v_leg[i + 1]
-        dz = z[i + 1] - z[i]
-        tz = dz / climb_ms if dz > 0 else -dz / descent_ms
-        t_arr[i + 1] = t_arr[i] + pts[i].hold_s + max(th, tz)
-    hold = np.array([p.hold_s for p in pts])
-    t_dep = t_arr + hold
+            speeds[i] = v
+    route = Route3D(en[:, ::-1], z, np.array([p.hold_s for p in pts]), speeds)
+    rp = predict_route(
+        predictor, route, np.asarray(wind_ne, dtype=float), v_ref, climb_ms=climb_ms, descent_ms=descent_ms
+    )
+    flags = [f for f, k in zip(rp.elements.flags, rp.elements.kind, strict=True) if k in ("leg", "turn")]
+    m = len(pts)
+    t_arr, t_dep, w = rp.t_arrive_s, rp.t_depart_s, rp.w_arrive_s
     lo_arr, _ = bounds.band(t_arr, w, coverage)
-    _, hi_dep = bounds.band(t_dep, w, coverage)
+    _, hi_dep = bounds.band(t_dep, rp.w_depart_s, coverage)
     outlines: list[np.ndarray] = []
     alts, times, vols = [], [], []
     for i in range(m - 1):
@@ -257,7 +240,7 @@ def build_intent(
             times.append((t_lo, t_hi))
     details = parse_details({"volumes": vols, "off_nominal_volumes": [], "priority": int(priority)}, "intent")
     eta = float(t_dep[-1])
-    eta_lo, eta_hi = bounds.band(np.array([eta]), w[-1], coverage)
+    eta_lo, eta_hi = bounds.band(np.array([eta]), rp.w_depart_s[-1], coverage)
     return IntentBuild(
         details=details,
         start=start,
@@ -274,6 +257,7 @@ def build_intent(
         volume_time_s=np.array(times).reshape(-1, 2),
         coverage=coverage,
         flags=flags,
+        route_prediction=rp,
     )
 
 

@@ -13,7 +13,7 @@ import functools
 import threading
 import warnings
 
-from uasnav.trajectory.predictor import TrajectoryPredictor
+from uasnav.trajectory.models import DEFAULT_METHOD, Predictor, make_predictor
 from uasnav.trajectory.samples import ElementSamples, measure_elements
 from uasnav.trajectory.simulator import WindModel, phantom4_plans, simulate_flight
 
@@ -29,12 +29,12 @@ SEED = 0
 _LOCK = threading.Lock()
 
 
-def default_model() -> TrajectoryPredictor:
+def default_model() -> Predictor:
     """The built-in model (trained once per process, then cached).
 
     Returns
     -------
-    TrajectoryPredictor
+    KinematicPredictor or TrajectoryPredictor (the default method)
         Fitted on ``len(TRAINING_WINDS) × 2 × FLIGHTS_PER_WIND`` simulated flights; the same
         every time (fixed seeds).
     """
@@ -50,7 +50,7 @@ def clear_cache() -> None:
 
 
 @functools.lru_cache(maxsize=1)
-def _train() -> TrajectoryPredictor:
+def _train() -> Predictor:
     parts = []
     index = 0
     for w, (speed, from_deg) in enumerate(TRAINING_WINDS):
@@ -66,7 +66,8 @@ def _train() -> TrajectoryPredictor:
     with warnings.catch_warnings():
         # few elements per cell is expected of a small simulated set; say nothing per request
         warnings.filterwarnings("ignore", category=UserWarning)
-        return TrajectoryPredictor(random_state=SEED).fit(ElementSamples.concat(parts))
+        # the default method (uasnav.trajectory.models.DEFAULT_METHOD), as `trajectory train`
+        return make_predictor(DEFAULT_METHOD).fit(ElementSamples.concat(parts))
 
 
 __all__ = ["FLIGHTS_PER_WIND", "SEED", "TRAINING_WINDS", "clear_cache", "default_model"]

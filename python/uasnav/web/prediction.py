@@ -24,7 +24,8 @@ import numpy as np
 from uasnav.errors import DataFormatError, InputError, UasnavError
 from uasnav.io.plans import MAX_PLAN_BYTES, PLAN_EXTENSIONS, plan_cruise_speed, plan_route, read_plan
 from uasnav.trajectory.features import wind_vector
-from uasnav.trajectory.predictor import MAX_MODEL_BYTES, Feasibility, TrajectoryPredictor
+from uasnav.trajectory.models import Predictor, load_model
+from uasnav.trajectory.predictor import MAX_MODEL_BYTES, Feasibility
 
 #: Plan formats accepted, by file-name suffix (the readers of :mod:`uasnav.io.plans`):
 #: QGroundControl ``.plan``, Mission Planner ``.waypoints``/``.txt``, uasnav's ``.csv``.
@@ -99,14 +100,14 @@ def read_uploaded_plan(filename: str, data: bytes) -> UploadedPlan:
     return UploadedPlan(np.asarray(route, dtype=float)[:, :2], origin, plan_cruise_speed(plan))
 
 
-def read_uploaded_model(data: bytes) -> TrajectoryPredictor:
+def read_uploaded_model(data: bytes) -> Predictor:
     """Parse an uploaded model JSON with the package's checked loader (``field == "model"``)."""
     if len(data) > MAX_UPLOAD_MODEL_BYTES:
         raise FieldError("model", f"model: file over {MAX_UPLOAD_MODEL_BYTES} bytes")
     with tempfile.TemporaryDirectory(prefix="uasnav-model-") as tmp:
         path = _write_upload(Path(tmp), "model", ".json", data)
         try:
-            return TrajectoryPredictor.load(path)
+            return load_model(path)  # either method (kinematic default, LVQ)
         except UasnavError as e:
             raise FieldError("model", "model: " + str(e).replace(str(path), "model")) from None
 
@@ -176,7 +177,7 @@ def parse_required(text: str, n_waypoints: int) -> np.ndarray:
 
 
 def predict_plan(
-    model: TrajectoryPredictor,
+    model: Predictor,
     plan_ne: np.ndarray,
     origin: tuple[float, float, float] | None,
     wind_speed_ms: float,

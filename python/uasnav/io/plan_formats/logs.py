@@ -11,7 +11,7 @@
   relative to home, except item 0, the home position, which is absolute).
 
 As in ``.waypoints`` files, item 0 with command 16 is ArduPilot's home position (AMSL). PX4
-ULogs keep the mission in the vehicle's dataman, not in the log: not read here.
+ULogs: :mod:`uasnav.io.plan_formats.ulog`.
 """
 
 from __future__ import annotations

@@ -1,0 +1,141 @@
+"""The mission plan embedded in a PX4 ULog (read with pyulog).
+
+PX4 keeps the mission itself in its dataman (on the SD card), not in the log. What a log can
+carry:
+
+- ``navigator_mission_item`` (PX4 ≥ 1.13): each mission item as the navigator makes it the
+  current one — ``sequence_current``, ``nav_cmd`` (MAVLink command), ``latitude``/``longitude``
+  (deg), ``altitude`` (m; relative to home if ``altitude_is_relative``, else AMSL),
+  ``time_inside`` (hold/loiter time, s → param 1), ``acceptance_radius`` (m → param 2),
+  ``loiter_radius`` (m → param 3), ``yaw`` (rad → param 4 in degrees), ``autocontinue``. The
+  last record of each sequence number wins. It is the mission *as flown*: items the vehicle
+  never reached are not in it, and ``DO_*`` items (e.g. ``DO_CHANGE_SPEED``) keep their
+  command but not their parameters (the topic has no fields for them).
+- ``home_position`` (``lat``, ``lon``, ``alt`` AMSL): the plan's home position.
+- ``mission`` (``count``, ``current_seq``, ``dataman_id``) and ``mission_result``
+  (``seq_total``): how many items the mission had, used to say what is missing.
+
+A log without ``navigator_mission_item`` records is refused with what it does hold (an empty
+mission, or a mission of N items the log does not carry).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from uasnav.errors import DataFormatError, InputError
+from uasnav.io.mission_plan import HomePosition, MissionItem, MissionPlan, check_item
+
+#: MAV_FRAME_GLOBAL (AMSL) and MAV_FRAME_GLOBAL_RELATIVE_ALT (relative to home).
+_FRAME_AMSL, _FRAME_RELATIVE, _FRAME_NONE = 0, 3, 2
+_MAV_CMD_NAV_LAST = 95
+_TOPICS = ["navigator_mission_item", "home_position", "mission", "mission_result"]
+
+
+def _topic(ulog: object, name: str) -> dict[str, np.ndarray] | None:
+    for d in getattr(ulog, "data_list", []):
+        if d.name == name and d.multi_id == 0:
+            return d.data  # type: ignore[no-any-return]
+    return None
+
+
+def _need(data: dict[str, np.ndarray], fields: tuple[str, ...], topic: str, source: str) -> None:
+    missing = [f for f in fields if f not in data]
+    if missing:
+        raise DataFormatError(f"ULog topic {topic} lacks field(s) {', '.join(missing)}", path=source)
+
+
+def read_ulog_plan(path: str | os.PathLike[str]) -> MissionPlan:
+    """The mission of a PX4 ULog (see module).
+
+    Raises
+    ------
+    InputError
+        No such file.
+    DataFormatError
+        Not a ULog, no mission items in the log (naming what the log says of its mission), an
+        item with an invalid command, position or altitude.
+    """
+    from pyulog import ULog
+
+    p = Path(path)
+    source = str(p)
+    if not p.is_file():
+        raise InputError(f"{p}: no such file")
+    try:
+        ulog = ULog(source, message_name_filter_list=_TOPICS)
+    except Exception as e:  # pyulog raises bare exceptions on corrupt files
+        raise DataFormatError(f"not a readable ULog ({type(e).__name__}: {e})", path=source) from None
+    nav = _topic(ulog, "navigator_mission_item")
+    if nav is None or nav["timestamp"].size == 0:
+        mission = _topic(ulog, "mission")
+        result = _topic(ulog, "mission_result")
+        if mission is not None and "count" in mission and mission["count"].size:
+            n = int(mission["count"][-1])
+            what = (
+                "an empty mission (mission.count = 0)"
+                if n == 0
+                else f"a mission of {n} items (mission.count) but not the items themselves"
+            )
+        elif result is not None and "seq_total" in result and result["seq_total"].size:
+            what = f"a mission of {int(result['seq_total'][-1])} items (mission_result) but not the items"
+        else:
+            what = "no mission topic"
+        raise DataFormatError(
+            f"no navigator_mission_item records: the log holds {what} (PX4 keeps missions in its "
+            "dataman; logs from PX4 ≥ 1.13 carry the items the navigator flew)",
+            path=source,
+        )
+    fields = ("sequence_current", "nav_cmd", "latitude", "longitude", "altitude")
+    _need(nav, fields, "navigator_mission_item", source)
+    last: dict[int, int] = {}
+    for r, seq in enumerate(nav["sequence_current"]):
+        last[int(seq)] = r  # the last record of each sequence number wins
+
+    def get(name: str, r: int, default: float = 0.0) -> float:
+        return float(nav[name][r]) if name in nav else default
+
+    items = []
+    for seq in sorted(last):
+        r = last[seq]
+        relative = bool(nav["altitude_is_relative"][r]) if "altitude_is_relative" in nav else True
+        yaw = get("yaw", r, math.nan)
+        cmd = int(nav["nav_cmd"][r])
+        # MAVLink NAV commands are numbered below 95 (MAV_CMD_NAV_LAST); the others (DO_*,
+        # CONDITION_*) have no position, and this topic does not carry their parameters
+        nav_item = cmd < _MAV_CMD_NAV_LAST
+        pos = (get("latitude", r), get("longitude", r), get("altitude", r)) if nav_item else (math.nan,) * 3
+        it = MissionItem(
+            command=cmd,
+            frame=(_FRAME_RELATIVE if relative else _FRAME_AMSL) if nav_item else _FRAME_NONE,
+            params=(
+                get("time_inside", r),
+                get("acceptance_radius", r),
+                get("loiter_radius", r),
+                math.degrees(yaw) if math.isfinite(yaw) else math.nan,
+            ),
+            lat_deg=pos[0],
+            lon_deg=pos[1],
+            alt_m=pos[2],
+            autocontinue=bool(nav["autocontinue"][r]) if "autocontinue" in nav else True,
+            jump_id=seq,
+        )
+        try:
+            check_item(it, f"navigator_mission_item {seq}")
+        except InputError as e:
+            raise DataFormatError(str(e), path=source) from None
+        items.append(it)
+    home = None
+    hp = _topic(ulog, "home_position")
+    if hp is not None and all(k in hp for k in ("lat", "lon", "alt")) and hp["lat"].size:
+        lat, lon, alt = (float(hp[k][-1]) for k in ("lat", "lon", "alt"))
+        if all(map(math.isfinite, (lat, lon, alt))) and abs(lat) <= 90 and abs(lon) <= 180:
+            home = HomePosition(lat, lon, alt)
+    return MissionPlan(items=tuple(items), home=home, source=source)
+
+
+__all__ = ["read_ulog_plan"]
