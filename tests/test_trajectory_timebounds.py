@@ -194,10 +194,11 @@ def test_cli_intent_then_deconflict(model, runs, shared_data, tmp_path):
     plan = shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan"
     base = ["trajectory", "intent", "--model", str(mpath), "--plan", str(plan), "--wind", "3@45"]
     r = CliRunner().invoke(
-        main, [*base, "--start", "2026-11-24T12:00:00Z", "--out", str(tmp_path / "a.json")]
+        main, [*base, "--start", "2026-11-24T12:00:00Z", "--out", str(tmp_path / "a.json"), "--json"]
     )
     # without --geoid-height: N of the EGM96 grid at each point (tests/test_geoid.py checks the grid)
     assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["geoid"].startswith("EGM96")
     egm = json.loads((tmp_path / "a.json").read_text())
     for name, start in (("a", "2026-11-24T12:00:00Z"), ("b", "2026-11-24T12:01:00Z")):
         r = CliRunner().invoke(
@@ -217,6 +218,7 @@ def test_cli_intent_then_deconflict(model, runs, shared_data, tmp_path):
         )
         assert r.exit_code == 0, r.output
     s = json.loads(r.stdout)
+    assert s["geoid"] == "given"
     assert s["eta_bounds_s"][0] < s["eta_s"] < s["eta_bounds_s"][1] and len(s["waypoint_bounds_s"]) == len(
         s["waypoint_times_s"]
     )

@@ -565,6 +565,7 @@ def intent(  # type: ignore[no-untyped-def]
     from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
     from uasnav.utm.intent import build_intent
+    from uasnav.utm.altitude import geoid_model
 
     wind = parse_wind(wind_text)
     start = parse_time(start_text, "--start")
@@ -634,6 +635,8 @@ def intent(  # type: ignore[no-untyped-def]
         "climb_ms": climb_rate,
         "descent_ms": descent_rate,
         "limits_from_log": from_log,
+        # where the W84 altitudes' geoid heights came from: the user's N, or the installed model
+        "geoid": "given" if geoid_height is not None else geoid_model(),
     }
     if b.route_prediction is not None:
         el = b.route_prediction.elements
