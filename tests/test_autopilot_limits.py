@@ -35,7 +35,8 @@ def test_ardupilot_limits_are_the_logged_parameters_in_si(shared_data, rel, kind
     assert lim.accel_ms2 == pytest.approx(ref["WPNAV_ACCEL"] / 100)
     assert lim.climb_ms == pytest.approx(ref["WPNAV_SPEED_UP"] / 100)
     assert lim.descent_ms == pytest.approx(ref["WPNAV_SPEED_DN"] / 100)
-    assert set(lim.source) == {"cruise_ms", "accel_ms2", "climb_ms", "descent_ms"}
+    assert lim.accel_z_ms2 == pytest.approx(ref["WPNAV_ACCEL_Z"] / 100)
+    assert set(lim.source) == {"cruise_ms", "accel_ms2", "climb_ms", "descent_ms", "accel_z_ms2"}
 
 
 def test_px4_limits_from_ulog_header(shared_data):
@@ -51,7 +52,11 @@ def test_px4_limits_from_ulog_header(shared_data):
         assert lim.climb_ms == pytest.approx(ref["MPC_Z_VEL_MAX_UP"])
         assert lim.descent_ms == pytest.approx(ref["MPC_Z_VEL_MAX_DN"])
     # the small log carries both: MPC_ACC_HOR (3 m/s²) wins over MPC_ACC_HOR_MAX (2 m/s²)
-    assert read_autopilot_limits(shared_data / "logs" / "px4_sample_log_small.ulg").accel_ms2 == 3.0
+    small = read_autopilot_limits(shared_data / "logs" / "px4_sample_log_small.ulg")
+    assert small.accel_ms2 == 3.0
+    # vertical: MPC_ACC_UP_MAX (4 m/s²) wins over MPC_ACC_DOWN_MAX (3 m/s²); the other log has neither
+    assert small.accel_z_ms2 == 4.0
+    assert read_autopilot_limits(shared_data / "logs" / "px4_sample.ulg").accel_z_ms2 is None
 
 
 def test_bad_files_are_refused(tmp_path):

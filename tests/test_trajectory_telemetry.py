@@ -70,6 +70,10 @@ def test_cli_train_predict_evaluate(shared_data, tmp_path):
     r = CliRunner().invoke(main, ["trajectory", "train", str(shared_data / TLOG), "--out", str(model)])
     assert r.exit_code == 0, r.output
     assert "25 elements of 5 run(s)" in r.output
+    # every limit of the kinematic default comes from the log's parameters (WPNAV_ACCEL_Z included)
+    params = json.loads(model.read_text())["params"]
+    assert params["accel_z_ms2"] == pytest.approx(1.0) and "accel_z_ms2" in params["limits_source"]
+    assert "defaults" not in params["limits_source"]
     plan = tmp_path / "plan.csv"
     plan.write_text("north,east\n0,0\n0,40\n40,40\n")
     r = CliRunner().invoke(

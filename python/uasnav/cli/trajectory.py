@@ -101,7 +101,8 @@ def _limits_source(flights: Sequence[str], lim: AutopilotLimits) -> str:
     if not lim.source:
         return "defaults"
     logs = [Path(f).name for f in flights if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg")]
-    rest = "" if {"accel_ms2", "climb_ms", "descent_ms"} <= set(lim.source) else "; others defaults"
+    kinematic = {"accel_ms2", "climb_ms", "descent_ms", "accel_z_ms2"}
+    rest = "" if kinematic <= set(lim.source) else "; others defaults"
     return f"{', '.join(lim.source)} from {logs[0] if logs else 'log'}{rest}"
 
 
@@ -163,7 +164,7 @@ def train(
             lim = _log_limits(flights)
             model = KinematicPredictor(
                 segment, lim.accel_ms2 or 1.0, lim.climb_ms or 2.5, lim.descent_ms or 1.5,
-                limits_source=_limits_source(flights, lim),
+                accel_z_ms2=lim.accel_z_ms2 or 1.0, limits_source=_limits_source(flights, lim),
             ).fit(all_s)  # fmt: skip
     if why is not None:
         click.echo(f"warning: {why}", err=True)
@@ -181,6 +182,7 @@ def train(
             "accel_ms2": model.accel_ms2,
             "climb_ms": model.climb_ms,
             "descent_ms": model.descent_ms,
+            "accel_z_ms2": model.accel_z_ms2,
             "source": model.limits_source,
         }
     if as_json:
@@ -564,8 +566,8 @@ def intent(  # type: ignore[no-untyped-def]
     from uasnav.trajectory.calibration import calibrate as fit_bounds
     from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
-    from uasnav.utm.intent import build_intent
     from uasnav.utm.altitude import geoid_model
+    from uasnav.utm.intent import build_intent
 
     wind = parse_wind(wind_text)
     start = parse_time(start_text, "--start")

@@ -11,6 +11,7 @@ cruise        ``WPNAV_SPEED``              ``MPC_XY_CRUISE``
 horiz. accel  ``WPNAV_ACCEL``              ``MPC_ACC_HOR`` (else ``MPC_ACC_HOR_MAX``)
 climb         ``WPNAV_SPEED_UP``           ``MPC_Z_VEL_MAX_UP``
 descent       ``WPNAV_SPEED_DN``           ``MPC_Z_VEL_MAX_DN``
+vert. accel   ``WPNAV_ACCEL_Z``            ``MPC_ACC_UP_MAX`` (else ``MPC_ACC_DOWN_MAX``)
 ============  ===========================  ================================
 
 A limit the log does not carry (or carries as a non-finite or non-positive value) is ``None``;
@@ -33,6 +34,7 @@ ARDUPILOT_PARAMS: dict[str, tuple[str, float]] = {
     "WPNAV_ACCEL": ("accel_ms2", 0.01),
     "WPNAV_SPEED_UP": ("climb_ms", 0.01),
     "WPNAV_SPEED_DN": ("descent_ms", 0.01),
+    "WPNAV_ACCEL_Z": ("accel_z_ms2", 0.01),
 }
 #: PX4 parameter → (field, factor to SI); earlier names win (MPC_ACC_HOR before _MAX).
 PX4_PARAMS: dict[str, tuple[str, float]] = {
@@ -41,6 +43,9 @@ PX4_PARAMS: dict[str, tuple[str, float]] = {
     "MPC_ACC_HOR_MAX": ("accel_ms2", 1.0),
     "MPC_Z_VEL_MAX_UP": ("climb_ms", 1.0),
     "MPC_Z_VEL_MAX_DN": ("descent_ms", 1.0),
+    # one vertical limit per model: PX4's up-acceleration, its down one only when that is missing
+    "MPC_ACC_UP_MAX": ("accel_z_ms2", 1.0),
+    "MPC_ACC_DOWN_MAX": ("accel_z_ms2", 1.0),
 }
 
 
@@ -56,6 +61,8 @@ class AutopilotLimits:
         Horizontal acceleration limit, m/s².
     climb_ms, descent_ms : float or None
         Vertical speed limits up and down (both > 0), m/s.
+    accel_z_ms2 : float or None
+        Vertical acceleration limit, m/s².
     source : tuple of str
         Names of the fields that came from a log (the others are defaults or unknown).
     """
@@ -64,6 +71,7 @@ class AutopilotLimits:
     accel_ms2: float | None = None
     climb_ms: float | None = None
     descent_ms: float | None = None
+    accel_z_ms2: float | None = None
     source: tuple[str, ...] = ()
 
     def or_defaults(self) -> AutopilotLimits:
@@ -80,8 +88,9 @@ class AutopilotLimits:
 
 #: Limits assumed when a log carries none: the 1 m/s² the kinematic model always used (ArduPilot's
 #: WPNAV_ACCEL default of 100 cm/s² before 4.0), ArduPilot's WPNAV_SPEED_UP/DN defaults of 2.5 and
-#: 1.5 m/s, and its WPNAV_SPEED default of 5 m/s (a plan's own speed overrides it).
-DEFAULT_LIMITS = AutopilotLimits(cruise_ms=5.0, accel_ms2=1.0, climb_ms=2.5, descent_ms=1.5)
+#: 1.5 m/s, its WPNAV_ACCEL_Z default of 1 m/s², and its WPNAV_SPEED default of 5 m/s (a plan's own
+#: speed overrides it).
+DEFAULT_LIMITS = AutopilotLimits(cruise_ms=5.0, accel_ms2=1.0, climb_ms=2.5, descent_ms=1.5, accel_z_ms2=1.0)
 
 
 def _limits(values: dict[str, float], table: dict[str, tuple[str, float]]) -> AutopilotLimits:
