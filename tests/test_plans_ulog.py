@@ -10,8 +10,6 @@ here by a minimal ULog writer following the format specification
 from __future__ import annotations
 
 import math
-import struct
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,11 +18,7 @@ from pyulog import ULog
 from uasnav.errors import DataFormatError
 from uasnav.io.mission_plan import AltitudeFrame, ItemKind, route_points
 from uasnav.io.plans import read_plan
-
-_TYPES = {
-    "uint64_t": "Q", "int32_t": "i", "uint32_t": "I", "uint16_t": "H", "uint8_t": "B", "bool": "?",
-    "float": "f", "double": "d",
-}  # fmt: skip
+from ulog_writer import write_ulog
 
 NAV_ITEM = (
     ("uint64_t", "timestamp"), ("uint32_t", "instance_count"), ("uint16_t", "sequence_current"),
@@ -40,29 +34,6 @@ MISSION = (
     ("uint16_t", "count"),
     ("uint8_t", "dataman_id"),
 )
-
-
-def _msg(kind: bytes, payload: bytes) -> bytes:
-    return struct.pack("<HB", len(payload), kind[0]) + payload
-
-
-def write_ulog(path: Path, topics: dict[str, tuple[tuple[tuple[str, str], ...], list[dict]]]) -> None:
-    """A minimal ULog (version 1): header, one info message, then for each topic its format,
-    one subscription (multi id 0) and its records as data messages (fields packed in order,
-    little-endian, no padding — as the format defines)."""
-    out = bytearray(b"ULog\x01\x12\x35\x01" + struct.pack("<Q", 0))
-    key = b"char[4] ver_sw"
-    out += _msg(b"I", bytes([len(key)]) + key + b"test")
-    for name, (fields, _) in topics.items():
-        fmt = f"{name}:" + "".join(f"{t} {f};" for t, f in fields)
-        out += _msg(b"F", fmt.encode())
-    for msg_id, name in enumerate(topics):
-        out += _msg(b"A", struct.pack("<BH", 0, msg_id) + name.encode())
-    for msg_id, (_, (fields, rows)) in enumerate(topics.items()):
-        pack = "<" + "".join(_TYPES[t] for t, _ in fields)
-        for r in rows:
-            out += _msg(b"D", struct.pack("<H", msg_id) + struct.pack(pack, *(r[f] for _, f in fields)))
-    path.write_bytes(bytes(out))
 
 
 def _item(
