@@ -17,7 +17,7 @@ from uasnav.io.ed269 import Applicability, DailyPeriod, zones_from_json
 from uasnav.io.plans import read_plan, write_plan
 from uasnav.mission import Requirements
 from uasnav.mission.operation import PDRA_SOURCES, derive_operation, eu_scenarios
-from uasnav.mission.request import SELECT_OPTIONS, parse_select_options, run_select
+from uasnav.mission.request import SELECT_OPTIONS, OptionError, parse_select_options, run_select
 from uasnav.mission.zones import check_zones, is_plan_document, parse_area, parse_area_document
 
 UTC = dt.UTC
@@ -133,6 +133,8 @@ def test_prohibited_zone_makes_the_operation_not_authorisable(doc, tmp_path) -> 
     assert res.exit_code == 0, res.output
     out = json.loads(res.output)
     assert out["ranking"] == [] and out["withheld_ranking"], "nothing flyable is presented"
+    # no operation points at a rank of the (empty) ranking
+    assert out["operations"] and all(o["rank"] is None for o in out["operations"])
     auth = out["authorisation"]
     assert auth["authorisable"] is False and auth["verdict"].startswith("not authorisable")
     assert "PROHIBITED zone LSXX" in auth["verdict"] and "military area" in auth["verdict"]
@@ -186,6 +188,16 @@ def test_plan_file_footprint_is_its_route_buffered(doc, tmp_path) -> None:
     assert hits("--area", str(inside)) == ["LSXX"]
     assert hits("--area", str(far)) == []  # default buffer: the 50 m flight height (1:1 rule)
     assert hits("--area", str(far), "--area-buffer", "3000") == ["LSXX"]
+    # the buffer is the user's when given; by default the flight height (here the plan's 80 m,
+    # above --altitude 50); a route has no footprint without one: an explicit 0 is refused, not
+    # silently replaced
+    high = _wpl([(46.2160, 6.1680), (46.2165, 6.1689)], alt=80.0)
+    for given, want in ((None, 80.0), (25.0, 25.0)):
+        got = parse_select_options({"range": 1500, "area": high, "area_buffer": given}).area
+        assert got is not None and got.buffer_m == want, (given, got.buffer_m)
+    with pytest.raises(OptionError, match=r"buffer 0\.0 m") as e:
+        parse_select_options({"range": 1500, "area": high, "area_buffer": 0.0})
+    assert e.value.option == "area"
     # the same route as a QGroundControl .plan, by extension and by content (an upload)
     qgc = tmp_path / "in.plan"
     write_plan(read_plan(inside), qgc)

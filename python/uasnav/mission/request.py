@@ -761,8 +761,10 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
             if is_plan_document(where, content):
                 # A plan's footprint: the route widened by the buffer, by default the flight
                 # height (the 1:1 ground-risk-buffer rule, EASA AMC1 Art. 11 Annex A A.5.2.4).
-                area = parse_area_document(content, where, buffer_m=buffer if buffer else req.altitude_m)
-                if not buffer:
+                # An explicit --area-buffer is the user's (an explicit 0 is refused there).
+                default = req.altitude_m
+                area = parse_area_document(content, where, buffer_m=default if buffer is None else buffer)
+                if buffer is None:
                     # ... by the height the plan itself flies when that is higher.
                     from dataclasses import replace
 

@@ -418,7 +418,8 @@ class OperationChoice:
     feasible_pairs: int
     necessary_equipment: tuple[str, ...]
     best: RankedPair | None
-    #: Rank (1-based) of ``best`` in the selection's ranking, None when beyond ``top``.
+    #: Rank (1-based) of ``best`` in the selection's ranking, None when beyond ``top`` or when
+    #: the ranking is withheld (PROHIBITED zone).
     rank: int | None
 
     def to_dict(self) -> dict:
@@ -769,6 +770,8 @@ def select(
             # Nothing is presented as flyable: the configurations are withheld (kept for an
             # exemption request to the zone authority) and the mission is rejected by zone.
             withheld, ranking = ranking, []
+            # the operations' best configurations are withheld too: no rank in an empty ranking
+            operations = [replace(o, rank=None) for o in operations]
             for h in banned:
                 rejections.append(
                     Rejection(
