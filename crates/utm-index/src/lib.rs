@@ -732,8 +732,9 @@ impl<'a> SpaceTimeIndex<'a> {
                         sc.spawn(move || f(part, k0, k1))
                     })
                     .collect();
+                // a worker that panicked (a bug) re-panics here: never a silently short answer
                 hs.into_iter()
-                    .flat_map(|h| h.join().unwrap_or_default())
+                    .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
                     .collect()
             })
         };
@@ -886,8 +887,9 @@ impl<'a> SpaceTimeIndex<'a> {
                         })
                     })
                     .collect();
+                // a worker that panicked (a bug) re-panics here: never a silently short answer
                 hs.into_iter()
-                    .flat_map(|h| h.join().unwrap_or_default())
+                    .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
                     .collect()
             })
         };
