@@ -382,6 +382,29 @@ def test_uploaded_model_is_used(client, tmp_path) -> None:
     )
     b = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p)})
     assert a.json()["model"] == "uploaded model"
+    # the method is named as `trajectory predict --json` names it: the built-in model is the default
+    from uasnav.trajectory.models import DEFAULT_METHOD, method_of
+
+    assert a.json()["method"] == b.json()["method"] == method_of(m) == DEFAULT_METHOD
+    from uasnav.trajectory.models import make_predictor
+    from uasnav.trajectory.samples import ElementSamples, measure_elements
+    from uasnav.trajectory.simulator import WindModel, simulate_flight
+
+    parts = []
+    for j, plan in enumerate(phantom4_plans().values()):
+        tel = simulate_flight(plan, wind=WindModel(speed_ms=3.0, from_deg=0.0), seed=j)
+        parts.append(
+            measure_elements(
+                tel.plan_ne, tel.t, tel.pos_ne, tel.vel_ne, tel.wind_ne, tel.cruise_ms, flight=j
+            )[1]
+        )
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=UserWarning)  # few samples per class, expected
+        make_predictor("lvq", random_state=0).fit(ElementSamples.concat(parts)).save(path)
+    c = client.post(
+        "/api/trajectory/predict", files={"plan": ("a.csv", p), "model": ("m.json", path.read_bytes())}
+    )
+    assert c.status_code == 200 and c.json()["method"] == "lvq"
     assert a.json()["waypoint_times_s"] == pytest.approx(b.json()["waypoint_times_s"])
 
 

@@ -24,7 +24,7 @@ import numpy as np
 from uasnav.errors import DataFormatError, InputError, UasnavError
 from uasnav.io.plans import MAX_PLAN_BYTES, PLAN_EXTENSIONS, plan_cruise_speed, plan_route, read_plan
 from uasnav.trajectory.features import wind_vector
-from uasnav.trajectory.models import Predictor, load_model
+from uasnav.trajectory.models import Predictor, load_model, method_of
 from uasnav.trajectory.predictor import MAX_MODEL_BYTES, Feasibility
 
 #: Plan formats accepted, by file-name suffix (the readers of :mod:`uasnav.io.plans`):
@@ -138,6 +138,8 @@ class RoutePrediction:
     speed_ms: float
     model: str
     notes: list[str] = field(default_factory=list)
+    #: The model's method ("kinematic" default, "lvq" the thesis' network), as the CLI's ``method``.
+    method: str = ""
     #: 4D plan check (required time per waypoint within a tolerance), if asked for.
     feasibility: Feasibility | None = None
 
@@ -159,6 +161,7 @@ class RoutePrediction:
             "wind": self.wind,
             "speed_ms": self.speed_ms,
             "model": self.model,
+            "method": self.method,
             "low_confidence_elements": [e["element"] for e in self.elements if e["low_confidence"]],
         }
 
@@ -238,6 +241,7 @@ def predict_plan(
         speed_ms=float(model.cruise_ms_ if speed_ms is None else speed_ms),
         model=model_name,
         feasibility=feas,
+        method=method_of(model),
     )
 
 
