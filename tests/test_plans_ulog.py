@@ -109,3 +109,29 @@ def test_ulog_without_mission_items_says_what_it_holds(tmp_path, shared_data):
     junk.write_bytes(b"not a ulog at all")
     with pytest.raises(DataFormatError, match="not a readable ULog"):
         read_plan(junk)
+
+
+def test_ulog_altitude_frame_from_the_frame_field_else_refused(tmp_path):
+    # a log whose topic has no altitude_is_relative: the MAV_FRAME field says the frame
+    no_rel = tuple(f for f in NAV_ITEM if f[1] != "altitude_is_relative")
+    items = [_item(1, 0, 16, 47.0, 8.0, 520.0, rel=False), _item(2, 1, 16, 47.001, 8.0, 30.0, rel=True)]
+    path = tmp_path / "frame.ulg"
+    write_ulog(path, {"navigator_mission_item": (no_rel, items)})
+    plan = read_plan(path)
+    assert [it.altitude_frame for it in plan.items] == [AltitudeFrame.AMSL, AltitudeFrame.RELATIVE]
+    assert [it.frame for it in plan.items] == [0, 3]
+    # a frame that is no global altitude frame (1 = MAV_FRAME_LOCAL_NED) is refused, named
+    local = tmp_path / "local.ulg"
+    write_ulog(local, {"navigator_mission_item": (no_rel, [{**items[0], "frame": 1}])})
+    with pytest.raises(DataFormatError, match=r"navigator_mission_item 0: frame 1 is not a global altitude"):
+        read_plan(local)
+    # neither field: refused, never assumed relative to home
+    neither = tuple(f for f in no_rel if f[1] != "frame")
+    bare = tmp_path / "bare.ulg"
+    write_ulog(bare, {"navigator_mission_item": (neither, items)})
+    with pytest.raises(DataFormatError, match="lacks both altitude_is_relative and frame"):
+        read_plan(bare)
+    # a DO_* item (no position) needs no frame
+    do = tmp_path / "do.ulg"
+    write_ulog(do, {"navigator_mission_item": (neither, [_item(1, 0, 178, 0.0, 0.0, 0.0)])})
+    assert read_plan(do).items[0].altitude_frame == AltitudeFrame.NONE

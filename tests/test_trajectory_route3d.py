@@ -313,3 +313,157 @@ def test_route_from_plan_frames_and_refusals():
         route_from_plan(MissionPlan(items=(wp(0, 30.0, frame=10), wp(100, 30.0, frame=10)), source="t"))
     with pytest.raises(InputError, match="unlimited loiter"):
         route_from_plan(MissionPlan(items=(wp(0, 30.0), wp(100, 30.0, cmd=17)), source="l"))
+
+
+def _slow_vertical_model(**limits):
+    """A kinematic model with its own vertical limits (as a log gives them), time bounds set."""
+    from uasnav.experiments.trajectory import run_phantom4
+    from uasnav.trajectory.kinematic import KinematicPredictor
+
+    m = KinematicPredictor(**limits).fit(run_phantom4(n_flights=2, n_train=1).train)
+    m.time_bounds_ = TimeBounds(np.full(20, 0.05), tau_s=5.0)
+    return m
+
+
+def test_intent_and_cli_route_use_the_models_vertical_limits(shared_data, tmp_path):
+    import json
+
+    from click.testing import CliRunner
+
+    from uasnav.cli import main
+    from uasnav.io.plans import read_plan
+
+    plan_path = shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan"
+    plan = read_plan(plan_path)
+    model = _slow_vertical_model(climb_ms=1.0, descent_ms=0.5, accel_z_ms2=0.5)
+    b = build_intent(plan, model, np.zeros(2), T0, geoid_height_m=N)
+    el = b.route_prediction.elements
+    up, down = el.kind == "climb", el.kind == "descent"
+    assert up.sum() == 1 and down.sum() == 1
+    # the closed form with the model's limits: |Δz|/v + v/a (take-off 50 m: 50/1 + 1/0.5 = 52 s)
+    want_up = float(vertical_time(el.dz_m[up][0], 1.0, 0.5))
+    want_down = float(vertical_time(el.dz_m[down][0], 0.5, 0.5))
+    assert el.dz_m[up][0] == pytest.approx(50.0) and want_up == pytest.approx(52.0)
+    np.testing.assert_allclose([el.time_s[up][0], el.time_s[down][0]], [want_up, want_down])
+    assert b.t_arrive_s[1] == pytest.approx(want_up)
+    # `trajectory predict --route` times the same route the same way
+    mpath = tmp_path / "m.json"
+    model.save(mpath)
+    r = CliRunner().invoke(
+        main,
+        ["trajectory", "predict", "--model", str(mpath), "--plan", str(plan_path), "--wind", "0@0",
+         "--route", "--json"],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    rows = json.loads(r.stdout)["elements"]
+    t_cli = {e["kind"]: e["time_s"] for e in rows if e["kind"] in ("climb", "descent")}
+    assert t_cli == pytest.approx({"climb": want_up, "descent": want_down})
+    # explicit limits still win, in the API and the CLI
+    fast = build_intent(plan, model, np.zeros(2), T0, geoid_height_m=N, climb_ms=2.0, accel_z_ms2=2.0)
+    assert fast.t_arrive_s[1] == pytest.approx(float(vertical_time(50.0, 2.0, 2.0)))
+    base = ["trajectory", "intent", "--model", str(mpath), "--plan", str(plan_path), "--wind", "0@0",
+            "--start", "2026-11-24T12:00:00Z", "--geoid-height", "47.4", "--out", str(tmp_path / "i.json"),
+            "--json"]  # fmt: skip
+    i = CliRunner().invoke(main, base)
+    assert i.exit_code == 0, i.output
+    s = json.loads(i.stdout)
+    assert (s["climb_ms"], s["descent_ms"], s["accel_z_ms2"]) == (1.0, 0.5, 0.5)
+    assert s["elements"]["climb"]["time_s"] == pytest.approx(want_up)
+    # --limits-from: the log's vertical speeds and acceleration (PX4 MPC_Z_VEL_MAX_UP/DN,
+    # MPC_ACC_UP_MAX = 4 m/s²) replace the model's; an explicit --climb-rate beats the log
+    from uasnav.io.autopilot_limits import read_autopilot_limits
+
+    ulg = shared_data / "logs" / "px4_sample_log_small.ulg"
+    lim = read_autopilot_limits(ulg)
+    i = CliRunner().invoke(main, [*base, "--limits-from", str(ulg), "--climb-rate", "3"])
+    assert i.exit_code == 0, i.output
+    s = json.loads(i.stdout)
+    assert (s["climb_ms"], s["descent_ms"], s["accel_z_ms2"]) == (3.0, lim.descent_ms, 4.0)
+    assert {"descent_ms", "accel_z_ms2"} <= set(s["limits_from_log"]) and "climb_ms" not in s[
+        "limits_from_log"
+    ]
+    assert s["elements"]["climb"]["time_s"] == pytest.approx(float(vertical_time(50.0, 3.0, 4.0)))
+
+
+def test_speed_changes_fly_each_leg_at_its_own_speed():
+    from uasnav.experiments.trajectory import run_phantom4
+    from uasnav.trajectory.kinematic import KinematicPredictor
+    from uasnav.trajectory.simulator import MultirotorParams, WindModel
+
+    # a = 1.2 m/s²: between the simulator's tilt-limited acceleration and its 0.8 m/s² braking
+    a = 1.2
+    model = KinematicPredictor(accel_ms2=a).fit(run_phantom4(n_flights=2, n_train=1).train)
+    calm = WindModel(speed_ms=0.0, gust_sigma_ms=0.0, flight_speed_sigma_ms=0.0)
+    line = np.array([[0.0, 0.0], [200.0, 0.0]])
+    for v in (2.0, 5.0, 10.0):
+        # a 200 m leg from rest to rest after DO_CHANGE_SPEED v, predicted with a default of 5 m/s
+        r = Route3D(line, np.zeros(2), np.zeros(2), np.array([np.nan, v]))
+        t = predict_route(model, r, np.zeros(2), 5.0).eta_s
+        assert t == pytest.approx(200.0 / v + v / a, rel=1e-3)  # closed form L/V + V/a
+        sim = np.median(
+            [simulate_route(r, params=MultirotorParams(cruise_ms=5.0), wind=calm, seed=s).t_reached_s[-1]
+             for s in range(3)]
+        )  # fmt: skip
+        # (scaling the 5 m/s time by 5/v, as before, was 19 % short at 10 m/s, 10 % long at 2 m/s)
+        assert abs(t - sim) / sim < 0.06, (v, t, sim)
+    # two straight legs, 200 m at 10 m/s then 200 m at 2 m/s (a = 1 m/s²): accelerate 10 s
+    # (50 m), cruise 102 m (10.2 s), brake to 2 m/s at the change 8 s (48 m), cruise 198 m
+    # (99 s), brake 2 s (2 m) = 129.2 s
+    m1 = KinematicPredictor(accel_ms2=1.0).fit(run_phantom4(n_flights=2, n_train=1).train)
+    two = Route3D(
+        np.array([[0.0, 0], [200, 0], [400, 0]]), np.zeros(3), np.zeros(3), np.array([np.nan, 10, 2])
+    )
+    p = predict_route(m1, two, np.zeros(2), 5.0)
+    assert p.eta_s == pytest.approx(129.2, rel=1e-3)
+    # (the waypoint time is interpolated inside the 10 m element that holds it: ≈ 1 s here)
+    assert p.t_arrive_s[1] == pytest.approx(10 + 10.2 + 8, abs=1.5)
+    # the LVQ keeps its documented approximation: its times scaled by cruise ÷ leg speed
+    from uasnav.trajectory.predictor import TrajectoryPredictor
+
+    lvq = TrajectoryPredictor(random_state=0).fit(run_phantom4(n_flights=2, n_train=1).train)
+    slow = Route3D(line, np.zeros(2), np.zeros(2), np.array([np.nan, 2.5]))
+    base = predict_route(lvq, Route3D.flat(line), np.zeros(2), 5.0).eta_s
+    assert predict_route(lvq, slow, np.zeros(2), 5.0).eta_s == pytest.approx(2.0 * base)
+
+
+def test_amsl_plan_without_home_names_what_is_missing(model, tmp_path):
+    """An all-AMSL plan with a take-off and a landing: the ground points the route adds are
+    relative to home, so without a home altitude the take-off height is unknown — refused
+    naming that, and timed once the home altitude is given (API and ``predict --route
+    --home-alt``)."""
+    import json
+
+    from click.testing import CliRunner
+
+    from uasnav.cli import main
+    from uasnav.io.plans import read_plan, write_plan
+    from uasnav.trajectory.route3d import route_from_plan
+
+    def item(n: float, cmd: int) -> MissionItem:
+        lat, lon, _ = pymap3d.enu2geodetic(0.0, n, 0.0, HOME[0], HOME[1], 0.0)
+        return MissionItem(cmd, 0, params=(0.0,) * 4, lat_deg=float(lat), lon_deg=float(lon), alt_m=450.0)
+
+    path = tmp_path / "amsl.waypoints"
+    write_plan(MissionPlan(items=(item(0, 22), item(100, 16), item(200, 21)), source="a"), path)
+    plan = read_plan(path)
+    assert plan.home is None
+    with pytest.raises(
+        InputError, match=r"altitudes are AMSL but its take-off/landing on the ground is relative"
+    ):
+        route_from_plan(plan)
+    r = route_from_plan(plan, home_amsl_m=400.0)
+    np.testing.assert_allclose(r.alt_m[[0, 1, -1]], [400.0, 450.0, 400.0])
+    mpath = tmp_path / "m.json"
+    model.save(mpath)
+    base = ["trajectory", "predict", "--model", str(mpath), "--plan", str(path), "--wind", "0@0", "--route"]
+    bad = CliRunner().invoke(main, base)
+    assert bad.exit_code == 1 and "take-off/landing on the ground is relative to home" in bad.output
+    assert "mixed" not in bad.output
+    ok = CliRunner().invoke(main, [*base, "--home-alt", "400", "--json"])
+    assert ok.exit_code == 0, ok.output
+    el = json.loads(ok.stdout)["elements"]
+    assert el[0]["kind"] == "climb" and el[0]["dz_m"] == pytest.approx(50.0)
+    assert el[-1]["kind"] == "descent" and el[-1]["dz_m"] == pytest.approx(-50.0)
+    # --home-alt belongs to the 3D route
+    misuse = CliRunner().invoke(main, base[:-1] + ["--home-alt", "400"])
+    assert misuse.exit_code == 2 and "--route" in misuse.output

@@ -207,8 +207,14 @@ def train(
     is_flag=True,
     help="Time the plan's 3D route: take-off, legs, turns, climbs, descents, holds, landing.",
 )
+@click.option(
+    "--home-alt",
+    type=Real(-1000.0, 9000.0),
+    help="With --route: home altitude AMSL (m) if the plan has none and mixes relative and AMSL "
+    "altitudes (an AMSL plan's take-off and landing on the ground are relative to home).",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3d, as_json):  # type: ignore[no-untyped-def]
+def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3d, home_alt, as_json):  # type: ignore[no-untyped-def]
     """Per-element times, ETA and 4D waypoint times of PLAN (CSV lat,lon,alt or north,east).
 
     With --required, also checks the 4D plan's feasibility: each waypoint reached within
@@ -219,8 +225,10 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3
     if route3d:
         if required is not None:
             raise click.UsageError("--required applies to the horizontal plan, not with --route")
-        _predict_route(model_path, plan_path, wind_text, speed, as_json)
+        _predict_route(model_path, plan_path, wind_text, speed, home_alt, as_json)
         return
+    if home_alt is not None:
+        raise click.UsageError("--home-alt applies to the 3D route: give --route too")
     from uasnav.trajectory.models import load_model, method_of
     from uasnav.trajectory.plans import read_plan
 
@@ -260,7 +268,12 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3
 
 
 def _predict_route(
-    model_path: str, plan_path: str, wind_text: str, speed: float | None, as_json: bool
+    model_path: str,
+    plan_path: str,
+    wind_text: str,
+    speed: float | None,
+    home_alt: float | None,
+    as_json: bool,
 ) -> None:
     """``predict --route``: the 3D elements of a geodetic plan."""
     from uasnav.io.plans import plan_cruise_speed, read_plan
@@ -270,7 +283,7 @@ def _predict_route(
     wind = parse_wind(wind_text)
     model = load_model(model_path)
     plan = read_plan(plan_path)
-    route = route_from_plan(plan)
+    route = route_from_plan(plan, home_amsl_m=home_alt)
     v = speed or plan_cruise_speed(plan) or model.cruise_ms_
     p = predict_route(model, route, wind, v)
     rows = p.elements.rows()
@@ -518,24 +531,20 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
 @click.option(
     "--climb-rate",
     type=POSITIVE,
-    default=2.5,
-    show_default=True,
-    help="Climb speed (m/s); a kinematic model's own limit unless given.",
+    help="Climb speed (m/s); default a kinematic model's own limit, else ArduPilot's 2.5.",
 )
 @click.option(
     "--descent-rate",
     type=POSITIVE,
-    default=1.5,
-    show_default=True,
-    help="Descent speed (m/s); a kinematic model's own limit unless given.",
+    help="Descent speed (m/s); default a kinematic model's own limit, else ArduPilot's 1.5.",
 )
 @click.option(
     "--limits-from",
     "limits_log",
     type=click.Path(dir_okay=False),
-    help="Flight log (.tlog .bin .ulg) of the vehicle: its WPNAV_SPEED_UP/DN or MPC_Z_VEL_MAX_UP/DN "
-    "replace the default climb/descent rates, its WPNAV_SPEED or MPC_XY_CRUISE the model's speed "
-    "(explicit options and the plan's own speed win).",
+    help="Flight log (.tlog .bin .ulg) of the vehicle: its WPNAV_SPEED_UP/DN, WPNAV_ACCEL_Z or "
+    "MPC_Z_VEL_MAX_UP/DN, MPC_ACC_UP_MAX replace the model's vertical limits, its WPNAV_SPEED or "
+    "MPC_XY_CRUISE the model's speed (explicit options and the plan's own speed win).",
 )
 @click.option(
     "--priority", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="F3548 priority."
@@ -566,6 +575,7 @@ def intent(  # type: ignore[no-untyped-def]
     from uasnav.trajectory.calibration import calibrate as fit_bounds
     from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
+    from uasnav.trajectory.route3d import vertical_limits
     from uasnav.utm.altitude import geoid_model
     from uasnav.utm.intent import build_intent
 
@@ -574,32 +584,22 @@ def intent(  # type: ignore[no-untyped-def]
     check_outputs([model_path, plan_path], {"--out": out, "--geojson": geojson})
     model = load_model(model_path)
     plan = read_plan(plan_path)
+    # vertical limits: the explicit options, else the log's (--limits-from), else the model's
+    # own (build_intent → route3d.vertical_limits)
+    accel_z: float | None = None
     from_log: list[str] = []
     if limits_log:
         from uasnav.io.autopilot_limits import read_autopilot_limits
 
         lim = read_autopilot_limits(limits_log)
-        ctx = click.get_current_context()
-        explicit = {
-            n
-            for n in ("climb_rate", "descent_rate")
-            if ctx.get_parameter_source(n) == click.core.ParameterSource.COMMANDLINE
-        }
-        if lim.climb_ms is not None and "climb_rate" not in explicit:
+        if lim.climb_ms is not None and climb_rate is None:
             climb_rate, from_log = lim.climb_ms, [*from_log, "climb_ms"]
-        if lim.descent_ms is not None and "descent_rate" not in explicit:
+        if lim.descent_ms is not None and descent_rate is None:
             descent_rate, from_log = lim.descent_ms, [*from_log, "descent_ms"]
+        if lim.accel_z_ms2 is not None:
+            accel_z, from_log = lim.accel_z_ms2, [*from_log, "accel_z_ms2"]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
-    from uasnav.trajectory.kinematic import KinematicPredictor
-
-    if isinstance(model, KinematicPredictor):
-        # a kinematic model carries the vertical limits of the vehicle it was trained on
-        src = click.get_current_context().get_parameter_source
-        if src("climb_rate") != click.core.ParameterSource.COMMANDLINE and "climb_ms" not in from_log:
-            climb_rate = model.climb_ms
-        if src("descent_rate") != click.core.ParameterSource.COMMANDLINE and "descent_ms" not in from_log:
-            descent_rate = model.descent_ms
     if model.time_bounds_ is None:
         with click.progressbar(
             length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
@@ -613,8 +613,10 @@ def intent(  # type: ignore[no-untyped-def]
     b = build_intent(
         plan, model, wind, start, coverage=coverage, lateral_buffer_m=lateral_buffer,
         vertical_buffer_m=vertical_buffer, geoid_height_m=geoid_height, home_amsl_m=home_alt,
-        climb_ms=climb_rate, descent_ms=descent_rate, cruise_ms=speed, priority=priority,
+        climb_ms=climb_rate, descent_ms=descent_rate, accel_z_ms2=accel_z, cruise_ms=speed,
+        priority=priority,
     )  # fmt: skip
+    up, down, a_z = vertical_limits(model, climb_rate, descent_rate, accel_z)
     write_intent(b.details, out)
     if geojson:
         la, lo, _ = pymap3d.enu2geodetic(
@@ -634,8 +636,9 @@ def intent(  # type: ignore[no-untyped-def]
         "waypoint_times_s": b.t_arrive_s,
         "waypoint_bounds_s": [[float(x), float(y)] for x, y in zip(b.t_lo_s, b.t_hi_s, strict=True)],
         "low_confidence_elements": sum(bool(f) for f in b.flags),
-        "climb_ms": climb_rate,
-        "descent_ms": descent_rate,
+        "climb_ms": up,
+        "descent_ms": down,
+        "accel_z_ms2": a_z,
         "limits_from_log": from_log,
         # where the W84 altitudes' geoid heights came from: the user's N, or the installed model
         "geoid": "given" if geoid_height is not None else geoid_model(),

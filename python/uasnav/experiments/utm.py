@@ -36,7 +36,7 @@ from uasnav.trajectory.calibration import (
 )
 from uasnav.trajectory.features import wind_vector
 from uasnav.trajectory.models import Predictor
-from uasnav.trajectory.route3d import Route3D
+from uasnav.trajectory.route3d import Route3D, vertical_limits
 from uasnav.trajectory.route_sim import simulate_route
 from uasnav.trajectory.simulator import MultirotorParams, VerticalLimits, WindModel
 from uasnav.trajectory.timebounds import clopper_pearson
@@ -226,9 +226,9 @@ def run(
     route = Route3D(
         b.route_en[:, ::-1], b.route_alt_w84, np.array([p.hold_s for p in pts]), np.full(len(pts), np.nan)
     )
-    vl = VerticalLimits(
-        climb_ms=float(getattr(model, "climb_ms", 2.5)), descent_ms=float(getattr(model, "descent_ms", 1.5))
-    )
+    # the same vertical limits as the intent's prediction (the model's own, else the defaults)
+    up, down, a_z = vertical_limits(model)
+    vl = VerticalLimits(climb_ms=up, descent_ms=down, accel_z_ms2=a_z)
     tr = simulate_route(
         route, params=MultirotorParams(cruise_ms=3.33), wind=WindModel(*WIND), vertical=vl, seed=seed
     )

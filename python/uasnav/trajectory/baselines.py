@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uasnav.errors import InputError
 from uasnav.trajectory.geometry import plan_length
 from uasnav.trajectory.samples import ElementSamples
 
@@ -79,24 +80,34 @@ def kinematic_times(
     cruise_ms: float,
     accel_ms2: float = 1.0,
     ds_m: float = 0.1,
+    leg_speed_ms: np.ndarray | None = None,
 ) -> np.ndarray:
     """Times (s) to fly arc-length intervals [s_start, s_end] (m) of the plan for a point mass:
-    v(s) = min(V, √(2a s), √(v_k² + 2a|s − s_k|)) around each waypoint k)
-    with corner speed v_k = V·max(cos(θ_k/2), 0.1), 0 at the ends."""
+    v(s) = min(V_g(s), √(v_k² + 2a|s − s_k|) around each waypoint k)
+    with V_g the commanded speed of the leg g holding s (``leg_speed_ms``, shape (n − 1,), m/s,
+    NaN = ``cruise_ms``; default every leg at ``cruise_ms``), corner speed
+    v_k = min(V_{k−1}, V_k)·max(cos(θ_k/2), 0.1) (the simulator's rule), 0 at the ends. A
+    straight leg of length L flown from rest to rest at V takes L/V + V/a (L ≥ V²/a)."""
     p = np.asarray(plan_ne, dtype=float)[:, :2]
     d = np.diff(p, axis=0)
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
     total = plan_length(p)
     s = np.arange(0.0, total + ds_m, ds_m)
     s[-1] = min(s[-1], total)
-    v = np.full(s.shape, float(cruise_ms))
+    v_leg = np.full(d.shape[0], float(cruise_ms))
+    if leg_speed_ms is not None:
+        ls = np.asarray(leg_speed_ms, dtype=float)
+        if ls.shape != v_leg.shape or np.any(ls[np.isfinite(ls)] <= 0) or np.isinf(ls).any():
+            raise InputError(f"leg_speed_ms needs {v_leg.size} speeds > 0 m/s (NaN = cruise), got {ls}")
+        v_leg = np.where(np.isfinite(ls), ls, v_leg)
+    v = v_leg[np.clip(np.searchsorted(cum, s, side="right") - 1, 0, v_leg.size - 1)]
     for k in range(p.shape[0]):
         if k in (0, p.shape[0] - 1):
             vk = 0.0
         else:
             c = d[k - 1] @ d[k] / (np.hypot(*d[k - 1]) * np.hypot(*d[k]))
             theta = np.arccos(np.clip(c, -1.0, 1.0))
-            vk = cruise_ms * max(np.cos(theta / 2.0), 0.1)
+            vk = min(v_leg[k - 1], v_leg[k]) * max(np.cos(theta / 2.0), 0.1)
         v = np.minimum(v, np.sqrt(vk**2 + 2.0 * accel_ms2 * np.abs(s - cum[k])))
     # Time to each grid point: v² is linear in s on every ramp, so each grid interval is flown
     # at constant acceleration and takes exactly 2·Δs / (v₁ + v₂) (exact also from rest, where

@@ -8,7 +8,7 @@ forecast), the truth is the simulated flight: the time its arc length along the 
 reaches each element boundary. Everything is deterministic from the seed.
 
 3D runs (:func:`simulated_route_runs`, what ``uasnav trajectory calibrate`` and the intents
-use): a random route with a take-off, sloped legs, holds and a landing
+use): a random route with a take-off, sloped legs, holds, speed changes and a landing
 (:func:`random_route`), flown by :func:`uasnav.trajectory.route_sim.simulate_route` with the
 predictor's vertical limits, scored at every 3D element boundary — so the calibrated bounds
 cover climbs, descents and hovers as well as the horizontal elements.
@@ -29,7 +29,7 @@ from uasnav.trajectory.features import wind_vector
 from uasnav.trajectory.geometry import arc_length_along
 from uasnav.trajectory.models import Predictor
 from uasnav.trajectory.predictor import PlanPrediction
-from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route
+from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route, vertical_limits
 from uasnav.trajectory.route_sim import RouteTruth, simulate_route
 from uasnav.trajectory.samples import crossing_times
 from uasnav.trajectory.simulator import (
@@ -150,10 +150,12 @@ class SimulatedRouteRun:
     truth: RouteTruth
 
 
-def random_route(rng: np.random.Generator) -> Route3D:
+def random_route(rng: np.random.Generator, cruise_ms: float = MultirotorParams.cruise_ms) -> Route3D:
     """A random 3D route (north/east m, altitude m above the take-off point): a vertical
     take-off to 15–60 m, a :func:`random_plan` whose waypoints change altitude by up to ±15 m
-    (half of them) and are held 3–15 s (one in three), and a vertical landing at the end."""
+    (half of them) and are held 3–15 s (one in three), a ``DO_CHANGE_SPEED`` to 0.5–2 ×
+    ``cruise_ms`` (m/s) before one leg in three, held until the next change (the bounds
+    calibrated on these routes cover speed changes), and a vertical landing at the end."""
     plan = random_plan(rng)
     h = float(rng.uniform(15.0, 60.0))
     alt = [h]
@@ -163,7 +165,14 @@ def random_route(rng: np.random.Generator) -> Route3D:
     hold = np.where(rng.random(plan.shape[0]) < 1 / 3, rng.uniform(3.0, 15.0, plan.shape[0]), 0.0)
     hold[0] = 0.0
     ne = np.vstack([plan[:1], plan, plan[-1:]])
-    return Route3D(ne, np.array([0.0, *alt, 0.0]), np.array([0.0, *hold, 0.0]), np.full(ne.shape[0], np.nan))
+    # the speed of the leg into each plan point: a change before one leg in three, then held
+    speeds, v = [], np.nan
+    for _ in range(plan.shape[0] - 1):
+        if rng.random() < 1 / 3:
+            v = float(cruise_ms * rng.uniform(0.5, 2.0))
+        speeds.append(v)
+    speed = np.array([np.nan, np.nan, *speeds, np.nan])
+    return Route3D(ne, np.array([0.0, *alt, 0.0]), np.array([0.0, *hold, 0.0]), speed)
 
 
 def simulate_route_run(predictor: Predictor, seed: int, cruise_ms: float | None = None) -> SimulatedRouteRun:
@@ -172,13 +181,10 @@ def simulate_route_run(predictor: Predictor, seed: int, cruise_ms: float | None 
     ArduPilot's defaults) flown by the simulator too."""
     v = predictor.cruise_ms_ if cruise_ms is None else float(cruise_ms)
     rng = np.random.default_rng(seed)
-    route = random_route(rng)
+    route = random_route(rng, v)
     speed, from_deg = float(rng.uniform(0.0, 8.0)), float(rng.uniform(0.0, 360.0))
-    vl = VerticalLimits(
-        climb_ms=float(getattr(predictor, "climb_ms", 2.5)),
-        descent_ms=float(getattr(predictor, "descent_ms", 1.5)),
-        accel_z_ms2=float(getattr(predictor, "accel_z_ms2", 1.0)),
-    )
+    up, down, a_z = vertical_limits(predictor)
+    vl = VerticalLimits(climb_ms=up, descent_ms=down, accel_z_ms2=a_z)
     truth = simulate_route(
         route,
         params=MultirotorParams(cruise_ms=v),

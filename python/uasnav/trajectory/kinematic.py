@@ -144,7 +144,11 @@ class KinematicPredictor:
             raise InputError("KinematicPredictor is not fitted: call fit() or load a model")
 
     def predict(
-        self, plan_ne: np.ndarray, wind_ne: np.ndarray, cruise_ms: float | None = None
+        self,
+        plan_ne: np.ndarray,
+        wind_ne: np.ndarray,
+        cruise_ms: float | None = None,
+        leg_speed_ms: np.ndarray | None = None,
     ) -> PlanPrediction:
         """Element times, ETA and waypoint times of a horizontal plan (north/east m).
 
@@ -152,6 +156,9 @@ class KinematicPredictor:
         <uasnav.trajectory.predictor.TrajectoryPredictor.predict>`; ``dv_ms`` holds the speed
         change L/t − V the point mass implies, ``cell_used`` the element's own cell. The wind
         enters only the flags (the point mass flies the commanded ground speed).
+        ``leg_speed_ms`` (shape (n − 1,), m/s, NaN = the cruise speed) gives legs their own
+        commanded speed (``DO_CHANGE_SPEED``): each leg is flown, accelerations and braking
+        included, at its own speed (:func:`~uasnav.trajectory.baselines.kinematic_times`).
         """
         self._check_fitted()
         v_ref = self.cruise_ms_ if cruise_ms is None else float(cruise_ms)
@@ -164,7 +171,9 @@ class KinematicPredictor:
         p = np.asarray(plan_ne, dtype=float)[:, :2]
         # speed-profile grid: 0.1 m, coarser on very long plans (at most 2·10⁵ points)
         ds = max(0.1, float(el.s_end_m[-1]) / 200_000)
-        t = kinematic_times(p, el.s_start_m, el.s_end_m, v_ref, accel_ms2=self.accel_ms2, ds_m=ds)
+        t = kinematic_times(
+            p, el.s_start_m, el.s_end_m, v_ref, accel_ms2=self.accel_ms2, ds_m=ds, leg_speed_ms=leg_speed_ms
+        )
         lo, hi = self.wind_range_ms_
         flags: list[list[str]] = []
         for i in range(len(el)):

@@ -7,8 +7,15 @@ north/east frame with altitudes. :func:`predict_route` times it element by eleme
 * **leg / turn** — the horizontal stretches between stops (the start, the end, a hold, a
   vertical move) are predicted by the trajectory predictor (kinematic point mass by default, or
   the thesis' LVQ), element by element; corner elements are ``turn``, the others ``leg``.
-  After a ``DO_CHANGE_SPEED`` a leg's element times are scaled by (prediction speed ÷ leg
-  speed). A sloped leg (climbing or descending while it moves) cannot be flown faster than
+  After a ``DO_CHANGE_SPEED`` the kinematic model flies each leg at its own speed
+  (accelerating and braking included; corner speeds from the slower of the two legs, as the
+  simulator and ArduPilot's waypoint controller do), so a straight leg of length L from rest to
+  rest at V takes L/V + V/a. The LVQ network has no speed input besides the one commanded
+  speed it predicts a stretch at, so for it a leg's element times are scaled by (prediction
+  speed ÷ leg speed) — an approximation that also scales the acceleration and braking phases,
+  whose true time grows with V instead (for a point mass at a = 1 m/s², scaling the 5 m/s time
+  of a 200 m leg gives 22.5 s at 10 m/s against the true 30 s, 112.5 s at 2 m/s against 102 s).
+  A sloped leg (climbing or descending while it moves) cannot be flown faster than
   its vertical limit allows — ArduPilot's waypoint controller caps the speed along a 3D leg
   so that its vertical part stays within ``WPNAV_SPEED_UP/DN`` — so its time is at least the
   vertical time of its height change.
@@ -113,7 +120,7 @@ def route_from_plan(plan: MissionPlan, home_amsl_m: float | None = None) -> Rout
     Raises :class:`InputError` for altitudes above terrain (no terrain model), mixed frames
     without a home altitude, and unbounded holds (an unlimited loiter, a loiter of N turns).
     """
-    from uasnav.io.mission_plan import AltitudeFrame, route_points
+    from uasnav.io.mission_plan import AltitudeFrame, ItemKind, route_points
     from uasnav.trajectory.geometry import geodetic_to_local
 
     pts = route_points(plan)
@@ -128,7 +135,27 @@ def route_from_plan(plan: MissionPlan, home_amsl_m: float | None = None) -> Rout
     if len(frames) > 1:
         home = home_amsl_m if home_amsl_m is not None else (plan.home.alt_amsl_m if plan.home else None)
         if home is None:
-            raise InputError(f"{plan.source}: relative and AMSL altitudes mixed and no home altitude")
+            # the ground points the route adds (before a take-off, the touch-down of a land or
+            # return) are 0 m relative to home: with AMSL items their height is unknown, and
+            # taking it from the first item would time a take-off climb of 0 m
+            own = {
+                p.frame for p in pts if p.item is not None and p.kind not in (ItemKind.TAKEOFF, ItemKind.LAND)
+            }
+            added = [
+                p
+                for p in pts
+                if p.frame == AltitudeFrame.RELATIVE and p.kind in (ItemKind.TAKEOFF, ItemKind.LAND)
+            ]
+            if own == {AltitudeFrame.AMSL} and added:
+                raise InputError(
+                    f"{plan.source}: the plan's altitudes are AMSL but its take-off/landing on the "
+                    "ground is relative to home, and the plan has no home altitude (give it: "
+                    "--home-alt, m AMSL)"
+                )
+            raise InputError(
+                f"{plan.source}: relative and AMSL altitudes mixed and no home altitude (give it: "
+                "--home-alt, m AMSL)"
+            )
         alt = np.array(
             [a + home if p.frame == AltitudeFrame.RELATIVE else a for a, p in zip(alt, pts, strict=True)]
         )
@@ -230,6 +257,30 @@ def _scaled(t: np.ndarray, t_wp: np.ndarray, f: np.ndarray) -> np.ndarray:
     return spent @ f
 
 
+def vertical_limits(
+    predictor: object,
+    climb_ms: float | None = None,
+    descent_ms: float | None = None,
+    accel_z_ms2: float | None = None,
+) -> tuple[float, float, float]:
+    """The vertical limits (climb m/s, descent m/s, vertical acceleration m/s²) a route is
+    timed with: each given value, else the predictor's own (a kinematic model holds the
+    vehicle's, from its log), else ArduPilot's defaults (``WPNAV_SPEED_UP`` 2.5 m/s,
+    ``WPNAV_SPEED_DN`` 1.5 m/s, ``WPNAV_ACCEL_Z`` 1 m/s²). Raises :class:`InputError` for a
+    limit that is not finite and > 0."""
+    out = []
+    for name, given, attr, default in (
+        ("climb rate", climb_ms, "climb_ms", 2.5),
+        ("descent rate", descent_ms, "descent_ms", 1.5),
+        ("vertical accel", accel_z_ms2, "accel_z_ms2", 1.0),
+    ):
+        x = float(given if given is not None else getattr(predictor, attr, default))
+        if not (math.isfinite(x) and x > 0):
+            raise InputError(f"{name} must be finite and > 0, got {x!r}")
+        out.append(x)
+    return out[0], out[1], out[2]
+
+
 def predict_route(
     predictor: object,
     route: Route3D,
@@ -250,20 +301,15 @@ def predict_route(
     cruise_ms : float, optional — horizontal speed (default the model's).
     climb_ms, descent_ms, accel_z_ms2 : float, optional
         Vertical limits (m/s, m/s²); default the predictor's own (a kinematic model holds the
-        vehicle's), else ArduPilot's defaults 2.5, 1.5, 1.0.
+        vehicle's), else ArduPilot's defaults 2.5, 1.5, 1.0 (:func:`vertical_limits`).
     """
+    from uasnav.trajectory.kinematic import KinematicPredictor
+
     v_ref = float(cruise_ms if cruise_ms is not None else predictor.cruise_ms_)  # type: ignore[attr-defined]
-    up = float(climb_ms if climb_ms is not None else getattr(predictor, "climb_ms", 2.5))
-    down = float(descent_ms if descent_ms is not None else getattr(predictor, "descent_ms", 1.5))
-    a_z = float(accel_z_ms2 if accel_z_ms2 is not None else getattr(predictor, "accel_z_ms2", 1.0))
-    for name, x in (
-        ("cruise speed", v_ref),
-        ("climb rate", up),
-        ("descent rate", down),
-        ("vertical accel", a_z),
-    ):
-        if not (math.isfinite(x) and x > 0):
-            raise InputError(f"{name} must be finite and > 0, got {x!r}")
+    if not (math.isfinite(v_ref) and v_ref > 0):
+        raise InputError(f"cruise speed must be finite and > 0, got {v_ref!r}")
+    up, down, a_z = vertical_limits(predictor, climb_ms, descent_ms, accel_z_ms2)
+    own_speeds = isinstance(predictor, KinematicPredictor)
     n = len(route)
     dh, dz = route.horizontal_m, route.dz_m
     moves = dh > SAME_PLACE_M
@@ -312,12 +358,17 @@ def predict_route(
         j = i + 1
         while j < n - 1 and moves[j] and route.hold_s[j] == 0:
             j += 1
-        pred = predictor.predict(route.ne[i : j + 1], np.asarray(wind_ne, dtype=float), v_ref)  # type: ignore[attr-defined]
+        w = np.asarray(wind_ne, dtype=float)
+        if own_speeds:  # each leg at its own speed (the leg into point g + 1 flies v_leg[g + 1])
+            pred = predictor.predict(route.ne[i : j + 1], w, v_ref, leg_speed_ms=v_leg[i + 1 : j + 1])
+        else:
+            pred = predictor.predict(route.ne[i : j + 1], w, v_ref)  # type: ignore[attr-defined]
         el = pred.elements
         leg = i + np.asarray(el.leg, dtype=int)
-        # unscaled time T(s) along the stretch, then one factor per leg: its own speed (the
-        # leg into point g + 1 flies v_leg[g + 1]) and, for a sloped leg, no faster than the
-        # vertical limit allows; T'(s) = Σ_g f_g · (time spent in leg g before s)
+        # time T(s) along the stretch as predicted, then one factor per leg: the LVQ's speed
+        # scaling (1 for the kinematic model, which flew each leg at its speed) and, for a
+        # sloped leg, no faster than the vertical limit allows;
+        # T'(s) = Σ_g f_g · (time spent in leg g before s)
         s_knots = np.concatenate([[el.s_start_m[0]], el.s_end_m])
         t_knots = np.concatenate([[0.0], np.cumsum(np.asarray(pred.time_s, dtype=float))])
         s_wp = np.concatenate([[0.0], np.cumsum(dh[i:j])])
@@ -325,7 +376,7 @@ def predict_route(
         f = np.empty(j - i)
         for g in range(i, j):
             t_h = float(t_wp0[g - i + 1] - t_wp0[g - i])
-            f[g - i] = v_ref / v_leg[g + 1]
+            f[g - i] = 1.0 if own_speeds else v_ref / v_leg[g + 1]
             if abs(dz[g]) > SAME_HEIGHT_M and t_h > 0:
                 t_v = float(vertical_time(dz[g], up if dz[g] > 0 else down, a_z))
                 f[g - i] = max(f[g - i], t_v / t_h)
@@ -374,5 +425,6 @@ __all__ = [
     "RoutePrediction",
     "predict_route",
     "route_from_plan",
+    "vertical_limits",
     "vertical_time",
 ]

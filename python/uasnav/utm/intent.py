@@ -39,14 +39,12 @@ from uasnav.errors import InputError
 from uasnav.io.mission_plan import MissionPlan, RoutePoint, plan_cruise_speed, route_points
 from uasnav.io.operational_intent import parse_details, rfc3339
 from uasnav.trajectory.models import Predictor
-from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route
+from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route, vertical_limits
 from uasnav.trajectory.timebounds import DEFAULT_COVERAGE
 from uasnav.utm.altitude import w84_altitudes
 
 DEFAULT_LATERAL_BUFFER_M = 15.0
 DEFAULT_VERTICAL_BUFFER_M = 10.0
-DEFAULT_CLIMB_MS = 2.5
-DEFAULT_DESCENT_MS = 1.5
 DEFAULT_PIECE_M = 100.0
 #: Shortest volume, s (a volume must end after it starts).
 MIN_VOLUME_S = 1.0
@@ -112,8 +110,9 @@ def build_intent(
     vertical_buffer_m: float = DEFAULT_VERTICAL_BUFFER_M,
     geoid_height_m: float | None = None,
     home_amsl_m: float | None = None,
-    climb_ms: float = DEFAULT_CLIMB_MS,
-    descent_ms: float = DEFAULT_DESCENT_MS,
+    climb_ms: float | None = None,
+    descent_ms: float | None = None,
+    accel_z_ms2: float | None = None,
     piece_m: float = DEFAULT_PIECE_M,
     cruise_ms: float | None = None,
     priority: int = 0,
@@ -130,7 +129,10 @@ def build_intent(
     lateral_buffer_m, vertical_buffer_m : float — buffers around the path, m.
     geoid_height_m : float — geoid height N at the site, m (W84 = AMSL + N); required.
     home_amsl_m : float, optional — home altitude AMSL, m (default the plan's).
-    climb_ms, descent_ms : float — vertical speeds, m/s.
+    climb_ms, descent_ms, accel_z_ms2 : float, optional
+        Vertical speed (m/s) and acceleration (m/s²) limits; default the predictor's own (a
+        kinematic model's, from the vehicle's log), else ArduPilot's defaults
+        (:func:`uasnav.trajectory.route3d.vertical_limits`).
     piece_m : float — longest piece of a leg per volume, m.
     cruise_ms : float, optional — horizontal speed (default the plan's, else the model's).
     priority : int — F3548 priority.
@@ -145,13 +147,9 @@ def build_intent(
         )
     if start.tzinfo is None:
         raise InputError("start time needs a time zone")
-    for name, x in (
-        ("lateral buffer", lateral_buffer_m),
-        ("climb rate", climb_ms),
-        ("descent rate", descent_ms),
-        ("piece length", piece_m),
-    ):
+    for name, x in (("lateral buffer", lateral_buffer_m), ("piece length", piece_m)):
         _positive(x, name)
+    up, down, a_z = vertical_limits(predictor, climb_ms, descent_ms, accel_z_ms2)
     if not (math.isfinite(vertical_buffer_m) and vertical_buffer_m >= 0):
         raise InputError(f"vertical buffer must be finite and ≥ 0, got {vertical_buffer_m!r}")
     bounds.quantile(coverage)  # refuses a coverage the calibration cannot give
@@ -181,7 +179,13 @@ def build_intent(
             speeds[i] = v
     route = Route3D(en[:, ::-1], z, np.array([p.hold_s for p in pts]), speeds)
     rp = predict_route(
-        predictor, route, np.asarray(wind_ne, dtype=float), v_ref, climb_ms=climb_ms, descent_ms=descent_ms
+        predictor,
+        route,
+        np.asarray(wind_ne, dtype=float),
+        v_ref,
+        climb_ms=up,
+        descent_ms=down,
+        accel_z_ms2=a_z,
     )
     flags = [f for f, k in zip(rp.elements.flags, rp.elements.kind, strict=True) if k in ("leg", "turn")]
     m = len(pts)
@@ -262,8 +266,6 @@ def build_intent(
 
 
 __all__ = [
-    "DEFAULT_CLIMB_MS",
-    "DEFAULT_DESCENT_MS",
     "DEFAULT_LATERAL_BUFFER_M",
     "DEFAULT_PIECE_M",
     "DEFAULT_VERTICAL_BUFFER_M",

@@ -5,7 +5,11 @@ carry:
 
 - ``navigator_mission_item`` (PX4 ≥ 1.13): each mission item as the navigator makes it the
   current one — ``sequence_current``, ``nav_cmd`` (MAVLink command), ``latitude``/``longitude``
-  (deg), ``altitude`` (m; relative to home if ``altitude_is_relative``, else AMSL),
+  (deg; PX4 logs them as float32, a resolution of about 1e-5° ≈ 0.4 m at mid latitudes, so
+  the positions read back are that coarse), ``altitude`` (m; relative to home if
+  ``altitude_is_relative``, else AMSL; a log without that field is read by its ``frame``
+  (MAV_FRAME: 0/5 global = AMSL, 3/6 global-relative, 10/11 above terrain), and one with
+  neither is refused — the frame is never assumed),
   ``time_inside`` (hold/loiter time, s → param 1), ``acceptance_radius`` (m → param 2),
   ``loiter_radius`` (m → param 3), ``yaw`` (rad → param 4 in degrees), ``autocontinue``. The
   last record of each sequence number wins. It is the mission *as flown*: items the vehicle
@@ -28,7 +32,14 @@ from pathlib import Path
 import numpy as np
 
 from uasnav.errors import DataFormatError, InputError
-from uasnav.io.mission_plan import HomePosition, MissionItem, MissionPlan, check_item
+from uasnav.io.mission_plan import (
+    MAV_FRAMES,
+    AltitudeFrame,
+    HomePosition,
+    MissionItem,
+    MissionPlan,
+    check_item,
+)
 
 #: MAV_FRAME_GLOBAL (AMSL) and MAV_FRAME_GLOBAL_RELATIVE_ALT (relative to home).
 _FRAME_AMSL, _FRAME_RELATIVE, _FRAME_NONE = 0, 3, 2
@@ -47,6 +58,28 @@ def _need(data: dict[str, np.ndarray], fields: tuple[str, ...], topic: str, sour
     missing = [f for f in fields if f not in data]
     if missing:
         raise DataFormatError(f"ULog topic {topic} lacks field(s) {', '.join(missing)}", path=source)
+
+
+def _altitude_frame(nav: dict[str, np.ndarray], r: int, seq: int, source: str) -> int:
+    """The MAV_FRAME of record ``r``: ``altitude_is_relative`` (what PX4's navigator flies by),
+    else the ``frame`` field when it is a global frame; refused when neither says it."""
+    if "altitude_is_relative" in nav:
+        return _FRAME_RELATIVE if bool(nav["altitude_is_relative"][r]) else _FRAME_AMSL
+    if "frame" not in nav:
+        raise DataFormatError(
+            "ULog topic navigator_mission_item lacks both altitude_is_relative and frame: the "
+            "altitude frame (relative to home or AMSL) of its items is unknown",
+            path=source,
+        )
+    f = int(nav["frame"][r])
+    if MAV_FRAMES.get(f, AltitudeFrame.NONE) == AltitudeFrame.NONE:
+        raise DataFormatError(
+            f"navigator_mission_item {seq}: frame {f} is not a global altitude frame (MAV_FRAME "
+            "0/5 AMSL, 3/6 relative to home, 10/11 above terrain) and the topic has no "
+            "altitude_is_relative",
+            path=source,
+        )
+    return f
 
 
 def read_ulog_plan(path: str | os.PathLike[str]) -> MissionPlan:
@@ -102,16 +135,16 @@ def read_ulog_plan(path: str | os.PathLike[str]) -> MissionPlan:
     items = []
     for seq in sorted(last):
         r = last[seq]
-        relative = bool(nav["altitude_is_relative"][r]) if "altitude_is_relative" in nav else True
         yaw = get("yaw", r, math.nan)
         cmd = int(nav["nav_cmd"][r])
         # MAVLink NAV commands are numbered below 95 (MAV_CMD_NAV_LAST); the others (DO_*,
         # CONDITION_*) have no position, and this topic does not carry their parameters
         nav_item = cmd < _MAV_CMD_NAV_LAST
+        frame = _altitude_frame(nav, r, seq, source) if nav_item else _FRAME_NONE
         pos = (get("latitude", r), get("longitude", r), get("altitude", r)) if nav_item else (math.nan,) * 3
         it = MissionItem(
             command=cmd,
-            frame=(_FRAME_RELATIVE if relative else _FRAME_AMSL) if nav_item else _FRAME_NONE,
+            frame=frame,
             params=(
                 get("time_inside", r),
                 get("acceptance_radius", r),
