@@ -366,3 +366,27 @@ def test_plans_embedded_in_logs(shared_data):
     # log171 carries only ArduPilot's home item: no mission, said so
     with pytest.raises(DataFormatError, match="only a home position"):
         read_plan(shared_data / "logs" / "ardupilot_log171.bin")
+
+
+def test_items_built_in_code_take_any_numbers_and_refuse_others(tmp_path):
+    """A plan built through the API with integer (or numpy) numbers writes like a read one; a
+    non-number is refused when the item is built, naming the item."""
+    from uasnav.io.mission_plan import HomePosition, MissionItem, MissionPlan
+
+    items = (
+        MissionItem(22, 3, (0, 0, 0, 0), 47, 8, 30),
+        MissionItem(16, 3, (5, 2, 0, np.float32(90.0)), 47.001, 8, np.int64(30)),
+        MissionItem(21, 3, (0, 0, 0, 0), 47.001, 8.001, 0),
+    )
+    assert all(isinstance(x, float) for it in items for x in (*it.params, it.lat_deg, it.alt_m))
+    plan = MissionPlan(items, HomePosition(47.0, 8.0, 480.0))
+    for ext in (".plan", ".waypoints"):
+        path = tmp_path / f"p{ext}"
+        write_plan(plan, path)
+        back = read_plan(path)
+        assert [it.command for it in back.items] == [22, 16, 21]
+        assert back.items[1].params[:2] == (5.0, 2.0) and back.items[1].alt_m == 30.0
+    with pytest.raises(InputError, match="command 16"):
+        MissionItem(16, 3, ("5", None, 0, 0))
+    with pytest.raises(InputError, match="expected 4 params"):
+        MissionItem(16, 3, (1.0, 2.0))

@@ -154,6 +154,23 @@ class MissionItem:
     autocontinue: bool = True
     jump_id: int | None = None
 
+    def __post_init__(self) -> None:
+        # numbers as floats whatever the caller passed (ints, numpy scalars): the writers and
+        # the properties rely on float methods; anything that is not a number is refused here
+        try:
+            params = tuple(float(x) for x in self.params)
+            lat, lon, alt = float(self.lat_deg), float(self.lon_deg), float(self.alt_m)
+        except (TypeError, ValueError):
+            raise InputError(
+                f"mission item (command {self.command}): params and lat/lon/alt must be numbers"
+            ) from None
+        if len(params) != 4:
+            raise InputError(f"mission item (command {self.command}): expected 4 params, got {len(params)}")
+        object.__setattr__(self, "params", params)
+        object.__setattr__(self, "lat_deg", lat)
+        object.__setattr__(self, "lon_deg", lon)
+        object.__setattr__(self, "alt_m", alt)
+
     @property
     def kind(self) -> ItemKind:
         """What the item does (:class:`ItemKind`); unknown commands are ``OTHER``."""
