@@ -586,7 +586,7 @@ impl<T: Real> InsFilter<T> {
             lever.then(|| (-skew(&cl_b), -skew(&c_wl), c * skew(&l))),
             &r,
         )?;
-        let nis = z.dot(&g.chol.solve(&z));
+        let nis = z.dot(&strapdown::chol_solve(&g.chol, &z));
         self.last_nis = nis;
         let passes = nis <= cfg.gate_chi2; // false for NaN too
         if !passes {
@@ -602,7 +602,7 @@ impl<T: Real> InsFilter<T> {
         if self.win_len > 0 {
             // mean z = zs/n, cov(mean) = Σs/n²: the statistic is zsᵀ·Σs⁻¹·zs.
             if let Some(ch) = ss_sum.cholesky() {
-                let t = zs.dot(&ch.solve(&zs));
+                let t = zs.dot(&strapdown::chol_solve(&ch, &zs));
                 let passes = t <= cfg.gate_chi2;
                 if !passes {
                     return Ok(FixStatus::ExcludedWindow);
@@ -621,7 +621,7 @@ impl<T: Real> InsFilter<T> {
         }
         // Fault terms of the protection levels.
         let pos_cols = g.hp.fixed_columns::<3>(0).into_owned(); // (H·P)[:, δr] = (P·Hᵀ)ᵀ rows
-        let x = pos_cols.transpose() * g.chol.solve(&pos_cols); // A·K·S·Kᵀ·Aᵀ (3×3)
+        let x = pos_cols.transpose() * strapdown::chol_solve(&g.chol, &pos_cols); // A·K·S·Kᵀ·Aᵀ (3×3)
         let xh = x.fixed_view::<2, 2>(0, 0).into_owned();
         let lam = cfg.lambda_undetected;
         let snap_h =
