@@ -228,6 +228,24 @@ def test_declination_from_the_log_or_the_magnetic_model(shared_data) -> None:  #
     assert yaw[None] < 0.75 * yaw[0.0], yaw
 
 
+def test_declination_outside_the_magnetic_model_years_does_not_stop_a_replay() -> None:
+    """A log dated outside the shipped WMM (a receiver with the GPS week-rollover bug reports
+    1999; any log after 2030): without magnetometer aiding nothing is looked up; with it the
+    replay runs without declination and warns; an explicit declination still wins."""
+    import dataclasses
+
+    f = simulate_flight(duration_s=120.0, seed=3)
+    assert f.mag is not None
+    old = dataclasses.replace(f, meta={**f.meta, "utc_year": 1999.4})
+    r = ins.run(old, ins.InsConfig(use_mag=False, decimation=50))
+    assert r.summary["declination_source"] == "not used (no magnetometer aiding)"
+    with pytest.warns(UserWarning, match="outside the shipped World Magnetic Model"):
+        r = ins.run(old, ins.InsConfig(decimation=50))
+    assert r.summary["declination_deg"] == 0.0 and "1999.40" in r.summary["declination_source"]
+    r = ins.run(old, ins.InsConfig(declination_deg=2.0, decimation=50))
+    assert (r.summary["declination_deg"], r.summary["declination_source"]) == (2.0, "configuration")
+
+
 def _dataflash_without(src: Path, dst: Path, drop: set[str]) -> int:
     """Copy a DataFlash log record by record (lengths from its FMT records), leaving out the
     message types ``drop``; returns how many records were left out."""

@@ -617,15 +617,19 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         gyro0 = np.zeros(3)
     stationary = _static_mask(flight, cfg, rate)
     core_cfg = cfg.core_dict()
-    declination_deg, declination_source = resolve_declination(flight, cfg.declination_deg)
+    baro = flight.baro if cfg.use_baro else None
+    mag = flight.mag if cfg.use_mag else None
     if "declination_rad" in cfg.extra:  # an explicit nav-core key wins
         declination_deg, declination_source = (
             math.degrees(core_cfg["declination_rad"]),
             "extra['declination_rad']",
         )
+    elif mag is None and cfg.declination_deg is None:
+        # only the magnetometer's heading aiding uses it: nothing to look up (nor to fail on)
+        declination_deg, declination_source = 0.0, "not used (no magnetometer aiding)"
+    else:
+        declination_deg, declination_source = resolve_declination(flight, cfg.declination_deg)
     core_cfg["declination_rad"] = math.radians(declination_deg)
-    baro = flight.baro if cfg.use_baro else None
-    mag = flight.mag if cfg.use_mag else None
     llh = np.ascontiguousarray(np.column_stack([np.radians(g.lat), np.radians(g.lon), g.alt]))
     acc = np.ascontiguousarray(np.column_stack([g.h_acc, g.v_acc, g.s_acc]))
     c = np.ascontiguousarray

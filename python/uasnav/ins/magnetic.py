@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
+import warnings
 from typing import TYPE_CHECKING, Any
 
 from uasnav.errors import InputError
@@ -103,7 +104,8 @@ def resolve_declination(flight: Flight, declination_deg: float | None) -> tuple[
 
     ``declination_deg`` (configuration) wins; then the log's (``flight.meta["declination_deg"]``,
     set by the readers with ``flight.meta["declination_source"]``); then the WMM at the first
-    GNSS fix on ``flight.meta["utc_year"]``; else 0 with source ``"none"``.
+    GNSS fix on ``flight.meta["utc_year"]`` (a date outside the shipped models: 0, with a
+    warning); else 0 with source ``"none"``.
     """
     if declination_deg is not None:
         d = float(declination_deg)
@@ -116,6 +118,15 @@ def resolve_declination(flight: Flight, declination_deg: float | None) -> tuple[
     if meta.get("declination_deg") is not None:
         return float(meta["declination_deg"]), str(meta.get("declination_source", "log"))
     year = meta.get("utc_year")
+    if year is not None and not WMM_YEARS[0] <= float(year) < WMM_YEARS[1]:
+        # e.g. a receiver with the GPS week-rollover bug (1999 dates), or a log after 2030:
+        # the replay goes on without declination, and says so (it is no reason to refuse a log)
+        why = (
+            f"none (the log is dated {float(year):.2f}, outside the shipped World Magnetic Model "
+            f"{WMM_YEARS[0]:.0f}–{WMM_YEARS[1]:.0f}; give declination_deg / uasnav nav --declination)"
+        )
+        warnings.warn(f"declination: {why}", UserWarning, stacklevel=2)
+        return 0.0, why
     if year is not None:
         g = flight.gnss
         lat, lon, alt = float(g.lat[0]), float(g.lon[0]), float(g.alt[0])
