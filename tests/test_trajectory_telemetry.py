@@ -73,7 +73,7 @@ def test_cli_train_predict_evaluate(shared_data, tmp_path):
     # every limit of the kinematic default comes from the log's parameters (WPNAV_ACCEL_Z included)
     params = json.loads(model.read_text())["params"]
     assert params["accel_z_ms2"] == pytest.approx(1.0) and "accel_z_ms2" in params["limits_source"]
-    assert "defaults" not in params["limits_source"]
+    assert params["limits_source"].endswith("from phoenix_mission1_arducopter.tlog")
     plan = tmp_path / "plan.csv"
     plan.write_text("north,east\n0,0\n0,40\n40,40\n")
     r = CliRunner().invoke(

@@ -96,14 +96,13 @@ def _method_option(f):  # type: ignore[no-untyped-def]
     )(f)
 
 
-def _limits_source(flights: Sequence[str], lim: AutopilotLimits) -> str:
-    """Which limits came from which log, for the model file."""
+def _limits_source(lim: AutopilotLimits, log: str | None) -> str:
+    """Which limits came from which log (``log``, see :func:`_log_limits`), for the model file."""
     if not lim.source:
         return "defaults"
-    logs = [Path(f).name for f in flights if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg")]
     kinematic = {"accel_ms2", "climb_ms", "descent_ms", "accel_z_ms2"}
     rest = "" if kinematic <= set(lim.source) else "; others defaults"
-    return f"{', '.join(lim.source)} from {logs[0] if logs else 'log'}{rest}"
+    return f"{', '.join(lim.source)} from {log or 'log'}{rest}"
 
 
 @command.command("train")
@@ -161,10 +160,10 @@ def train(
                 )
                 model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
         else:
-            lim = _log_limits(flights)
+            lim, lim_log = _log_limits(flights)
             model = KinematicPredictor(
                 segment, lim.accel_ms2 or 1.0, lim.climb_ms or 2.5, lim.descent_ms or 1.5,
-                accel_z_ms2=lim.accel_z_ms2 or 1.0, limits_source=_limits_source(flights, lim),
+                accel_z_ms2=lim.accel_z_ms2 or 1.0, limits_source=_limits_source(lim, lim_log),
             ).fit(all_s)  # fmt: skip
     if why is not None:
         click.echo(f"warning: {why}", err=True)
@@ -308,17 +307,18 @@ def _predict_route(
     click.echo(f"ETA {p.eta_s:.1f} s ({method_of(model)} model, {len(route)} route points)")
 
 
-def _log_limits(flights: Sequence[str]) -> AutopilotLimits:
+def _log_limits(flights: Sequence[str]) -> tuple[AutopilotLimits, str | None]:
     """The autopilot limits of the first log among ``flights`` that carries an acceleration
-    limit, completed with the defaults (CSV flights carry no parameters)."""
+    limit, completed with the defaults (CSV flights carry no parameters), and that log's name
+    (None: all defaults)."""
     from uasnav.io.autopilot_limits import AutopilotLimits, read_autopilot_limits
 
     for f in flights:
         if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg"):
             lim = read_autopilot_limits(f)
             if lim.accel_ms2 is not None:
-                return lim.or_defaults()
-    return AutopilotLimits().or_defaults()
+                return lim.or_defaults(), Path(f).name
+    return AutopilotLimits().or_defaults(), None
 
 
 @command.command("evaluate")
@@ -359,7 +359,7 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         # prints its one error line only
         with warnings_after_success():
             fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
-            limits = _log_limits(flights)
+            limits, _ = _log_limits(flights)
             errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
         table = {
             e.name: {
