@@ -17,7 +17,9 @@ the commanded speed V, the acceleration limit a (ArduPilot ``WPNAV_ACCEL``, PX4
 climbs and descents) are timed by :mod:`uasnav.trajectory.route3d` with the vertical limits
 held here (``WPNAV_SPEED_UP/DN``, ``MPC_Z_VEL_MAX_UP/DN``).
 
-What is learned from the training flights: the commanded speed (median), the wind range and
+Wind does not change the predicted times: a multirotor's position controller holds the commanded
+ground speed within its limits (the LVQ network, which learns the wind's effect, suits vehicles
+that do not). What is learned from the training flights: the commanded speed (median), the wind range and
 the populated feature cells — elements of a plan outside them are flagged, and flagged elements
 widen the calibrated time bounds (:func:`uasnav.trajectory.timebounds.widening`).
 """
