@@ -213,12 +213,7 @@ class KinematicPredictor:
         cruise_ms: float | None = None,
     ) -> Feasibility:
         """Is each 4D waypoint (required time from the start, s) reached within ``tolerance_s``?"""
-        req = np.asarray(required_times_s, dtype=float)
-        p = np.asarray(plan_ne)
-        if req.shape != (p.shape[0],) or not np.isfinite(req).all():
-            raise InputError(f"need one finite required time per waypoint ({p.shape[0]}), got {req.shape}")
-        pred = self.predict(p, wind_ne, cruise_ms)
-        return Feasibility(required_s=req, predicted_s=pred.waypoint_times_s, tolerance_s=float(tolerance_s))
+        return Feasibility.of(self, plan_ne, required_times_s, wind_ne, tolerance_s, cruise_ms)
 
     # -- persistence ---------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:

@@ -123,6 +123,25 @@ class Feasibility:
         """Every waypoint reached within the tolerance."""
         return bool(self.ok.all())
 
+    @classmethod
+    def of(
+        cls,
+        predictor: Any,
+        plan_ne: np.ndarray,
+        required_times_s: np.ndarray,
+        wind_ne: np.ndarray,
+        tolerance_s: float = 5.0,
+        cruise_ms: float | None = None,
+    ) -> Feasibility:
+        """Each waypoint's required time (s from the start) against ``predictor``'s prediction of
+        the plan (any method: ``predictor.predict(plan_ne, wind_ne, cruise_ms)``)."""
+        req = np.asarray(required_times_s, dtype=float)
+        p = np.asarray(plan_ne)
+        if req.shape != (p.shape[0],) or not np.isfinite(req).all():
+            raise InputError(f"need one finite required time per waypoint ({p.shape[0]}), got {req.shape}")
+        pred = predictor.predict(p, wind_ne, cruise_ms)
+        return cls(required_s=req, predicted_s=pred.waypoint_times_s, tolerance_s=float(tolerance_s))
+
 
 class TrajectoryPredictor:
     """Element-time predictor trained on flown elements (thesis §5.1).
@@ -325,12 +344,7 @@ class TrajectoryPredictor:
         cruise_ms: float | None = None,
     ) -> Feasibility:
         """Is each 4D waypoint (required time from the start, s) reached within ``tolerance_s``?"""
-        req = np.asarray(required_times_s, dtype=float)
-        p = np.asarray(plan_ne)
-        if req.shape != (p.shape[0],) or not np.isfinite(req).all():
-            raise InputError(f"need one finite required time per waypoint ({p.shape[0]}), got {req.shape}")
-        pred = self.predict(p, wind_ne, cruise_ms)
-        return Feasibility(required_s=req, predicted_s=pred.waypoint_times_s, tolerance_s=float(tolerance_s))
+        return Feasibility.of(self, plan_ne, required_times_s, wind_ne, tolerance_s, cruise_ms)
 
     # -- persistence ---------------------------------------------------------------------
     def get_params(self) -> dict[str, Any]:
