@@ -459,6 +459,27 @@ def test_page_downloads_are_what_is_shown(client) -> None:
     assert [row["uas"] for row in csv.DictReader(io.StringIO(uris["ranking.csv"]))] == [
         x["uas"] for x in api["ranking"]
     ]
+    # each configuration with the operation it implies (issue 18: the operation follows the UA)
+    assert [
+        (row["visibility"], row["category"]) for row in csv.DictReader(io.StringIO(uris["ranking.csv"]))
+    ] == [(x["visibility"], x["category"]) for x in api["ranking"]]
+
+
+def test_page_shows_the_operation_of_each_configuration_and_every_operation(client) -> None:
+    """At 300 m the best UA flies VLOS in the open category while the small UAS that cannot be
+    kept in sight there imply a BVLOS/specific operation: the page lists both operations with
+    their best configuration, and each ranked row its own operation."""
+    form = {**{k: str(v) for k, v in THESIS.items()}, "range": "300"}
+    api = client.post("/api/select", json={**THESIS, "range": 300}).json()
+    assert {o["visibility"] for o in api["operations"]} >= {"VLOS", "BVLOS"}
+    page = client.post("/select", data=form).text
+    table = page[page.index('id="operations"') : page.index("</table>", page.index('id="operations"'))]
+    for o in api["operations"]:
+        assert f"<td>{o['visibility']}</td><td>{o['category']}</td>" in table
+        if o["best"]:
+            assert f"{o['best']['uas']} + {o['best']['camera']}" in table
+    ops = re.findall(r'<td class="operation">([^<]+)</td>', page)
+    assert ops == [f"{x['visibility']}, {x['category']}" for x in api["ranking"]]
 
 
 def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:

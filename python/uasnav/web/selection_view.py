@@ -36,6 +36,8 @@ RANKING_COLUMNS = (
     "score_resolution",
     "mass_g",
     "cost_usd",
+    "visibility",
+    "category",
     "open_subcategory",
 )
 REJECTION_COLUMNS = ("kind", "item", "test", "value", "limit", "unit", "margin", "message")
