@@ -135,3 +135,21 @@ def test_ulog_altitude_frame_from_the_frame_field_else_refused(tmp_path):
     do = tmp_path / "do.ulg"
     write_ulog(do, {"navigator_mission_item": (neither, [_item(1, 0, 178, 0.0, 0.0, 0.0)])})
     assert read_plan(do).items[0].altitude_frame == AltitudeFrame.NONE
+
+
+def test_corrupt_ulog_plan_prints_nothing(tmp_path, capfd):
+    """pyulog prints its corruption notices to stdout: the plan reader keeps them off it (a
+    command's --json output must stay clean) and still reads what the file holds."""
+    path = tmp_path / "cut.ulg"
+    write_ulog(path, {"navigator_mission_item": (NAV_ITEM, ITEMS)})
+    data = bytearray(path.read_bytes())
+    data[7] = 9  # a file version pyulog does not know: it warns on stdout and reads on
+    path.write_bytes(bytes(data[:-7]) + b"\xff" * 40)  # last record cut, then garbage
+    capfd.readouterr()
+    try:
+        plan = read_plan(path)
+    except DataFormatError:
+        plan = None
+    out = capfd.readouterr()
+    assert out.out == "", out.out
+    assert plan is None or [it.command for it in plan.items][:3] == [22, 16, 16]

@@ -99,10 +99,17 @@ def read_ulog_plan(path: str | os.PathLike[str]) -> MissionPlan:
     source = str(p)
     if not p.is_file():
         raise InputError(f"{p}: no such file")
-    try:
-        ulog = ULog(source, message_name_filter_list=_TOPICS)
-    except Exception as e:  # pyulog raises bare exceptions on corrupt files
-        raise DataFormatError(f"not a readable ULog ({type(e).__name__}: {e})", path=source) from None
+    from uasnav.io._quiet import library_output_captured
+
+    ulog, failure = None, None
+    # pyulog prints its corruption notices to stdout, which must stay clean for --json
+    with library_output_captured():
+        try:
+            ulog = ULog(source, message_name_filter_list=_TOPICS)
+        except Exception as e:  # pyulog raises bare exceptions on corrupt files
+            failure = e
+    if ulog is None:
+        raise DataFormatError(f"not a readable ULog ({type(failure).__name__}: {failure})", path=source)
     nav = _topic(ulog, "navigator_mission_item")
     if nav is None or nav["timestamp"].size == 0:
         mission = _topic(ulog, "mission")
