@@ -21,7 +21,6 @@ iron are not modelled.
 
 from __future__ import annotations
 
-import datetime as _dt
 import math
 import warnings
 from typing import TYPE_CHECKING, Any
@@ -32,8 +31,6 @@ if TYPE_CHECKING:
     from uasnav.io.navdata import Flight
 
 __all__ = [
-    "decimal_year",
-    "gps_week_ms_to_utc",
     "resolve_declination",
     "wmm_declination_deg",
     "wmm_model_name",
@@ -41,25 +38,6 @@ __all__ = [
 
 #: Years the shipped WMM coefficients cover (WMM2010 … WMM2025, 5 years each).
 WMM_YEARS = (2010.0, 2030.0)
-
-#: GPS time − UTC (leap seconds) since 2017-01-01; a few seconds do not matter to the WMM.
-GPS_UTC_LEAP_S = 18
-
-
-def decimal_year(when: _dt.datetime) -> float:
-    """``when`` (naive = UTC) as a decimal year, e.g. 2015-07-02T12:00 → 2015.5."""
-    start = _dt.datetime(when.year, 1, 1, tzinfo=when.tzinfo)
-    end = _dt.datetime(when.year + 1, 1, 1, tzinfo=when.tzinfo)
-    return when.year + (when - start).total_seconds() / (end - start).total_seconds()
-
-
-def gps_week_ms_to_utc(week: float, time_ms: float) -> _dt.datetime:
-    """UTC (naive) of a GPS week number and time of week (ms)."""
-    return (
-        _dt.datetime(1980, 1, 6)
-        + _dt.timedelta(weeks=float(week), milliseconds=float(time_ms))
-        - _dt.timedelta(seconds=GPS_UTC_LEAP_S)
-    )
 
 
 def wmm_declination_deg(lat_deg: float, lon_deg: float, height_m: float, year: float) -> float:

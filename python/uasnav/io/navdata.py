@@ -308,8 +308,8 @@ def _dataflash_declination_meta(path: Any, gp: dict[str, FloatArray], first: int
     (decimal year) from the ``GPS`` week and time of week of fix ``first``."""
     from pathlib import Path
 
-    from uasnav.ins.magnetic import decimal_year, gps_week_ms_to_utc
     from uasnav.io._mavlink import messages, reading
+    from uasnav.io.gpstime import decimal_year, gps_week_ms_to_utc
 
     p = Path(path)
     params: dict[str, float] = {}
@@ -606,7 +606,7 @@ def _ulog_declination_meta(ulog: Any, g: dict[str, FloatArray], sel: NDArray[np.
     saves the declination it used there), and ``utc_year`` from the GNSS ``time_utc_usec``."""
     import datetime as _dt
 
-    from uasnav.ins.magnetic import decimal_year
+    from uasnav.io.gpstime import decimal_year
 
     meta: dict[str, Any] = {}
     dec = ulog.initial_parameters.get("EKF2_MAG_DECL")
