@@ -555,7 +555,7 @@ def bench_ins(n: int, n_peer: int, repeat: int) -> None:
 def bench_ins_log171(repeat: int) -> None:
     """Real data: read ArduPilot log171 and replay it (IMU, 5 Hz GNSS, baro, mag)."""
     from uasnav import ins
-    from uasnav.io.navdata import read_dataflash_nav
+    from uasnav.io.formats.dataflash import read_dataflash_nav
 
     path = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "logs" / "ardupilot_log171.bin"
     t_read = median_time(lambda: read_dataflash_nav(path), repeat)

@@ -322,7 +322,7 @@ def test_log171_replay_within_fixed_acceptance_bounds(shared_data) -> None:  # t
     """ArduPilot log171 with GNSS against the autopilot's EKF over the airborne part (84–238 s;
     the crash after it is left out): horizontal RMS ≤ 3 m, velocity RMS ≤ 0.5 m/s, roll/pitch
     RMS ≤ 2° (the issue's bounds, fixed before the first run) — for each of the three IMUs."""
-    from uasnav.io.navdata import read_dataflash_nav
+    from uasnav.io.formats.dataflash import read_dataflash_nav
 
     f = read_dataflash_nav(shared_data / "logs" / "ardupilot_log171.bin").between(0.0, 238.0)
     assert f.reference is not None and set(f.imus) == {"IMU", "IMU2", "IMU3"}

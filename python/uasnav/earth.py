@@ -9,7 +9,8 @@ References
 P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*,
 2nd ed., Artech House (2013): eq. 2.134 (Somigliana normal gravity on the ellipsoid) and
 eq. 2.139 (second-order free-air height correction).
-NIMA TR8350.2, *Department of Defense World Geodetic System 1984*, 3rd ed. (2000), Table 3.1–3.3.
+NIMA TR8350.2, *Department of Defense World Geodetic System 1984*, 3rd ed. (2000), Table 3.1–3.3
+(the constants live in :mod:`uasnav.geo.wgs84`).
 """
 
 from __future__ import annotations
@@ -20,19 +21,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import InputError
+from uasnav.geo.wgs84 import OMEGA_IE, WGS84_A, WGS84_B, WGS84_E2, WGS84_F, WGS84_MU
 
-#: Earth rotation rate ω_ie (rad/s), WGS-84.
-OMEGA_IE = 7.292115e-5
-#: WGS-84 semi-major axis (m).
-WGS84_A = 6378137.0
-#: WGS-84 flattening.
-WGS84_F = 1.0 / 298.257223563
-#: WGS-84 first eccentricity squared e².
-WGS84_E2 = WGS84_F * (2.0 - WGS84_F)
-#: WGS-84 semi-minor axis (m).
-WGS84_B = WGS84_A * (1.0 - WGS84_F)
-#: WGS-84 Earth gravitational constant GM (m³/s²).
-WGS84_MU = 3.986004418e14
 #: Normal gravity at the equator (m/s²), WGS-84.
 GAMMA_EQUATOR = 9.7803253359
 #: Largest |height| (m) the free-air series is used for (the top of the atmosphere; far above,

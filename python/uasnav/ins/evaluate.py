@@ -2,8 +2,9 @@
 check its consistency (NEES), and run GNSS-outage experiments.
 
 Differences are estimate − reference, position in metres NED (north/east from the latitude and
-longitude differences with the WGS-84 radii at the reference point). Statistics: RMS and the
-95th percentile of the magnitude. Yaw differences are wrapped to ±180°.
+longitude differences with the WGS-84 radii of curvature at the reference point,
+:func:`uasnav.geo.frames.radii_of_curvature`; heights subtracted in the one datum both carry).
+Statistics: RMS and the 95th percentile of the magnitude. Yaw differences are wrapped to ±180°.
 """
 
 from __future__ import annotations
@@ -17,19 +18,12 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
-from uasnav import earth
 from uasnav.errors import InputError
+from uasnav.geo.frames import radii_of_curvature
 from uasnav.ins.core import InsConfig, InsResult, run
 from uasnav.io.navdata import Flight, Trajectory
 
 FloatArray = NDArray[np.float64]
-
-
-def _radii(lat_rad: FloatArray) -> tuple[FloatArray, FloatArray]:
-    s2 = np.sin(lat_rad) ** 2
-    d = 1.0 - earth.WGS84_E2 * s2
-    re = earth.WGS84_A / np.sqrt(d)
-    return re * (1.0 - earth.WGS84_E2) / d, re
 
 
 def ned_difference(
@@ -41,7 +35,7 @@ def ned_difference(
     rlon = np.interp(t, ref.t, ref.lon)
     ralt = np.interp(t, ref.t, ref.alt)
     phi = np.radians(rlat)
-    rn, re = _radii(phi)
+    rn, re = radii_of_curvature(rlat)
     dn = np.radians(lat - rlat) * (rn + ralt)
     de = np.radians(lon - rlon) * (re + ralt) * np.cos(phi)
     return np.column_stack([dn, de, -(alt - ralt)])
@@ -54,8 +48,10 @@ class Comparison:
     Attributes are RMS and 95th percentiles (p95) of the magnitudes: horizontal and vertical
     position (m), velocity (m/s, 3-D), roll/pitch (deg, RMS per axis and of both) and yaw
     (deg; p95 of roll/pitch over both axes' magnitudes). ``vertical_bias_m`` is the mean
-    vertical difference (the autopilot may use another datum); ``n`` the number of compared
-    samples; ``reference`` its name.
+    vertical difference; ``n`` the number of compared samples; ``reference`` its name;
+    ``datum`` the height datum both heights were compared in (:class:`~uasnav.geo.datum.HeightDatum`
+    value: the readers give the autopilot's estimate in the datum of the GNSS fixes the filter
+    flew on).
     """
 
     horizontal_rms_m: float
@@ -74,6 +70,7 @@ class Comparison:
     t_span: tuple[float, float] = (0.0, 0.0)
     roll_pitch_p95_deg: float | None = None
     yaw_p95_deg: float | None = None
+    datum: str = "ellipsoid"
 
     def as_dict(self) -> dict[str, Any]:
         """Plain dict for JSON."""
@@ -143,6 +140,7 @@ def compare(result: InsResult, ref: Trajectory, *, t_range: tuple[float, float] 
         t_span=(float(lo), float(hi)),
         roll_pitch_p95_deg=rp95,
         yaw_p95_deg=yaw95,
+        datum=str(ref.alt_datum),
     )
 
 

@@ -1,6 +1,11 @@
 """Every file format of uasnav: IMU logs, flight telemetry and numeric tables.
 
-IMU logs → :class:`~uasnav.imu.ImuLog`; :func:`read_log` picks the reader from the extension.
+Any log → :func:`open_log` (:mod:`uasnav.io.logfile`): one :class:`LogFile` whose typed views
+(IMUs, GNSS, barometer, magnetometer, the autopilot's estimate, plan, parameters, limits, modes,
+identity) are decoded in one pass per command.
+
+IMU logs → :class:`~uasnav.imu.ImuLog`; :func:`read_log` (``open_log(path).imu``) picks the
+reader from the extension.
 
 ========== ================================ ===========================================
 extension  reader                           notes
@@ -46,11 +51,12 @@ from uasnav.imu import ImuLog, require_log
 from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.io.dataflash import read_dataflash, read_dataflash_flight, read_dataflash_messages
 from uasnav.io.flight import FlightLog, read_flight_csv
+from uasnav.io.logfile import LogFile, open_log
 from uasnav.io.npz import read_npz, write_npz
 from uasnav.io.px4 import read_ulog, read_ulog_flight
 from uasnav.io.table import read_csv_table, write_csv_table
 from uasnav.io.tlog import read_tlog, read_tlog_flight
-from uasnav.io.xio import is_xio_csv, read_xio_csv
+from uasnav.io.xio import read_xio_csv
 
 READ_EXTENSIONS = (".csv", ".txt", ".npz", ".ulg", ".bin", ".tlog")
 WRITE_EXTENSIONS = (".csv", ".npz")
@@ -58,36 +64,22 @@ FLIGHT_EXTENSIONS = (".csv", ".tlog", ".bin", ".ulg")
 
 
 def read_log(path: str | os.PathLike[str]) -> ImuLog:
-    """Read an IMU log; the format follows the extension (see the module table)."""
+    """Read an IMU log (``open_log(path).imu``; the format follows the extension and, for CSV,
+    the header: see the module table)."""
     p = Path(path)
-    suffix = p.suffix.lower()
-    if suffix in (".csv", ".txt"):
-        try:
-            with open(p, "rb") as fh:
-                # the layout is told by the header's start: a bounded peek, whatever the file
-                first = fh.readline(4096).decode("utf-8", errors="replace")
-        except FileNotFoundError:
-            raise DataFormatError("no such file", path=str(p)) from None
-        except IsADirectoryError:
-            raise DataFormatError("is a directory, not a file", path=str(p)) from None
-        except OSError as e:
-            raise DataFormatError(f"cannot read ({e.strerror or e})", path=str(p)) from None
-        return read_xio_csv(p) if is_xio_csv(first) else read_csv_v1(p)
-    if suffix == ".npz":
-        return read_npz(p)
-    if suffix == ".ulg":
-        return read_ulog(p)
-    if suffix == ".bin":
-        logs = read_dataflash(p)
-        return logs[sorted(logs)[0]]
-    if suffix == ".tlog":
-        logs = read_tlog(p)
-        return logs[sorted(logs)[0]]
-    raise InputError(f"{p}: unknown log format {suffix!r} (supported: {', '.join(READ_EXTENSIONS)})")
+    if p.suffix.lower() not in READ_EXTENSIONS:
+        suffix = p.suffix.lower()
+        raise InputError(f"{p}: unknown log format {suffix!r} (supported: {', '.join(READ_EXTENSIONS)})")
+    if p.is_dir():
+        raise DataFormatError("is a directory, not a file", path=str(p))
+    log = open_log(p, need=("imu",))
+    if log.format_name == "flight-csv":
+        return read_csv_v1(p)  # a flight CSV is no IMU log: the CSV v1 reader says what is missing
+    return log.imu  # type: ignore[no-any-return]
 
 
 def read_flight(path: str | os.PathLike[str]) -> FlightLog:
-    """Read the flight telemetry of a log; the format follows the extension (.csv, .tlog, .bin, .ulg).
+    """Read the flight telemetry of a log (``open_log(path).flight``: .csv, .tlog, .bin, .ulg).
 
     Raises
     ------
@@ -102,15 +94,11 @@ def read_flight(path: str | os.PathLike[str]) -> FlightLog:
     if not p.is_file():
         raise InputError(f"{p}: not a regular file (a directory, device or FIFO)")
     ext = p.suffix.lower()
+    if ext not in FLIGHT_EXTENSIONS:
+        raise InputError(f"{p}: unknown telemetry format {ext!r} (expected .csv, .tlog, .bin, .ulg)")
     if ext == ".csv":
-        return read_flight_csv(p)
-    if ext == ".tlog":
-        return read_tlog_flight(p)
-    if ext == ".bin":
-        return read_dataflash_flight(p)
-    if ext == ".ulg":
-        return read_ulog_flight(p)
-    raise InputError(f"{p}: unknown telemetry format {ext!r} (expected .csv, .tlog, .bin, .ulg)")
+        return read_flight_csv(p)  # any CSV: the flight CSV reader names missing columns
+    return open_log(p, need=("flight",)).flight  # type: ignore[no-any-return]
 
 
 def write_log(log: ImuLog, path: str | os.PathLike[str]) -> None:
@@ -131,6 +119,8 @@ __all__ = [
     "READ_EXTENSIONS",
     "WRITE_EXTENSIONS",
     "FlightLog",
+    "LogFile",
+    "open_log",
     "read_csv_table",
     "read_csv_v1",
     "read_dataflash",

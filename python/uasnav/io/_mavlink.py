@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from uasnav.errors import DataFormatError
+from uasnav.io._active import lookup
 from uasnav.io._quiet import LibraryOutput, library_output_captured
 
 
@@ -45,7 +46,14 @@ def reading(p: Path, **kw: Any) -> Iterator[tuple[Any, LibraryOutput]]:
     The :class:`LibraryOutput` is complete only after the block: report it (and issue any
     warning) *after* leaving the block, since output inside it is swallowed. The connection
     is closed on exit; pymavlink's statistics of a corrupt log are noted (:func:`_note_corruption`).
+
+    While a decoded scan of ``p`` is active (:mod:`uasnav.io.formats._scan`), the connection
+    replays it and the decoder output is the scan's: the file is not opened again.
     """
+    scan = None if kw.pop("fresh", False) else lookup(p)
+    if scan is not None and hasattr(scan, "replay"):
+        yield scan.replay(), scan.decoder
+        return
     conn = None
     with library_output_captured() as out:
         try:
@@ -87,6 +95,12 @@ def messages(conn: Any, types: Sequence[str], p: Path, what: str) -> Iterator[An
         If pymavlink fails to decode a message.
     """
     wanted = list(types)
+    covers = getattr(conn, "covers", None)
+    if covers is not None and not covers(wanted):
+        # a replayed scan without these types: read them from the file (one more pass)
+        with reading(p, **conn.kw, fresh=True) as (fresh, _):
+            yield from messages(fresh, wanted, p, what)
+        return
     while True:
         try:
             msg = conn.recv_match(type=wanted)
@@ -97,4 +111,18 @@ def messages(conn: Any, types: Sequence[str], p: Path, what: str) -> Iterator[An
         yield msg
 
 
-__all__ = ["connect", "messages", "reading"]
+def scan_file(p: Path, types: Sequence[str], **kw: Any) -> tuple[list[Any], LibraryOutput]:
+    """Every message of ``types`` in the log ``p`` (one pass, in log order) and what the decoder
+    reported (complete: the file is closed).
+
+    Raises
+    ------
+    DataFormatError
+        As :func:`connect` and :func:`messages`.
+    """
+    with reading(p, fresh=True, **kw) as (conn, decoder):
+        msgs = list(messages(conn, types, p, "MAVLink" if p.suffix.lower() == ".tlog" else "DataFlash"))
+    return msgs, decoder
+
+
+__all__ = ["connect", "messages", "reading", "scan_file"]

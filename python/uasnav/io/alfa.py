@@ -26,6 +26,10 @@ Topics read:
 ``mavros-local_position-velocity``           the autopilot's velocity (ENU, reference)
 ``mavros-imu-data``                          the autopilot's attitude (reference)
 ============================================ ===============================================
+
+Heights: both fixes and the autopilot's position are ``sensor_msgs/NavSatFix`` altitudes, which
+ROS defines above the WGS-84 ellipsoid (mavros adds the EGM96 undulation to the autopilot's
+AMSL); they are read as ellipsoidal and compare directly.
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import DataFormatError
+from uasnav.geo.datum import HeightDatum
 from uasnav.imu import ImuLog
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 
@@ -183,6 +188,7 @@ def read_alfa_folder(path: str | os.PathLike[str]) -> Flight:
         np.sqrt(np.maximum(h_var, 1e-4)),
         np.sqrt(np.maximum(fix["field.position_covariance8"], 1e-4)),
         np.full(fix["t"].size, ALFA_SPEED_ACC_M_S),
+        alt_datum=HeightDatum.ELLIPSOID,
     )
     baro = None
     pr = _read_topic(folder, "mavros-imu-atm_pressure", ["field.fluid_pressure"], required=False)
@@ -226,7 +232,7 @@ def read_alfa_folder(path: str | os.PathLike[str]) -> Flight:
             v_ref,
             eul,
             name="PX4/mavros global_position + imu/data",
-            alt_datum="as logged",
+            alt_datum=HeightDatum.ELLIPSOID,
         )
     # The magnetometer is returned in meta only: its unit is undocumented (|B| ≈ 5e5 as logged)
     # and the site's declination (≈ −9°) is not modelled, so as a heading aid it does more harm

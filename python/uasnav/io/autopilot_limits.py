@@ -122,7 +122,7 @@ def _mavlink_params(p: Path) -> dict[str, float]:
 def _ulog_params(p: Path) -> dict[str, float]:
     from uasnav.io.px4 import _open
 
-    ulog, _ = _open(p)
+    ulog, _ = _open(p, [])  # parameters only: no topic
     return {k: float(v) for k, v in ulog.initial_parameters.items() if k in PX4_PARAMS}
 
 

@@ -51,6 +51,7 @@ from uasnav.io._common import (
 )
 from uasnav.io._mavlink import messages, reading
 from uasnav.io.flight import FIX_LIMITS, FlightLog, flight_from_fixes
+from uasnav.io.views import gps_to_utc
 
 #: Message names of the IMUs in older logs (newer logs use ``IMU`` with an instance field ``I``).
 IMU_TYPES = ("IMU", "IMU2", "IMU3")
@@ -273,11 +274,6 @@ def _number(v: Any) -> float:
 #: A board's identity line in ``MSG`` (e.g. ``PX4v2 004A002F 33345119 32383433``: board and the
 #: processor's 96-bit unique id), logged at every boot by ArduPilot.
 _BOARD_ID = re.compile(r"^\S+ [0-9A-F]{8} [0-9A-F]{8} [0-9A-F]{8}$")
-#: GPS − UTC (s) from the given UTC date on (leap seconds; IERS bulletin C).
-_GPS_UTC = ((dt.datetime(2012, 7, 1, tzinfo=dt.timezone.utc), 16),
-            (dt.datetime(2015, 7, 1, tzinfo=dt.timezone.utc), 17),
-            (dt.datetime(2017, 1, 1, tzinfo=dt.timezone.utc), 18))  # fmt: skip
-_GPS_EPOCH = dt.datetime(1980, 1, 6, tzinfo=dt.timezone.utc)
 
 
 def read_dataflash_identity(path: str | os.PathLike[str]) -> dict[str, Any]:
@@ -286,8 +282,8 @@ def read_dataflash_identity(path: str | os.PathLike[str]) -> dict[str, Any]:
     Returns a dict with ``vehicle`` (the board identity line of ``MSG``, board name and unique
     processor id) and ``boot_utc`` (UTC :class:`datetime.datetime` of boot time 0, from the
     first ``GPS`` message with a 3-D fix and a GPS week: ``GWk``/``GMS`` or, in old logs,
-    ``Week``/``TimeMS``, minus its boot time ``TimeUS``/``T``; GPS − UTC leap seconds applied
-    from 2012 on); keys are absent when the log lacks them.
+    ``Week``/``TimeMS``, minus its boot time ``TimeUS``/``T``) with ``leap_seconds`` (GPS − UTC
+    applied, :func:`uasnav.io.views.gps_to_utc`); keys are absent when the log lacks them.
     """
     p = Path(path)
     out: dict[str, Any] = {}
@@ -302,10 +298,10 @@ def read_dataflash_identity(path: str | os.PathLike[str]) -> dict[str, Any]:
                 week, ms = (d.get("GWk"), d.get("GMS")) if "GWk" in d else (d.get("Week"), d.get("TimeMS"))
                 boot_s = d["TimeUS"] * 1e-6 if "TimeUS" in d else (d["T"] * 1e-3 if "T" in d else None)
                 if week and ms is not None and boot_s is not None:
-                    gps = _GPS_EPOCH + dt.timedelta(weeks=int(week), milliseconds=float(ms))
-                    leap = max([s for since, s in _GPS_UTC if gps >= since], default=15)
-                    out["boot_utc"] = gps - dt.timedelta(seconds=leap + boot_s)
-            if len(out) == 2:
+                    utc, leap = gps_to_utc(int(week), float(ms))
+                    out["boot_utc"] = utc - dt.timedelta(seconds=boot_s)
+                    out["leap_seconds"] = leap
+            if len(out) == 3:
                 break
     return out
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
+from uasnav.io._active import lookup
 from uasnav.io._common import (
     TEMP_RANGE_C,
     build_log,
@@ -63,10 +64,16 @@ def _cols(d: Any, stem: str, path: str) -> np.ndarray:
         ) from None
 
 
-def _open(p: Path) -> tuple[Any, LibraryOutput]:
-    """The parsed ULog ``p`` and what pyulog printed meanwhile (one error handling for both
-    readers; pyulog prints its corruption notices to stdout, which must stay clean for
-    ``--json``)."""
+def parse_ulog(p: Path, topics: list[str] | None = None) -> tuple[Any, LibraryOutput]:
+    """The ULog ``p`` parsed by pyulog (only ``topics`` when given: its
+    ``message_name_filter_list``) and what pyulog printed meanwhile (its corruption notices go
+    to stdout, which must stay clean for ``--json``).
+
+    Raises
+    ------
+    DataFormatError
+        Missing file, not a regular file (a device or FIFO), or not a ULog pyulog can parse.
+    """
     from pyulog import ULog
 
     if not p.exists():
@@ -77,7 +84,7 @@ def _open(p: Path) -> tuple[Any, LibraryOutput]:
     failure: Exception | None = None
     with library_output_captured() as decoder:
         try:
-            ulog = ULog(str(p))
+            ulog = ULog(str(p), message_name_filter_list=topics)
         except Exception as e:  # pyulog raises bare exceptions on corrupt headers
             failure = e
     if ulog is None:
@@ -87,6 +94,15 @@ def _open(p: Path) -> tuple[Any, LibraryOutput]:
     if getattr(ulog, "file_corruption", False) and not decoder.lines:
         decoder.note("pyulog detected file corruption")
     return ulog, decoder
+
+
+def _open(p: Path, topics: list[str] | None = None) -> tuple[Any, LibraryOutput]:
+    """The parsed ULog ``p``: the active scan's (:mod:`uasnav.io.formats._scan`) when there is
+    one, else a fresh parse of ``topics`` (None: every topic)."""
+    scan = lookup(p)
+    if scan is not None and hasattr(scan, "ulog"):
+        return scan.ulog, scan.decoder
+    return parse_ulog(p, topics)
 
 
 def _no_topic(ulog: Any, decoder: LibraryOutput, what: str, sp: str) -> DataFormatError:
@@ -297,4 +313,4 @@ def read_ulog_flight(path: str | os.PathLike[str]) -> FlightLog:
     return flight_from_fixes(fixes, p, waypoints={}, reached=reached, wind=wind, decoder=decoder)
 
 
-__all__ = ["read_ulog", "read_ulog_flight", "read_ulog_imus"]
+__all__ = ["parse_ulog", "read_ulog", "read_ulog_flight", "read_ulog_imus"]

@@ -44,7 +44,8 @@ from uasnav.io.mission_plan import (
 #: MAV_FRAME_GLOBAL (AMSL) and MAV_FRAME_GLOBAL_RELATIVE_ALT (relative to home).
 _FRAME_AMSL, _FRAME_RELATIVE, _FRAME_NONE = 0, 3, 2
 _MAV_CMD_NAV_LAST = 95
-_TOPICS = ["navigator_mission_item", "home_position", "mission", "mission_result"]
+#: The topics the plan is read from.
+TOPICS = ("navigator_mission_item", "home_position", "mission", "mission_result")
 
 
 def _topic(ulog: object, name: str) -> dict[str, np.ndarray] | None:
@@ -93,23 +94,13 @@ def read_ulog_plan(path: str | os.PathLike[str]) -> MissionPlan:
         Not a ULog, no mission items in the log (naming what the log says of its mission), an
         item with an invalid command, position or altitude.
     """
-    from pyulog import ULog
+    from uasnav.io.px4 import _open
 
     p = Path(path)
     source = str(p)
     if not p.is_file():
         raise InputError(f"{p}: no such file")
-    from uasnav.io._quiet import library_output_captured
-
-    ulog, failure = None, None
-    # pyulog prints its corruption notices to stdout, which must stay clean for --json
-    with library_output_captured():
-        try:
-            ulog = ULog(source, message_name_filter_list=_TOPICS)
-        except Exception as e:  # pyulog raises bare exceptions on corrupt files
-            failure = e
-    if ulog is None:
-        raise DataFormatError(f"not a readable ULog ({type(failure).__name__}: {failure})", path=source)
+    ulog, _ = _open(p, list(TOPICS))  # pyulog's notices are kept off stdout (--json stays clean)
     nav = _topic(ulog, "navigator_mission_item")
     if nav is None or nav["timestamp"].size == 0:
         mission = _topic(ulog, "mission")
@@ -178,4 +169,4 @@ def read_ulog_plan(path: str | os.PathLike[str]) -> MissionPlan:
     return MissionPlan(items=tuple(items), home=home, source=source)
 
 
-__all__ = ["read_ulog_plan"]
+__all__ = ["TOPICS", "read_ulog_plan"]

@@ -1,0 +1,93 @@
+"""The base of the log format classes: which message types each view needs, one decoding pass
+for the union of them, and the view builders. Each format's rules (time fields, GNSS delay,
+EKF origin, height datums, field layouts across firmware versions) live in its own class."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any, ClassVar
+
+from uasnav.errors import DataFormatError
+
+#: Every view a :class:`~uasnav.io.logfile.LogFile` can offer.
+VIEWS = (
+    "imus",
+    "imu",
+    "nav",
+    "gnss",
+    "baro",
+    "mag",
+    "autopilot_estimate",
+    "flight",
+    "plan",
+    "params",
+    "limits",
+    "modes",
+    "identity",
+)
+#: Views taken from the navigation data (:class:`~uasnav.io.navdata.Flight`).
+NAV_PARTS = {"gnss": "gnss", "baro": "baro", "mag": "mag", "autopilot_estimate": "reference"}
+
+
+class LogFormat:
+    """One log format. Subclasses set :attr:`name` and :attr:`SOURCES` (view → message types or
+    topics it decodes) and implement :meth:`scan` (binary formats) and ``build_<view>``."""
+
+    name: ClassVar[str] = ""
+    #: The message types / topics each view needs.
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {}
+
+    def __init__(self, path: Path, **options: Any) -> None:
+        self.path = Path(path)
+        self.options = options
+
+    @classmethod
+    def carries(cls, view: str) -> bool:
+        """Whether this format can have the view at all."""
+        if view in NAV_PARTS:
+            return "nav" in cls.SOURCES
+        return view in cls.SOURCES
+
+    def types_for(self, views: Iterable[str]) -> set[str]:
+        """The union of the message types the ``views`` need."""
+        out: set[str] = set()
+        for v in views:
+            out.update(self.SOURCES.get("nav" if v in NAV_PARTS else v, ()))
+        return out
+
+    def scan(self, types: set[str], previous: Any | None) -> Any | None:
+        """Decode the file once for ``types`` (a scan object of :mod:`uasnav.io.formats._scan`);
+        None for formats read whole. ``previous`` is the last scan, to merge with."""
+        return None
+
+    def build(self, view: str, cache: dict[str, Any]) -> Any:
+        """The view ``view`` (called with the scan active; ``cache`` holds views already built)."""
+        if view in NAV_PARTS:
+            nav = cache.get("nav")
+            if nav is None:
+                nav = cache["nav"] = self.build("nav", cache)
+            return getattr(nav, NAV_PARTS[view])
+        if view == "nav" and self.options.get("gnss") is not None and self.name != "csv-v1":
+            return self._with_gnss(self.build_nav())  # type: ignore[attr-defined]
+        fn = getattr(self, f"build_{view}", None)
+        if fn is None or view not in self.SOURCES:
+            raise DataFormatError(
+                f"a {self.name} log carries no {view.replace('_', ' ')}", path=str(self.path)
+            )
+        return fn()
+
+    def _with_gnss(self, nav: Any) -> Any:
+        """``nav`` with the GNSS fixes of the option ``gnss`` (a GNSS CSV path or GnssData)."""
+        from uasnav.io.navdata import Flight, GnssData
+
+        gnss = self.options["gnss"]
+        if not isinstance(gnss, GnssData):
+            from uasnav.io.gnss_csv import read_gnss_csv
+
+            gnss = read_gnss_csv(gnss)
+        n = nav
+        return Flight(n.imu, gnss, n.baro, n.mag, n.reference, n.truth, n.imus, n.airborne, n.meta)
+
+
+__all__ = ["NAV_PARTS", "VIEWS", "LogFormat"]

@@ -1,0 +1,139 @@
+"""Text and array logs read whole: CSV v1 (+ a GNSS CSV given separately), the x-io CSV, the
+flight CSV and ``.npz``. Which CSV a file is follows its header (:func:`csv_kind`).
+
+Heights: the GNSS CSV's ``alt`` is ellipsoidal (:mod:`uasnav.io.gnss_csv`); the flight CSV's
+``alt`` is the telemetry's height (not stated by the file).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, ClassVar
+
+from uasnav.errors import DataFormatError, InputError
+from uasnav.io.flight import FLIGHT_CSV_COLUMNS
+from uasnav.io.formats.base import LogFormat
+from uasnav.io.navdata import Flight, GnssData, MagData
+from uasnav.io.views import Identity
+
+
+def csv_kind(path: str | Path) -> str:
+    """``csv-v1``, ``xio-csv`` or ``flight-csv`` from the first non-comment line of a CSV file.
+
+    Raises
+    ------
+    DataFormatError
+        Missing file, a directory, or unreadable.
+    """
+    from uasnav.io.xio import is_xio_csv
+
+    p = Path(path)
+    try:
+        with open(p, "rb") as fh:
+            for _ in range(1000):
+                raw = fh.readline(4096)  # a bounded peek, whatever the file
+                if not raw:
+                    break
+                line = raw.decode("utf-8", errors="replace").lstrip("\ufeff").strip()
+                if not line or line.startswith("#"):
+                    continue
+                if is_xio_csv(line):
+                    return "xio-csv"
+                cols = [c.strip() for c in line.split(",")]
+                if cols[: len(FLIGHT_CSV_COLUMNS)] == list(FLIGHT_CSV_COLUMNS) or {"lat", "lon"} <= set(cols):
+                    return "flight-csv"
+                return "csv-v1"
+    except FileNotFoundError:
+        raise DataFormatError("no such file", path=str(p)) from None
+    except IsADirectoryError:
+        raise DataFormatError("is a directory, not a file", path=str(p)) from None
+    except OSError as e:
+        raise DataFormatError(f"cannot read ({e.strerror or e})", path=str(p)) from None
+    return "csv-v1"
+
+
+class _WholeFile(LogFormat):
+    """A format read whole by one reader: the IMU log is read once and cached."""
+
+    def _imu(self) -> Any:
+        raise NotImplementedError
+
+    def build_imu(self) -> Any:
+        cached = self.options.get("_imu")
+        if cached is None:
+            cached = self.options["_imu"] = self._imu()
+        return cached
+
+    def build_imus(self) -> dict[str, Any]:
+        return {"imu0": self.build_imu()}
+
+    def build_identity(self) -> Identity:
+        meta = self.build_imu().meta
+        return Identity(vehicle_id=meta.get("vehicle"), board=meta.get("hardware"), clock="file")
+
+
+class CsvV1Format(_WholeFile):
+    """CSV v1 IMU log (:func:`uasnav.io.csv_v1.read_csv_v1`); ``nav`` with the GNSS CSV given
+    as the option ``gnss`` (``mx my mz`` become the magnetometer when present)."""
+
+    name = "csv-v1"
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "nav": (), "identity": ()}
+
+    def _imu(self) -> Any:
+        from uasnav.io.csv_v1 import read_csv_v1
+
+        return read_csv_v1(self.path)
+
+    def build_nav(self) -> Flight:
+        gnss = self.options.get("gnss")
+        if gnss is None:
+            raise InputError(
+                f"{self.path}: a CSV IMU log needs --gnss GNSS.csv (t,lat,lon,alt,vn,ve,vd,h_acc,v_acc,s_acc)"
+            )
+        if not isinstance(gnss, GnssData):
+            from uasnav.io.gnss_csv import read_gnss_csv
+
+            gnss = read_gnss_csv(gnss)
+        imu = self.build_imu()
+        mag = MagData(imu.t, imu.mag) if imu.mag is not None else None
+        meta = {"source": str(self.path), "format": "csv-v1", "imu": "IMU"}
+        return Flight(imu, gnss, None, mag, imus={"IMU": imu}, meta=meta)
+
+
+class XioFormat(_WholeFile):
+    """x-io Technologies CSV (:func:`uasnav.io.xio.read_xio_csv`)."""
+
+    name = "xio-csv"
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "identity": ()}
+
+    def _imu(self) -> Any:
+        from uasnav.io.xio import read_xio_csv
+
+        return read_xio_csv(self.path)
+
+
+class NpzFormat(_WholeFile):
+    """uasnav / ADIS ``.npz`` IMU arrays (:func:`uasnav.io.npz.read_npz`)."""
+
+    name = "npz"
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "identity": ()}
+
+    def _imu(self) -> Any:
+        from uasnav.io.npz import read_npz
+
+        return read_npz(self.path)
+
+
+class FlightCsvFormat(LogFormat):
+    """Flight CSV ``t,lat,lon,alt,v_N,v_E,v_D`` (:func:`uasnav.io.flight.read_flight_csv`)."""
+
+    name = "flight-csv"
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"flight": ()}
+
+    def build_flight(self) -> Any:
+        from uasnav.io.flight import read_flight_csv
+
+        return read_flight_csv(self.path)
+
+
+__all__ = ["CsvV1Format", "FlightCsvFormat", "NpzFormat", "XioFormat", "csv_kind"]

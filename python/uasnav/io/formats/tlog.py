@@ -1,0 +1,295 @@
+"""MAVLink telemetry logs (``.tlog``): one pymavlink pass per command for the message types its
+views need (:attr:`TlogFormat.SOURCES`). IMU streams and flight telemetry:
+:mod:`uasnav.io.tlog`; navigation data: :func:`read_tlog_nav`; plan: ``MISSION_ITEM(_INT)``;
+params/limits: ``PARAM_VALUE``; modes: ``HEARTBEAT.custom_mode``; identity: ``HEARTBEAT``
+(autopilot, vehicle type), ``AUTOPILOT_VERSION``. Log time is the ground station's wall clock
+(UTC, s since 1970).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import os
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from uasnav.errors import DataFormatError
+from uasnav.geo.datum import HeightDatum, receiver_undulation
+from uasnav.imu import ImuLog
+from uasnav.io._common import because
+from uasnav.io._mavlink import messages, reading
+from uasnav.io.alfa import isa_pressure_altitude
+from uasnav.io.formats._scan import MavlinkScan
+from uasnav.io.formats.base import LogFormat
+from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
+from uasnav.io.tlog import IMU_TYPES
+from uasnav.io.views import Identity, ModeTimeline, changes
+from uasnav.units import STANDARD_GRAVITY
+
+NAV_TYPES = ("SCALED_IMU", "RAW_IMU", "GPS_RAW_INT", "SCALED_PRESSURE", "GLOBAL_POSITION_INT", "ATTITUDE")
+#: MAV_AUTOPILOT and MAV_TYPE numbers of HEARTBEAT (common subset).
+AUTOPILOTS = {3: "ArduPilot", 12: "PX4"}
+MAV_TYPES = {1: "fixed-wing", 2: "multirotor", 13: "multirotor", 14: "multirotor", 15: "multirotor",
+             10: "rover", 19: "VTOL", 20: "VTOL", 21: "VTOL", 22: "VTOL"}  # fmt: skip
+_GCS = 6  # MAV_TYPE_GCS: the ground station's own heartbeat
+
+
+def read_tlog_nav(path: str | os.PathLike[str]) -> Flight:
+    """Navigation data of a MAVLink log as a :class:`~uasnav.io.navdata.Flight`: the IMU from
+    ``SCALED_IMU`` (else ``RAW_IMU``, ArduPilot scaling: mg, mrad/s), ``GPS_RAW_INT`` (fixes
+    with ``fix_type`` ≥ 3; ``h_acc``/``v_acc``/``vel_acc`` when sent, else σ from ``eph``),
+    ``SCALED_PRESSURE`` (ISA pressure altitude), the IMU's magnetometer, and the reference from
+    ``GLOBAL_POSITION_INT`` and ``ATTITUDE``. Heights: AMSL (``GPS_RAW_INT.alt``,
+    ``GLOBAL_POSITION_INT.alt``), or ellipsoidal when every fix carries MAVLink 2's
+    ``alt_ellipsoid`` (the estimate then moved by the receiver's own undulation). All on the
+    log's wall clock (the time stamp the ground station wrote on arrival: telemetry jitter of
+    tens of ms is part of the data).
+    Telemetry IMU streams are typically 10–50 Hz: say so where it limits accuracy.
+
+    Raises
+    ------
+    DataFormatError
+        No IMU message, no GPS_RAW_INT, or fewer than 2 3-D fixes.
+    """
+    p = Path(path)
+    imu_rows: dict[str, list[tuple[float, ...]]] = {"SCALED_IMU": [], "RAW_IMU": []}
+    gps: list[tuple[float, ...]] = []
+    baro: list[tuple[float, float]] = []
+    ref: list[tuple[float, ...]] = []
+    att: list[tuple[float, ...]] = []
+    types = NAV_TYPES
+    with reading(p, dialect="ardupilotmega") as (conn, decoder):
+        for m in messages(conn, types, p, "MAVLink"):
+            kind = m.get_type()
+            ts = float(m._timestamp)
+            if kind in imu_rows:
+                imu_rows[kind].append(
+                    (
+                        ts,
+                        m.xgyro * 1e-3,
+                        m.ygyro * 1e-3,
+                        m.zgyro * 1e-3,
+                        m.xacc * 1e-3 * STANDARD_GRAVITY,
+                        m.yacc * 1e-3 * STANDARD_GRAVITY,
+                        m.zacc * 1e-3 * STANDARD_GRAVITY,
+                        m.xmag * 1e-1,
+                        m.ymag * 1e-1,
+                        m.zmag * 1e-1,
+                    )
+                )
+            elif kind == "GPS_RAW_INT" and m.fix_type >= 3:
+                h_acc = getattr(m, "h_acc", 0) * 1e-3 or max(m.eph * 1e-2, 0.5) * 1.5
+                v_acc = getattr(m, "v_acc", 0) * 1e-3 or 1.5 * h_acc
+                s_acc = getattr(m, "vel_acc", 0) * 1e-3 or 0.3
+                cog = np.radians(m.cog * 1e-2)
+                gps.append(
+                    (
+                        ts,
+                        m.lat * 1e-7,
+                        m.lon * 1e-7,
+                        m.alt * 1e-3,
+                        m.vel * 1e-2 * np.cos(cog),
+                        m.vel * 1e-2 * np.sin(cog),
+                        0.0,
+                        h_acc,
+                        v_acc,
+                        s_acc,
+                        getattr(m, "alt_ellipsoid", 0) * 1e-3,
+                    )
+                )
+            elif kind == "SCALED_PRESSURE":
+                baro.append((ts, float(m.press_abs) * 100.0))
+            elif kind == "GLOBAL_POSITION_INT":
+                ref.append(
+                    (ts, m.lat * 1e-7, m.lon * 1e-7, m.alt * 1e-3, m.vx * 0.01, m.vy * 0.01, m.vz * 0.01)
+                )
+            elif kind == "ATTITUDE":
+                att.append((ts, np.degrees(m.roll), np.degrees(m.pitch), np.degrees(m.yaw)))
+    key = "SCALED_IMU" if len(imu_rows["SCALED_IMU"]) >= 2 else "RAW_IMU"
+    if len(imu_rows[key]) < 2:
+        raise DataFormatError(
+            f"no SCALED_IMU/RAW_IMU messages{because(decoder)}", path=str(p), column="SCALED_IMU"
+        )
+    if len(gps) < 2:
+        raise DataFormatError(
+            f"fewer than 2 GPS_RAW_INT fixes with fix_type >= 3{because(decoder)}",
+            path=str(p),
+            column="GPS_RAW_INT",
+        )
+
+    def increasing(a: np.ndarray) -> np.ndarray:
+        keep = np.zeros(a.shape[0], dtype=bool)
+        last = -np.inf
+        for i, x in enumerate(a[:, 0]):
+            if x > last:
+                keep[i], last = True, x
+        return a[keep]
+
+    a = increasing(np.asarray(imu_rows[key], dtype=np.float64))
+    g = increasing(np.asarray(gps, dtype=np.float64))
+    t0 = float(a[0, 0])
+    imu = ImuLog(
+        a[:, 0] - t0,
+        a[:, 1:4],
+        a[:, 4:7],
+        meta={"source": str(p), "format": "mavlink-tlog", "message": key, "frame": "FRD"},
+    )
+    mag_ok = np.linalg.norm(a[:, 7:10], axis=1) > 0
+    mag = MagData(a[mag_ok, 0] - t0, a[mag_ok, 7:10]) if mag_ok.sum() >= 2 else None
+    # GPS_RAW_INT.alt is AMSL; MAVLink 2 adds alt_ellipsoid (0 when not sent): then the fixes are
+    # ellipsoidal and the estimate (GLOBAL_POSITION_INT.alt, AMSL) moves by the receiver's N
+    n_geoid = None
+    datum = HeightDatum.AMSL
+    has_ell = g[:, 10] != 0
+    if np.all(has_ell):
+        n_geoid = receiver_undulation(g[:, 10], g[:, 3])
+        g[:, 3] = g[:, 10]
+        datum = HeightDatum.ELLIPSOID
+    # GPS_RAW_INT has no vertical velocity: derive it from the fixes' height.
+    g[:, 6] = -np.gradient(g[:, 3], g[:, 0]) if g.shape[0] >= 2 else 0.0
+    gnss = GnssData(
+        g[:, 0] - t0, g[:, 1], g[:, 2], g[:, 3], g[:, 4:7], g[:, 7], g[:, 8], g[:, 9],
+        alt_datum=datum, geoid_undulation_m=n_geoid,
+    )  # fmt: skip
+    b = increasing(np.asarray(baro, dtype=np.float64)) if len(baro) >= 2 else None
+    baro_d = BaroData(b[:, 0] - t0, isa_pressure_altitude(b[:, 1])) if b is not None else None
+    reference = None
+    if len(ref) >= 2:
+        r = increasing(np.asarray(ref, dtype=np.float64))
+        eul = None
+        if len(att) >= 2:
+            at = increasing(np.asarray(att, dtype=np.float64))
+            eul = np.column_stack(
+                [np.interp(r[:, 0], at[:, 0], at[:, i]) for i in (1, 2)]
+                + [
+                    np.degrees(
+                        np.arctan2(
+                            np.interp(r[:, 0], at[:, 0], np.sin(np.radians(at[:, 3]))),
+                            np.interp(r[:, 0], at[:, 0], np.cos(np.radians(at[:, 3]))),
+                        )
+                    )
+                ]
+            )
+        reference = Trajectory(
+            r[:, 0] - t0,
+            r[:, 1],
+            r[:, 2],
+            r[:, 3] + (n_geoid or 0.0),
+            r[:, 4:7],
+            eul,
+            name="ArduPilot GLOBAL_POSITION_INT + ATTITUDE"
+            + ("" if n_geoid is None else f" (AMSL + receiver geoid undulation {n_geoid:+.2f} m)"),
+            alt_datum=datum,
+        )
+    return Flight(
+        imu,
+        gnss,
+        baro_d,
+        mag,
+        reference=reference,
+        imus={key: imu},
+        meta={
+            "source": str(p),
+            "format": "mavlink-tlog",
+            "imu": key,
+            "t0_wall_s": t0,
+            "note": f"telemetry IMU at {imu.sample_rate:.1f} Hz on arrival time stamps: "
+            "it limits the accuracy",
+        },
+    )
+
+
+class TlogFormat(LogFormat):
+    """MAVLink telemetry log (see the module docs)."""
+
+    name = "mavlink-tlog"
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {
+        "imus": IMU_TYPES,
+        "imu": IMU_TYPES,
+        "nav": NAV_TYPES,
+        "flight": ("GLOBAL_POSITION_INT", "MISSION_ITEM_INT", "MISSION_ITEM", "MISSION_ITEM_REACHED",
+                   "WIND", "PARAM_VALUE"),
+        "plan": ("MISSION_ITEM_INT", "MISSION_ITEM"),
+        "params": ("PARAM_VALUE",),
+        "limits": ("PARAM_VALUE",),
+        "modes": ("HEARTBEAT",),
+        "identity": ("HEARTBEAT", "AUTOPILOT_VERSION"),
+    }  # fmt: skip
+
+    def scan(self, types: set[str], previous: Any | None) -> MavlinkScan:
+        if previous is not None and previous.covers(types):
+            return previous  # type: ignore[no-any-return]
+        union = set(types) | (set(previous.types) if previous is not None else set())
+        return MavlinkScan(self.path, union, dialect="ardupilotmega")
+
+    def _messages(self, types: list[str]) -> list[Any]:
+        with reading(self.path, dialect="ardupilotmega") as (conn, _):
+            return list(messages(conn, types, self.path, "MAVLink"))
+
+    def build_imus(self) -> Any:
+        from uasnav.io.tlog import read_tlog
+
+        return read_tlog(self.path)
+
+    def build_imu(self) -> Any:
+        logs = self.build_imus()
+        return logs[sorted(logs)[0]]
+
+    def build_nav(self) -> Flight:
+        return read_tlog_nav(self.path)
+
+    def build_flight(self) -> Any:
+        from uasnav.io.tlog import read_tlog_flight
+
+        return read_tlog_flight(self.path)
+
+    def build_plan(self) -> Any:
+        from uasnav.io.plan_formats.logs import read_tlog_plan
+
+        return read_tlog_plan(self.path)
+
+    def build_params(self) -> dict[str, float]:
+        out = {}
+        for m in self._messages(["PARAM_VALUE"]):
+            out[str(m.param_id).rstrip("\x00")] = float(m.param_value)  # the last value wins
+        return out
+
+    def build_limits(self) -> Any:
+        from uasnav.io.autopilot_limits import ARDUPILOT_PARAMS, PX4_PARAMS, _limits
+
+        params = self.build_params()
+        px4 = any(k.startswith(("MPC_", "EKF2_")) for k in params)
+        return _limits(params, PX4_PARAMS if px4 else ARDUPILOT_PARAMS)
+
+    def build_modes(self) -> ModeTimeline:
+        beats = [m for m in self._messages(["HEARTBEAT"]) if int(m.type) != _GCS]
+        t = np.array([float(m._timestamp) for m in beats], dtype=np.float64)
+        names = [f"MODE_{int(m.custom_mode)}" for m in beats]
+        if t.size and np.any(np.diff(t) < 0):
+            order = np.argsort(t, kind="stable")
+            t, names = t[order], [names[i] for i in order]
+        return changes(t, names, "HEARTBEAT.custom_mode")
+
+    def build_identity(self) -> Identity:
+        msgs = self._messages(["HEARTBEAT", "AUTOPILOT_VERSION"])
+        beat = next((m for m in msgs if m.get_type() == "HEARTBEAT" and int(m.type) != _GCS), None)
+        ver = next((m for m in msgs if m.get_type() == "AUTOPILOT_VERSION"), None)
+        version = None
+        if ver is not None and int(ver.flight_sw_version):
+            v = int(ver.flight_sw_version)
+            version = f"{(v >> 24) & 0xFF}.{(v >> 16) & 0xFF}.{(v >> 8) & 0xFF}"
+        return Identity(
+            autopilot=None
+            if beat is None
+            else AUTOPILOTS.get(int(beat.autopilot), f"MAV_AUTOPILOT {beat.autopilot}"),
+            vehicle_type=None if beat is None else MAV_TYPES.get(int(beat.type), f"MAV_TYPE {beat.type}"),
+            firmware_version=version,
+            vehicle_id=None if beat is None else f"sysid {beat.get_srcSystem()}",
+            utc_at_zero=dt.datetime(1970, 1, 1, tzinfo=dt.timezone.utc),
+            clock="wall",
+        )
+
+
+__all__ = ["TlogFormat", "read_tlog_nav"]
