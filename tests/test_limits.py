@@ -284,8 +284,12 @@ def test_cli_trajectory_predict_three_line_plan_with_a_1e9_m_leg(
 
 
 def test_plan_files_are_read_within_a_byte_limit(tmp_path: Path) -> None:
+    import functools
+
     from uasnav.errors import DataFormatError
-    from uasnav.trajectory.plans import MAX_PLAN_BYTES, read_plan
+    from uasnav.io.plans import MAX_PLAN_BYTES, read_plan_route
+
+    read_plan = functools.partial(read_plan_route, other_as_csv=True)
 
     if Path("/dev/zero").exists():  # before: read to the end of an endless device
         exc = _bounded(lambda: read_plan("/dev/zero"), peak_mb=4 * MAX_PLAN_BYTES / MB)

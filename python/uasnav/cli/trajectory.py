@@ -6,7 +6,7 @@ import math
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 import numpy as np
@@ -147,7 +147,8 @@ def train(
     # error line only
     with warnings_after_success():
         # flight logs and/or element datasets (.parquet, e.g. from `uasnav fleet elements`)
-        all_s, n_runs = training_samples(flights, plan, speed, wind, segment, max_gap)
+        opened: dict[str, Any] = {}
+        all_s, n_runs = training_samples(flights, plan, speed, wind, segment, max_gap, opened=opened)
         why = None
         model: KinematicPredictor | TrajectoryPredictor
         if method == "lvq":
@@ -160,7 +161,7 @@ def train(
                 )
                 model = TrajectoryPredictor(segment, prototypes, algorithm, random_state=seed).fit(all_s)
         else:
-            lim, lim_log = _log_limits(flights)
+            lim, lim_log = _log_limits(flights, opened)
             model = KinematicPredictor(
                 segment, lim.accel_ms2 or 1.0, lim.climb_ms or 2.5, lim.descent_ms or 1.5,
                 accel_z_ms2=lim.accel_z_ms2 or 1.0, limits_source=_limits_source(lim, lim_log),
@@ -228,14 +229,14 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3
         return
     if home_alt is not None:
         raise click.UsageError("--home-alt applies to the 3D route: give --route too")
+    from uasnav.io.plans import read_plan_route
     from uasnav.trajectory.models import load_model, method_of
-    from uasnav.trajectory.plans import read_plan
 
     # options first, files second: a typo in an option is reported before any file is read
     wind = parse_wind(wind_text)
     req = parse_float_list(required, "--required") if required else None
     model = load_model(model_path)
-    plan_ne, _ = read_plan(plan_path)
+    plan_ne, _ = read_plan_route(plan_path, other_as_csv=True)
     p = model.predict(plan_ne, wind, speed)
     feas = None
     if req is not None:
@@ -307,15 +308,16 @@ def _predict_route(
     click.echo(f"ETA {p.eta_s:.1f} s ({method_of(model)} model, {len(route)} route points)")
 
 
-def _log_limits(flights: Sequence[str]) -> tuple[AutopilotLimits, str | None]:
+def _log_limits(flights: Sequence[str], logs: Any) -> tuple[AutopilotLimits, str | None]:
     """The autopilot limits of the first log among ``flights`` that carries an acceleration
     limit, completed with the defaults (CSV flights carry no parameters), and that log's name
-    (None: all defaults)."""
-    from uasnav.io.autopilot_limits import AutopilotLimits, read_autopilot_limits
+    (None: all defaults). ``logs`` are the logs as opened by ``flight_samples`` (path → LogFile):
+    their limits come from the same decoding pass."""
+    from uasnav.io.autopilot_limits import AutopilotLimits
 
     for f in flights:
-        if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg"):
-            lim = read_autopilot_limits(f)
+        if str(f) in logs:
+            lim = logs[str(f)].limits
             if lim.accel_ms2 is not None:
                 return lim.or_defaults(), Path(f).name
     return AutopilotLimits().or_defaults(), None
@@ -359,7 +361,7 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         # prints its one error line only
         with warnings_after_success():
             fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
-            limits, _ = _log_limits(flights)
+            limits, _ = _log_limits(flights, fs.logs)
             errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
         table = {
             e.name: {

@@ -11,6 +11,8 @@ trains on the result.
 
 from __future__ import annotations
 
+from typing import Any
+
 from uasnav.fleet.logs import format_of
 from uasnav.fleet.runner import Analysis, LogRows
 from uasnav.trajectory.element_table import ELEMENT_SCHEMA, to_rows
@@ -26,13 +28,20 @@ def elements_log(
     overrides the log's waypoint speed (m/s), ``max_gap_s`` is the largest telemetry gap in a
     measured element (s)."""
     from uasnav.io import read_flight
+    from uasnav.io.logfile import open_log
     from uasnav.trajectory.flights import flight_samples
 
     if format_of(path) not in _TELEMETRY:
         return LogRows([])
-    if not read_flight(path).waypoints:
-        return LogRows([])
-    fs = flight_samples([path], cruise_ms=cruise_ms, segment_m=segment_m, max_gap_s=max_gap_s)
+    if format_of(path) == "flight-csv":
+        if not read_flight(path).waypoints:
+            return LogRows([])
+        source: Any = path
+    else:
+        source = open_log(path, need=("flight",))
+        if not source.flight.waypoints:
+            return LogRows([])
+    fs = flight_samples([source], cruise_ms=cruise_ms, segment_m=segment_m, max_gap_s=max_gap_s)
     rows = []
     for run, s in enumerate(fs.samples):
         s.flight[:] = run

@@ -1,14 +1,13 @@
 """One log of a fleet, read once through :mod:`uasnav.io`: its format, IMUs and identity.
 
-The fleet never parses a format itself: every reader is :mod:`uasnav.io`'s. This module only
-says which reader a file needs (by extension, and for ``.csv`` by the header: CSV v1, x-io or
-the flight CSV) and gathers what every analysis needs: the IMU instances as
-:class:`~uasnav.imu.ImuLog` (``read_dataflash``/``read_tlog`` give every instance, ``read_ulog``
-the primary one) and the vehicle identity written in the log (CSV v1 ``# vehicle:``,
-``# autopilot:``, ``# start_time:`` comments; a ULog's flight-controller UUID and GNSS UTC time;
-a DataFlash log's board identity line and GPS week/time (:func:`uasnav.io.dataflash.read_dataflash_identity`);
-a ``.tlog``'s wall-clock time stamps; else ``unknown``). A ULog's IMUs are the primary one and
-every ``sensor_gyro``/``sensor_accel`` instance (:func:`uasnav.io.px4.read_ulog_imus`). A CSV v1 log ``X.csv``
+The fleet never parses a format itself: every log is opened with :func:`uasnav.io.open_log`
+(one decoding pass). This module names the format (by extension, and for ``.csv`` by the
+header: CSV v1, x-io or the flight CSV) and gathers what every analysis needs: the IMU
+instances as :class:`~uasnav.imu.ImuLog` (the ``imus`` view) and the vehicle identity written
+in the log (CSV v1 ``# vehicle:``, ``# autopilot:``, ``# start_time:`` comments; a ULog's
+flight-controller UUID and GNSS UTC time; a DataFlash log's board identity line and GPS
+week/time (the ``identity`` view); a ``.tlog``'s wall-clock time stamps; else ``unknown``). A
+ULog's IMUs are the primary one and every ``sensor_gyro``/``sensor_accel`` instance. A CSV v1 log ``X.csv``
 with ``X_gnss.csv`` beside it is one log of the GNSS/INS flight format (:func:`gnss_companion`);
 a ``.tlog`` without IMU streams is telemetry only.
 """
@@ -16,13 +15,13 @@ a ``.tlog`` without IMU streams is telemetry only.
 from __future__ import annotations
 
 import datetime as dt
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog
-from uasnav.io.flight import FLIGHT_CSV_COLUMNS
+from uasnav.io.logfile import LogFile
 
 #: Format names of the inventory (``format`` column) by reader.
 FORMATS = ("csv-v1", "xio-csv", "flight-csv", "npz", "px4-ulog", "ardupilot-dataflash", "mavlink-tlog")
@@ -44,6 +43,8 @@ class FleetLog:
         Identifiers written in the log, if any.
     start_time : datetime or None
         Start of the recording (UTC), if the log says.
+    file : LogFile or None
+        The opened log, for further views from the same decoding pass.
     """
 
     path: str
@@ -52,6 +53,7 @@ class FleetLog:
     vehicle: str | None = None
     autopilot: str | None = None
     start_time: dt.datetime | None = None
+    file: LogFile | None = field(default=None, compare=False, repr=False)
 
     @property
     def day(self) -> str | None:
@@ -60,24 +62,11 @@ class FleetLog:
 
 
 def csv_kind(path: str) -> str:
-    """``csv-v1``, ``xio-csv`` or ``flight-csv`` from the first non-comment line of a CSV file."""
-    from uasnav.io import is_xio_csv
+    """``csv-v1``, ``xio-csv`` or ``flight-csv`` from the header
+    (:func:`uasnav.io.formats.csvlog.csv_kind`)."""
+    from uasnav.io.formats.csvlog import csv_kind as kind
 
-    with open(path, "rb") as fh:
-        for _ in range(1000):
-            raw = fh.readline(4096)
-            if not raw:
-                break
-            line = raw.decode("utf-8", errors="replace").lstrip("\ufeff").strip()
-            if not line or line.startswith("#"):
-                continue
-            if is_xio_csv(line):
-                return "xio-csv"
-            cols = [c.strip() for c in line.split(",")]
-            if cols[: len(FLIGHT_CSV_COLUMNS)] == list(FLIGHT_CSV_COLUMNS) or {"lat", "lon"} <= set(cols):
-                return "flight-csv"
-            return "csv-v1"
-    return "csv-v1"
+    return kind(path)
 
 
 #: Suffix of the GNSS CSV that goes with a CSV v1 IMU log (``X.csv`` + ``X_gnss.csv``, the
@@ -126,14 +115,13 @@ def _start_time(meta: dict[str, Any]) -> dt.datetime | None:
     return t.replace(tzinfo=dt.timezone.utc) if t.tzinfo is None else t.astimezone(dt.timezone.utc)
 
 
-def _tlog_start(path: str) -> dt.datetime | None:
+def _tlog_start(log: LogFile) -> dt.datetime | None:
     """A .tlog's telemetry is stamped with the ground station's wall clock (UTC, s): its first
     GNSS sample dates the log. None without one (or before 2000: not a wall clock)."""
     from uasnav.errors import UasnavError
-    from uasnav.io import read_flight
 
     try:
-        t0 = float(read_flight(path).t[0])
+        t0 = float(log.flight.t[0])
     except (UasnavError, IndexError):
         return None
     if t0 < 946_684_800:  # 2000-01-01
@@ -141,46 +129,50 @@ def _tlog_start(path: str) -> dt.datetime | None:
     return dt.datetime.fromtimestamp(t0, tz=dt.timezone.utc)
 
 
-def read_fleet_log(path: str) -> FleetLog:
-    """Read ``path`` once with the reader its format needs (module docs)."""
-    from uasnav import io
+def read_fleet_log(path: str, need: tuple[str, ...] = ()) -> FleetLog:
+    """Read ``path`` once (:func:`uasnav.io.open_log`, one decoding pass for the IMUs, the
+    identity and the views ``need`` that the caller reads next from ``FleetLog.file``)."""
+    from uasnav.io.logfile import open_log
 
     fmt = format_of(path)
     imus: dict[str, ImuLog]
-    identity: dict[str, Any] = {}
+    vehicle = None
+    boot_utc = None
     if fmt in ("csv-v1", "xio-csv", "npz"):
-        imus = {"imu0": io.read_log(path)}
-    elif fmt == "px4-ulog":
-        from uasnav.io.px4 import read_ulog_imus
-
-        imus = read_ulog_imus(path)
-    elif fmt == "ardupilot-dataflash":
-        from uasnav.io.dataflash import read_dataflash_identity
-
-        imus = io.read_dataflash(path)
-        identity = read_dataflash_identity(path)
+        log = open_log(path, need=("imu", *need))
+        imus = {"imu0": log.imu}
+    elif fmt in ("px4-ulog", "ardupilot-dataflash"):
+        log = open_log(path, need=("imus", "identity", *need))
+        imus = dict(log.imus)
+        if fmt == "ardupilot-dataflash":
+            ident = log.identity
+            if ident.board and ident.vehicle_id:
+                vehicle = f"{ident.board} {ident.vehicle_id}"  # the board identity line of MSG
+            boot_utc = ident.utc_at_zero
     elif fmt == "mavlink-tlog":
+        log = open_log(path, need=("imus", "flight", *need))
         try:
-            imus = io.read_tlog(path)
+            imus = dict(log.imus)
         except DataFormatError as imu_error:
             # a ground station's telemetry often streams no IMU: then it is telemetry only
             # (like a flight CSV) if it has position fixes, else the reader's error stands
             try:
-                io.read_flight(path)
+                log.view("flight")
             except DataFormatError:
                 raise imu_error from None
             imus = {}
     else:  # flight CSV: telemetry only
-        io.read_flight(path)
+        log = open_log(path, need=("flight", *need))
+        log.view("flight")
         imus = {}
     meta = dict(next(iter(imus.values())).meta) if imus else {}
-    if "vehicle" in identity:
-        meta["vehicle"] = identity["vehicle"]
+    if vehicle is not None:
+        meta["vehicle"] = vehicle
     start = _start_time(meta)
-    if start is None and "boot_utc" in identity and imus:
-        start = identity["boot_utc"] + dt.timedelta(seconds=min(float(m.t[0]) for m in imus.values()))
+    if start is None and boot_utc is not None and imus:
+        start = boot_utc + dt.timedelta(seconds=min(float(m.t[0]) for m in imus.values()))
     if start is None and fmt == "mavlink-tlog":
-        start = _tlog_start(path)
+        start = _tlog_start(log)
     return FleetLog(
         path=path,
         format=fmt,
@@ -188,6 +180,7 @@ def read_fleet_log(path: str) -> FleetLog:
         vehicle=meta.get("vehicle"),
         autopilot=meta.get("autopilot") or _AUTOPILOT.get(fmt),
         start_time=start,
+        file=log,
     )
 
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 import pyarrow as pa
 
 from uasnav.errors import UasnavError
-from uasnav.fleet.logs import gnss_companion, read_fleet_log
+from uasnav.fleet.logs import format_of, gnss_companion, read_fleet_log
 from uasnav.fleet.runner import Analysis, LogRows
 
 IMU_TYPE = pa.struct(
@@ -60,9 +60,7 @@ _TELEMETRY = ("px4-ulog", "ardupilot-dataflash", "mavlink-tlog", "flight-csv")
 
 def scan_log(path: str) -> LogRows:
     """The inventory row of one log (module table)."""
-    from uasnav.io import read_flight
-
-    log = read_fleet_log(path)
+    log = read_fleet_log(path, need=("flight",) if format_of(path) in _TELEMETRY else ())
     imus = []
     duration = 0.0
     for name, imu in sorted(log.imus.items()):
@@ -79,7 +77,7 @@ def scan_log(path: str) -> LogRows:
     gnss, waypoints = False, 0
     if log.format in _TELEMETRY:
         try:
-            fl = read_flight(path)
+            fl = log.file.flight if log.file is not None else None
         except UasnavError:
             fl = None  # no (valid) GNSS in this log: that is what the column says
         if fl is not None:

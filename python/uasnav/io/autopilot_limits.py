@@ -105,27 +105,6 @@ def _limits(values: dict[str, float], table: dict[str, tuple[str, float]]) -> Au
     return AutopilotLimits(**out, source=tuple(sorted(out)))
 
 
-def _mavlink_params(p: Path) -> dict[str, float]:
-    from uasnav.io._mavlink import messages, reading
-
-    tlog = p.suffix.lower() == ".tlog"
-    kind = "PARAM_VALUE" if tlog else "PARM"
-    values: dict[str, float] = {}
-    with reading(p) as (conn, _):
-        for m in messages(conn, [kind], p, "MAVLink" if tlog else "DataFlash"):
-            name = (m.param_id if tlog else m.Name).rstrip("\x00")
-            if name in ARDUPILOT_PARAMS:
-                values[name] = float(m.param_value if tlog else m.Value)  # the last value logged wins
-    return values
-
-
-def _ulog_params(p: Path) -> dict[str, float]:
-    from uasnav.io.px4 import _open
-
-    ulog, _ = _open(p, [])  # parameters only: no topic
-    return {k: float(v) for k, v in ulog.initial_parameters.items() if k in PX4_PARAMS}
-
-
 def read_autopilot_limits(path: str | os.PathLike[str]) -> AutopilotLimits:
     """The navigation limits configured in a flight log (``.tlog``, ``.bin``, ``.ulg``).
 
@@ -151,12 +130,12 @@ def read_autopilot_limits(path: str | os.PathLike[str]) -> AutopilotLimits:
     ...
     uasnav.errors.DataFormatError: mission.csv: no autopilot parameters in a '.csv' file (.tlog .bin .ulg)
     """
+    from uasnav.io.logfile import open_log
+
     p = Path(path)
     ext = p.suffix.lower()
-    if ext in (".tlog", ".bin"):
-        return _limits(_mavlink_params(p), ARDUPILOT_PARAMS)
-    if ext == ".ulg":
-        return _limits(_ulog_params(p), PX4_PARAMS)
+    if ext in (".tlog", ".bin", ".ulg"):
+        return open_log(p, need=("limits",)).limits  # type: ignore[no-any-return]
     raise DataFormatError(f"no autopilot parameters in a {ext!r} file (.tlog .bin .ulg)", path=str(p))
 
 

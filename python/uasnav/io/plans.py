@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from uasnav.errors import InputError
+from uasnav.io.logfile import open_log
 from uasnav.io.mission_plan import (
     AltitudeFrame,
     HomePosition,
@@ -46,10 +47,8 @@ from uasnav.io.mission_plan import (
 from uasnav.io.plan_formats.csv_plan import read_plan_csv, write_plan_csv
 from uasnav.io.plan_formats.geojson import read_geojson, write_geojson
 from uasnav.io.plan_formats.kml import read_kml, write_kml
-from uasnav.io.plan_formats.logs import read_dataflash_plan, read_tlog_plan
 from uasnav.io.plan_formats.qgc import read_qgc_plan, write_qgc_plan
 from uasnav.io.plan_formats.source import MAX_PLAN_BYTES
-from uasnav.io.plan_formats.ulog import read_ulog_plan
 from uasnav.io.plan_formats.wpl import read_wpl, write_wpl
 
 #: Extension → reader.
@@ -60,9 +59,9 @@ PLAN_READERS: dict[str, Callable[[str | os.PathLike[str]], MissionPlan]] = {
     ".csv": read_plan_csv,
     ".kml": read_kml,
     ".geojson": read_geojson,
-    ".tlog": read_tlog_plan,
-    ".bin": read_dataflash_plan,
-    ".ulg": read_ulog_plan,
+    ".tlog": lambda p: _log_plan(p),
+    ".bin": lambda p: _log_plan(p),
+    ".ulg": lambda p: _log_plan(p),
 }
 #: Extension → writer.
 PLAN_WRITERS: dict[str, Callable[[MissionPlan, str | os.PathLike[str]], None]] = {
@@ -106,10 +105,22 @@ def write_plan(plan: MissionPlan, path: str | os.PathLike[str]) -> None:
     writer(plan, p)
 
 
-def read_plan_route(path: str | os.PathLike[str]) -> tuple[np.ndarray, tuple[float, float, float] | None]:
-    """``plan_route(read_plan(path))``: the horizontal route (north/east m, shape (n, 2)) and its
-    geodetic origin (lat °, lon °, alt m; None for a local plan)."""
-    return plan_route(read_plan(path))
+def read_plan_route(
+    path: str | os.PathLike[str], *, other_as_csv: bool = False
+) -> tuple[np.ndarray, tuple[float, float, float] | None]:
+    """``plan_route(read_plan(path))``: the horizontal route (north/east m, shape (n, 2)) in
+    flown order and its geodetic origin (the first waypoint: lat °, lon °, alt m; None for a
+    local ``north,east`` plan). With ``other_as_csv`` a file of another extension is read as a
+    plan CSV (the predictor's route files), at most :data:`MAX_PLAN_BYTES`."""
+    p = Path(path)
+    if other_as_csv and p.suffix.lower() not in PLAN_READERS:
+        return plan_route(read_plan_csv(p))
+    return plan_route(read_plan(p))
+
+
+def _log_plan(path: str | os.PathLike[str]) -> MissionPlan:
+    """The plan a flight log carries (``open_log(path).plan``)."""
+    return open_log(path, need=("plan",)).plan  # type: ignore[no-any-return]
 
 
 __all__ = [

@@ -173,10 +173,12 @@ def training_samples(
     wind_ne: np.ndarray | None = None,
     segment_m: float = 10.0,
     max_gap_s: float = 5.0,
+    opened: dict[str, Any] | None = None,
 ) -> tuple[ElementSamples, int]:
     """Training samples and number of runs from flight logs and/or element datasets (what
     ``uasnav trajectory train`` accepts); logs go through
-    :func:`uasnav.trajectory.flights.flight_samples`.
+    :func:`uasnav.trajectory.flights.flight_samples` (``opened``, when given, receives the
+    logs as opened there, path → LogFile, for further views from the same decoding pass).
 
     Raises
     ------
@@ -192,6 +194,8 @@ def training_samples(
         fs = flight_samples(logs, plan, cruise_ms, wind_ne, segment_m, max_gap_s)
         parts.append(fs.concat())
         n_runs = len(fs)
+        if opened is not None:
+            opened.update(fs.logs)
     for d in (x for x in inputs if is_element_dataset(x)):
         s, seg, k = read_element_dataset(d)
         if not np.isclose(seg, segment_m):

@@ -9,19 +9,22 @@ given plan when the log has no mission) and numbers the runs across files;
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import InputError
+from uasnav.io import read_flight
 from uasnav.io.autopilot_limits import DEFAULT_LIMITS
+from uasnav.io.flight import FlightLog
+from uasnav.io.logfile import LogFile, open_log
+from uasnav.io.plans import read_plan_route
 from uasnav.trajectory.baselines import evaluate_methods, kinematic_times
 from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, discretise, geodetic_to_local
-from uasnav.trajectory.plans import read_plan
+from uasnav.trajectory.runs import FlownRun, run_samples
 from uasnav.trajectory.samples import ElementSamples, measure_elements
-from uasnav.trajectory.telemetry import FlownRun, read_flight, run_samples
 
 
 @dataclass(frozen=True)
@@ -34,10 +37,13 @@ class FlightSamples:
         Per run, the log it comes from and the run (None for a log measured against a plan).
     samples : tuple of ElementSamples
         Per run, its elements; ``flight`` holds the run's index in ``samples``.
+    logs : dict of str → LogFile
+        The binary logs as opened (their ``limits`` view comes from the same decoding pass).
     """
 
     runs: tuple[tuple[str, FlownRun | None], ...]
     samples: tuple[ElementSamples, ...]
+    logs: dict[str, LogFile] = field(default_factory=dict, compare=False, repr=False)
 
     def __len__(self) -> int:
         return len(self.samples)
@@ -53,7 +59,7 @@ class FlightSamples:
 
 
 def flight_samples(
-    paths: Sequence[str | Path],
+    paths: Sequence[str | Path | LogFile],
     plan: str | Path | None = None,
     cruise_ms: float | None = None,
     wind_ne: NDArray[np.float64] | None = None,
@@ -64,8 +70,8 @@ def flight_samples(
 
     Parameters
     ----------
-    paths : sequence of path
-        Flight logs (.tlog, .bin, .ulg, .csv).
+    paths : sequence of path or LogFile
+        Flight logs (.tlog, .bin, .ulg, .csv), by path or as opened (:func:`uasnav.io.open_log`).
     plan : path, optional
         Geodetic plan CSV (lat,lon,alt) for logs without mission waypoints.
     cruise_ms : float, optional
@@ -85,15 +91,19 @@ def flight_samples(
     """
     runs_all: list[tuple[str, FlownRun | None]] = []
     samples_all: list[ElementSamples] = []
-    for path in paths:
-        log = read_flight(path)
+    opened: dict[str, LogFile] = {}
+    for item in paths:
+        log, lf = _read(item)
+        path = lf.path if isinstance(item, LogFile) and lf is not None else item
+        if lf is not None:
+            opened[str(path)] = lf
         runs: list[FlownRun] | list[None]
         if log.waypoints:
             runs, samples = run_samples(log, segment_m, cruise_ms, wind_ne, max_gap_s=max_gap_s)
         else:
             if plan is None:
                 raise InputError(f"{path}: no mission waypoints in the log; give --plan")
-            plan_ne, origin = read_plan(plan)
+            plan_ne, origin = read_plan_route(plan, other_as_csv=True)
             if origin is None:
                 raise InputError("--plan for telemetry must be geodetic (lat,lon,alt)")
             if cruise_ms is None:
@@ -109,7 +119,19 @@ def flight_samples(
             s.flight[:] = k
             runs_all.append((str(path), r))
             samples_all.append(s)
-    return FlightSamples(tuple(runs_all), tuple(samples_all))
+    return FlightSamples(tuple(runs_all), tuple(samples_all), opened)
+
+
+def _read(path: str | Path | LogFile) -> tuple[FlightLog, LogFile | None]:
+    """The telemetry of ``path`` and, for a binary log, the opened log (one decoding pass for
+    the telemetry and the autopilot limits; an already opened log is used as it is)."""
+    if isinstance(path, LogFile):
+        return path.flight, path
+    p = Path(path)
+    if p.suffix.lower() in (".tlog", ".bin", ".ulg") and p.is_file():
+        lf = open_log(p, need=("flight", "limits"))
+        return lf.flight, lf
+    return read_flight(p), None
 
 
 @dataclass(frozen=True)

@@ -1,9 +1,5 @@
-"""Flown mission runs of flight telemetry, and the elements measured on them.
-
-The telemetry readers live in :mod:`uasnav.io` (one module per log format); this module keeps
-their documented names: :func:`read_flight` (by extension: .csv, .tlog, .bin, .ulg) and
-:class:`FlightLog` are :func:`uasnav.io.read_flight` and :class:`uasnav.io.flight.FlightLog`,
-and ``read_csv``, ``read_tlog``, ``read_dataflash``, ``read_ulog`` the per-format flight readers.
+"""Flown mission runs of flight telemetry (:class:`uasnav.io.flight.FlightLog`, read with
+:func:`uasnav.io.open_log`), and the elements measured on them.
 
 :func:`flown_runs` cuts a log into mission runs (consecutive reached events of increasing
 sequence number) and :func:`run_samples` measures their elements.
@@ -17,13 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import InputError
-from uasnav.io import read_flight
-from uasnav.io.dataflash import read_dataflash_flight as read_dataflash
-from uasnav.io.flight import FLIGHT_CSV_COLUMNS as CSV_COLUMNS
 from uasnav.io.flight import FlightLog
-from uasnav.io.flight import read_flight_csv as read_csv
-from uasnav.io.px4 import read_ulog_flight as read_ulog
-from uasnav.io.tlog import read_tlog_flight as read_tlog
 from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, arc_length_along, geodetic_to_local, plan_length
 from uasnav.trajectory.samples import ElementSamples, measure_elements
 
@@ -146,15 +136,4 @@ def run_samples(
     return runs, samples
 
 
-__all__ = [
-    "CSV_COLUMNS",
-    "FlightLog",
-    "FlownRun",
-    "flown_runs",
-    "read_csv",
-    "read_dataflash",
-    "read_flight",
-    "read_tlog",
-    "read_ulog",
-    "run_samples",
-]
+__all__ = ["FlownRun", "flown_runs", "run_samples"]
