@@ -198,7 +198,8 @@ def _ulog_amsl_origin(path: Path, undulation: float) -> None:
     amsl = 400.0
     gps_f = (("uint64_t", "timestamp"), ("uint8_t", "fix_type"), ("int32_t", "lat"), ("int32_t", "lon"),
              ("int32_t", "alt"), ("int32_t", "alt_ellipsoid"), ("float", "vel_n_m_s"), ("float", "vel_e_m_s"),
-             ("float", "vel_d_m_s"), ("float", "eph"), ("float", "epv"), ("float", "s_variance_m_s"))  # fmt: skip
+             ("float", "vel_d_m_s"), ("float", "eph"), ("float", "epv"),
+             ("float", "s_variance_m_s"))  # fmt: skip
     gps = [
         {"timestamp": int(1e6 + k * 2e5), "fix_type": 3, "lat": 473977000, "lon": 85456000,
          "alt": int(amsl * 1e3), "alt_ellipsoid": int((amsl + undulation) * 1e3), "vel_n_m_s": 0.0,

@@ -10,8 +10,9 @@ from click.testing import CliRunner
 
 from uasnav.cli import main
 from uasnav.errors import InputError
+from uasnav.io import read_flight
+from uasnav.trajectory.runs import flown_runs, run_samples
 from uasnav.trajectory.samples import ElementSamples
-from uasnav.trajectory.telemetry import flown_runs, read_flight, run_samples
 
 TLOG = "flights/phoenix_mission1_arducopter.tlog"
 
@@ -225,14 +226,13 @@ def test_cli_csv_flight_with_plan(tmp_path):
     assert r.exit_code == 1 and "give --plan" in r.output
 
 
-def test_documented_names_are_the_io_readers():
-    # The readers live in uasnav.io; uasnav.trajectory.telemetry keeps its documented names.
-    import uasnav.io as io
-    from uasnav.io import dataflash, flight, px4, tlog
-    from uasnav.trajectory import telemetry
+def test_one_flight_reader_for_every_format(shared_data):
+    # read_flight is open_log's flight view: the same telemetry, no second reader
+    import importlib.util
 
-    assert telemetry.read_flight is io.read_flight and telemetry.FlightLog is flight.FlightLog
-    assert telemetry.read_csv is flight.read_flight_csv and telemetry.read_tlog is tlog.read_tlog_flight
-    assert telemetry.read_dataflash is dataflash.read_dataflash_flight
-    assert telemetry.read_ulog is px4.read_ulog_flight
-    assert telemetry.CSV_COLUMNS == ("t", "lat", "lon", "alt", "v_N", "v_E", "v_D")
+    from uasnav.io import open_log
+
+    assert importlib.util.find_spec("uasnav.trajectory.telemetry") is None
+    a = read_flight(shared_data / TLOG)
+    b = open_log(shared_data / TLOG).flight
+    assert np.array_equal(a.t, b.t) and a.waypoints == b.waypoints and a.reached == b.reached

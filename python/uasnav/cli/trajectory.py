@@ -569,9 +569,8 @@ def intent(  # type: ignore[no-untyped-def]
 ):  # fmt: skip
     """An ASTM F3548 operational intent (W84 volumes) whose volumes contain the predicted 4D
     trajectory with its calibrated time bounds and the buffers."""
-    import pymap3d
-
     from uasnav.cli.utm import parse_time
+    from uasnav.geo import frames
     from uasnav.io.operational_intent import write_intent, write_intent_geojson
     from uasnav.io.plans import plan_cruise_speed, read_plan
     from uasnav.trajectory.calibration import calibrate as fit_bounds
@@ -621,7 +620,7 @@ def intent(  # type: ignore[no-untyped-def]
     up, down, a_z = vertical_limits(model, climb_rate, descent_rate, accel_z)
     write_intent(b.details, out)
     if geojson:
-        la, lo, _ = pymap3d.enu2geodetic(
+        la, lo, _ = frames.enu_to_geodetic(
             b.route_en[:, 0], b.route_en[:, 1], 0.0, b.origin[0], b.origin[1], 0.0
         )
         write_intent_geojson(

@@ -8,7 +8,7 @@ already rotated into the vehicle body frame, so the three sensors share one moun
 (identity) and fusion is a weighted average whose weights come from each IMU's white noise in
 a static window.
 
-The log is read by :func:`uasnav.io.read_dataflash` (times in s). The report runs on simulated
+The log is read by :func:`uasnav.io.open_log` (its ``imus`` view; times in s). The report runs on simulated
 data only; this experiment is asserted by ``tests/test_redundancy.py::test_ardupilot_three_imus``
 and printed by ``python benches/bench_python.py redundancy_ardupilot``.
 """
@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from uasnav import redundancy as R
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
-from uasnav.io import read_dataflash
+from uasnav.io import open_log
 
 FloatArray = NDArray[np.float64]
 
@@ -135,7 +135,7 @@ def read_imus(path: str | os.PathLike[str]) -> list[ImuLog]:
         If the file is unreadable, has fewer than two IMU streams, or the streams share fewer
         than 10 time stamps.
     """
-    logs = read_dataflash(path)
+    logs = open_log(path, need=("imus",)).imus
     if len(logs) < 2:
         raise DataFormatError(f"fewer than two IMU streams ({', '.join(sorted(logs))})", path=str(path))
     try:

@@ -92,9 +92,9 @@ class UtmResult:
 
 
 def _item(cmd: int, e: float, n: float, alt: float, hold: float = 0.0) -> MissionItem:
-    import pymap3d
+    from uasnav.geo import frames
 
-    lat, lon, _ = pymap3d.enu2geodetic(e, n, 0.0, SITE[0], SITE[1], 0.0)
+    lat, lon, _ = frames.enu_to_geodetic(e, n, 0.0, SITE[0], SITE[1], 0.0)
     return MissionItem(
         command=cmd, frame=3, params=(hold, 0.0, 0.0, 0.0), lat_deg=float(lat), lon_deg=float(lon), alt_m=alt
     )
@@ -120,9 +120,9 @@ def survey_mission() -> MissionPlan:
 
 def crossing_mission() -> MissionPlan:
     """A transit crossing the survey east–west at 50 m, from a home 300 m east of it."""
-    import pymap3d
+    from uasnav.geo import frames
 
-    lat, lon, _ = pymap3d.enu2geodetic(300.0, 160.0, 0.0, SITE[0], SITE[1], 0.0)
+    lat, lon, _ = frames.enu_to_geodetic(300.0, 160.0, 0.0, SITE[0], SITE[1], 0.0)
     items = (
         MissionItem(command=22, frame=3, alt_m=50.0),
         _item(16, -150.0, 160.0, 50.0),
@@ -171,8 +171,8 @@ def real_coverage(
     declared the last waypoint reached (it lands short) are not counted."""
     from uasnav.io import read_flight
     from uasnav.trajectory.geometry import arc_length_along
+    from uasnav.trajectory.runs import flown_runs
     from uasnav.trajectory.samples import crossing_times
-    from uasnav.trajectory.telemetry import flown_runs
     from uasnav.trajectory.timebounds import widening
 
     log = read_flight(path)

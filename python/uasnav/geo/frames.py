@@ -9,6 +9,7 @@ height converts it first, :mod:`uasnav.geo.datum`). Arrays broadcast like numpy.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -60,13 +61,20 @@ def ecef_to_geodetic(x: ArrayLike, y: ArrayLike, z: ArrayLike) -> Triple:
     return _pm().ecef2geodetic(x, y, z)  # type: ignore[no-any-return]
 
 
-def radii_of_curvature(lat_deg: ArrayLike) -> tuple[FloatArray, FloatArray]:
+def radii_of_curvature(lat: ArrayLike, *, degrees: bool = True) -> tuple[Any, Any]:
     """Meridian (north–south) and prime-vertical (east–west) radii of curvature (m) at geodetic
-    latitude ``lat_deg`` (Groves eqs. 2.105–2.106)."""
-    s2 = np.sin(np.radians(np.asarray(lat_deg, dtype=np.float64))) ** 2
-    d = 1.0 - WGS84_E2 * s2
-    r_e = WGS84_A / np.sqrt(d)
-    return r_e * (1.0 - WGS84_E2) / d, r_e
+    latitude ``lat`` (degrees, or radians with ``degrees=False``; Groves eqs. 2.105–2.106).
+    A scalar gives floats, an array arrays."""
+    if np.ndim(lat) == 0:
+        phi = math.radians(float(lat)) if degrees else float(lat)  # type: ignore[arg-type]
+        d = 1.0 - WGS84_E2 * math.sin(phi) ** 2
+        r_e = WGS84_A / math.sqrt(d)
+        return r_e * (1.0 - WGS84_E2) / d, r_e
+    a = np.asarray(lat, dtype=np.float64)
+    s2 = np.sin(np.radians(a) if degrees else a) ** 2
+    dd = 1.0 - WGS84_E2 * s2
+    re = WGS84_A / np.sqrt(dd)
+    return re * (1.0 - WGS84_E2) / dd, re
 
 
 __all__ = [

@@ -35,7 +35,7 @@ def ned_difference(
     rlon = np.interp(t, ref.t, ref.lon)
     ralt = np.interp(t, ref.t, ref.alt)
     phi = np.radians(rlat)
-    rn, re = radii_of_curvature(rlat)
+    rn, re = radii_of_curvature(phi, degrees=False)
     dn = np.radians(lat - rlat) * (rn + ralt)
     de = np.radians(lon - rlon) * (re + ralt) * np.cos(phi)
     return np.column_stack([dn, de, -(alt - ralt)])

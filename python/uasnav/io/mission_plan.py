@@ -392,10 +392,10 @@ def plan_route(plan: MissionPlan) -> tuple[np.ndarray, tuple[float, float, float
         alt.append(al)
     if not lat:
         raise InputError(f"{plan.source}: the plan has no positioned waypoint")
-    import pymap3d
+    from uasnav.geo import frames
 
     origin = (lat[0], lon[0], alt[0])
-    n, e, _ = pymap3d.geodetic2ned(np.array(lat), np.array(lon), np.array(alt), *origin)
+    n, e, _ = frames.geodetic_to_ned(np.array(lat), np.array(lon), np.array(alt), *origin)
     ne = np.column_stack([n, e])
     keep = np.concatenate([[True], np.hypot(*np.diff(ne, axis=0).T) > 0.01])
     ne = ne[keep]

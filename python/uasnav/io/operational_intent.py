@@ -362,7 +362,7 @@ def intent_geojson(details: Any, route: list[tuple[float, float, float]] | None 
     64-gons, with their centre and radius kept in the properties) and, if given, the route
     (a LineString of (lon, lat, alt W84)). Properties: ``altitude_lower_w84_m``,
     ``altitude_upper_w84_m``, ``time_start``, ``time_end``, ``index``."""
-    import pymap3d
+    from uasnav.geo import frames
 
     feats: list[dict[str, Any]] = []
     for k, v in enumerate(details.volumes):
@@ -381,7 +381,7 @@ def intent_geojson(details: Any, route: list[tuple[float, float, float]] | None 
             r = float(c.radius.value)
             props["circle"] = {"center": [float(c.center.lng), float(c.center.lat)], "radius_m": r}
             a = np.linspace(0.0, 2 * np.pi, 65)[:-1]
-            la, lo, _ = pymap3d.enu2geodetic(
+            la, lo, _ = frames.enu_to_geodetic(
                 r * np.cos(a), r * np.sin(a), 0.0, c.center.lat, c.center.lng, 0.0
             )
             ring = [[float(x), float(y)] for x, y in zip(lo, la, strict=True)]

@@ -4,7 +4,7 @@ in plan, in height and in time, and what each requires.
 The mission area is GeoJSON (``Polygon``/``MultiPolygon``, a ``Feature`` or
 ``FeatureCollection`` of them; a ``Point`` — the take-off point — or a ``LineString`` is
 buffered by ``buffer_m``). Both area and zones are projected to a local East-North plane (m)
-about the area's centre with :func:`pymap3d.geodetic2enu` and intersected with shapely.
+about the area's centre with :func:`uasnav.geo.frames.geodetic_to_enu` and intersected with shapely.
 
 Height: the flight occupies the band from the ground to ``height_m`` above ground. A zone
 limit given AGL is compared directly; one given AMSL/WGS84 needs the ground elevation
@@ -29,13 +29,13 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import pymap3d
 from shapely import geometry as sg
 from shapely.ops import unary_union
 from shapely.validation import explain_validity
 
 from uasnav import jsoncheck as jc
 from uasnav.errors import DataFormatError, InputError
+from uasnav.geo import frames
 from uasnav.io.ed269 import MAX_BYTES, Volume, Zone, parse_zones
 from uasnav.io.mission_plan import AltitudeFrame, MissionPlan, plan_route
 from uasnav.io.plan_formats.csv_plan import parse_plan_csv
@@ -171,7 +171,7 @@ class MissionArea:
 
 def _enu(pts: list[tuple[float, float]], lon0: float, lat0: float) -> list[tuple[float, float]]:
     a = np.asarray(pts, dtype=float)
-    e, n, _ = pymap3d.geodetic2enu(a[:, 1], a[:, 0], 0.0, lat0, lon0, 0.0)
+    e, n, _ = frames.geodetic_to_enu(a[:, 1], a[:, 0], 0.0, lat0, lon0, 0.0)
     return list(zip(np.atleast_1d(e).tolist(), np.atleast_1d(n).tolist(), strict=True))
 
 
@@ -211,7 +211,7 @@ def area_from_plan(plan: MissionPlan, where: str = "plan", *, buffer_m: float) -
     if len(route) == 0:
         raise InputError(f"{where}: the plan has no positioned item")
     lat0, lon0 = origin[0], origin[1]
-    lat, lon, _ = pymap3d.ned2geodetic(route[:, 0], route[:, 1], 0.0, lat0, lon0, 0.0)
+    lat, lon, _ = frames.ned_to_geodetic(route[:, 0], route[:, 1], 0.0, lat0, lon0, 0.0)
     pts = list(zip(np.atleast_1d(lon).tolist(), np.atleast_1d(lat).tolist(), strict=True))
     part = ("point", pts[:1]) if len(pts) == 1 else ("line", pts)
     alts = tuple(

@@ -40,6 +40,7 @@ from scipy.spatial.transform import Rotation
 
 from uasnav import earth
 from uasnav.errors import InputError
+from uasnav.geo.frames import radii_of_curvature
 from uasnav.imu import ImuLog
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.limits import check_memory
@@ -85,13 +86,6 @@ def _gravity(lat0: float, h: FloatArray) -> FloatArray:
     g = [earth.normal_gravity(lat0, x) for x in (0.0, 1000.0, 2000.0)]
     c = np.polyfit([0.0, 1000.0, 2000.0], g, 2)
     return np.polyval(c, h)
-
-
-def _radii(lat: float) -> tuple[float, float]:
-    s2 = math.sin(lat) ** 2
-    d = 1.0 - earth.WGS84_E2 * s2
-    re = earth.WGS84_A / math.sqrt(d)
-    return re * (1.0 - earth.WGS84_E2) / d, re
 
 
 def _path(
@@ -195,7 +189,7 @@ def simulate_flight(
 
     pos, vel, acc = kin(t)
     lat0, lon0 = math.radians(latitude_deg), math.radians(longitude_deg)
-    rn, re = _radii(lat0)
+    rn, re = radii_of_curvature(lat0, degrees=False)
     h = height_m - pos[:, 2]
     lat = lat0 + pos[:, 0] / (rn + height_m)
     lon = lon0 + pos[:, 1] / ((re + height_m) * math.cos(lat0))

@@ -31,7 +31,7 @@ def geodetic_to_local(
     alt_m: np.ndarray,
     origin: tuple[float, float, float] | None = None,
 ) -> np.ndarray:
-    """WGS-84 geodetic coordinates → local NED (pymap3d ``geodetic2ned``).
+    """WGS-84 geodetic coordinates → local NED (:func:`uasnav.geo.frames.geodetic_to_ned`).
 
     Parameters
     ----------
@@ -47,7 +47,7 @@ def geodetic_to_local(
     ndarray, shape (n, 3)
         North, east, down, m.
     """
-    import pymap3d
+    from uasnav.geo import frames
 
     lat = np.asarray(lat_deg, dtype=float)
     lon = np.asarray(lon_deg, dtype=float)
@@ -60,7 +60,7 @@ def geodetic_to_local(
     if np.any(np.abs(lat) > 90.0):
         raise InputError(f"latitude out of range at waypoint {int(np.flatnonzero(np.abs(lat) > 90)[0])}")
     o = (lat[0], lon[0], alt[0]) if origin is None else origin
-    n, e, d = pymap3d.geodetic2ned(lat, lon, alt, o[0], o[1], o[2])
+    n, e, d = frames.geodetic_to_ned(lat, lon, alt, o[0], o[1], o[2])
     return np.column_stack([n, e, d])
 
 

@@ -137,8 +137,9 @@ def build_intent(
     cruise_ms : float, optional — horizontal speed (default the plan's, else the model's).
     priority : int — F3548 priority.
     """
-    import pymap3d
     import shapely
+
+    from uasnav.geo import frames
 
     bounds = getattr(predictor, "time_bounds_", None)
     if bounds is None:
@@ -165,7 +166,7 @@ def build_intent(
     lat = np.array([p.lat_deg for p in pts])
     lon = np.array([p.lon_deg for p in pts])
     lat0, lon0 = float(lat[0]), float(lon[0])
-    e, n, _ = pymap3d.geodetic2enu(lat, lon, 0.0, lat0, lon0, 0.0)
+    e, n, _ = frames.geodetic_to_enu(lat, lon, 0.0, lat0, lon0, 0.0)
     en = np.column_stack([e, n])
     step = np.hypot(*np.diff(en, axis=0).T)
     v_ref = float(cruise_ms or plan_cruise_speed(plan) or predictor.cruise_ms_)
@@ -212,7 +213,7 @@ def build_intent(
             if dh > SAME_PLACE_M:
                 poly = shapely.LineString([pa, pb]).buffer(lateral_buffer_m, quad_segs=4)
                 ring = np.asarray(poly.exterior.coords)[:-1]
-                la, lo_, _ = pymap3d.enu2geodetic(ring[:, 0], ring[:, 1], 0.0, lat0, lon0, 0.0)
+                la, lo_, _ = frames.enu_to_geodetic(ring[:, 0], ring[:, 1], 0.0, lat0, lon0, 0.0)
                 outline: dict[str, Any] = {
                     "outline_polygon": {
                         "vertices": [{"lat": float(x), "lng": float(y)} for x, y in zip(la, lo_, strict=True)]
@@ -220,7 +221,7 @@ def build_intent(
                 }
                 outlines.append(ring)
             else:
-                la, lo_, _ = pymap3d.enu2geodetic(pa[0], pa[1], 0.0, lat0, lon0, 0.0)
+                la, lo_, _ = frames.enu_to_geodetic(pa[0], pa[1], 0.0, lat0, lon0, 0.0)
                 outline = {
                     "outline_circle": {
                         "center": {"lat": float(la), "lng": float(lo_)},

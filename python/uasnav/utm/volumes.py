@@ -7,7 +7,7 @@ polygon of volume i is ``vertices_m[offsets[i]:offsets[i+1]]`` — and ``circle_
 (x, y, radius) for volumes with an empty vertex range.
 
 Horizontal coordinates are metres east/north in the ENU tangent plane at ``origin`` (the
-centre of the data's latitude/longitude box, pymap3d ``geodetic2enu`` at zero height). Over a
+centre of the data's latitude/longitude box, :func:`uasnav.geo.frames.geodetic_to_enu` at zero height). Over a
 city (tens of km) the plane distorts distances between nearby points by less than
 (d/R)² ≈ 10⁻⁵ relative; data spread over more than :data:`MAX_SPREAD_KM` is refused rather
 than deconflicted in a badly distorted plane (split it by region). Polygon edges are straight
@@ -82,7 +82,7 @@ def _outline(v: Any) -> tuple[np.ndarray, np.ndarray | None]:
 def volume_arrays(intents: Sequence[NamedIntent], off_nominal: bool = False) -> VolumeArrays:
     """Arrays of the ``volumes`` (and with ``off_nominal`` the ``off_nominal_volumes``) of
     ``intents`` (checked F3548 details, :mod:`uasnav.io.operational_intent`)."""
-    import pymap3d
+    from uasnav.geo import frames
 
     if not intents:
         raise InputError("no intents to deconflict")
@@ -110,7 +110,7 @@ def volume_arrays(intents: Sequence[NamedIntent], off_nominal: bool = False) -> 
     lon0 = float((allpts[:, 1].min() + allpts[:, 1].max()) / 2)
     if allpts[:, 1].max() - allpts[:, 1].min() > 180:
         raise InputError("intents on both sides of the antimeridian: deconflict each side separately")
-    e, n, _ = pymap3d.geodetic2enu(allpts[:, 0], allpts[:, 1], 0.0, lat0, lon0, 0.0)
+    e, n, _ = frames.geodetic_to_enu(allpts[:, 0], allpts[:, 1], 0.0, lat0, lon0, 0.0)
     en = np.column_stack([e, n])
     spread = float(np.hypot(e, n).max()) / 1000
     if spread > MAX_SPREAD_KM:

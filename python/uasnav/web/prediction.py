@@ -200,9 +200,9 @@ def predict_plan(
     el = p.elements
     latlon = None
     if origin is not None:
-        import pymap3d
+        from uasnav.geo import frames
 
-        lat, lon, _ = pymap3d.ned2geodetic(plan_ne[:, 0], plan_ne[:, 1], 0.0, *origin)
+        lat, lon, _ = frames.ned_to_geodetic(plan_ne[:, 0], plan_ne[:, 1], 0.0, *origin)
         latlon = np.column_stack([lat, lon])
     waypoints = []
     for i, t in enumerate(p.waypoint_times_s):

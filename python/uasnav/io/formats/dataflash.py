@@ -267,9 +267,9 @@ class DataflashFormat(LogFormat):
         return out
 
     def build_limits(self) -> Any:
-        from uasnav.io.autopilot_limits import ARDUPILOT_PARAMS, _limits
+        from uasnav.io.autopilot_params import ARDUPILOT_PARAMS, limits_from_params
 
-        return _limits(self.build_params(), ARDUPILOT_PARAMS)
+        return limits_from_params(self.build_params(), ARDUPILOT_PARAMS)
 
     def _texts(self) -> list[str]:
         from uasnav.io._mavlink import messages, reading

@@ -257,11 +257,11 @@ class TlogFormat(LogFormat):
         return out
 
     def build_limits(self) -> Any:
-        from uasnav.io.autopilot_limits import ARDUPILOT_PARAMS, PX4_PARAMS, _limits
+        from uasnav.io.autopilot_params import ARDUPILOT_PARAMS, PX4_PARAMS, limits_from_params
 
         params = self.build_params()
         px4 = any(k.startswith(("MPC_", "EKF2_")) for k in params)
-        return _limits(params, PX4_PARAMS if px4 else ARDUPILOT_PARAMS)
+        return limits_from_params(params, PX4_PARAMS if px4 else ARDUPILOT_PARAMS)
 
     def build_modes(self) -> ModeTimeline:
         beats = [m for m in self._messages(["HEARTBEAT"]) if int(m.type) != _GCS]

@@ -267,9 +267,9 @@ class UlogFormat(LogFormat):
         return out
 
     def build_limits(self) -> Any:
-        from uasnav.io.autopilot_limits import PX4_PARAMS, _limits
+        from uasnav.io.autopilot_params import PX4_PARAMS, limits_from_params
 
-        return _limits(self.build_params(), PX4_PARAMS)
+        return limits_from_params(self.build_params(), PX4_PARAMS)
 
     def build_modes(self) -> ModeTimeline:
         vs = _topic(self._ulog(), "vehicle_status")
