@@ -74,23 +74,31 @@ def test_each_command_decodes_a_log_once(
     assert parses[name] == 1, dict(parses)
 
 
-def test_train_and_fleet_scan_decode_a_log_once(
+def test_train_intent_and_fleet_decode_a_log_once(
     shared_data: Path, parses: collections.Counter[str], tmp_path: Path
 ) -> None:
     tlog = shared_data / "flights" / "phoenix_mission1_arducopter.tlog"
-    CliRunner().invoke(
-        main, ["trajectory", "train", str(tlog), "--method", "kinematic", "--out", str(tmp_path / "m.json")]
-    )
+    model = tmp_path / "m.json"
+    _run(["trajectory", "train", str(tlog), "--method", "kinematic", "--out", str(model)])
     assert parses[tlog.name] == 1, dict(parses)
     parses.clear()
+    plan = shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan"
+    CliRunner().invoke(
+        main,
+        ["trajectory", "intent", "--model", str(model), "--plan", str(plan), "--wind", "0@0",
+         "--start", "2026-05-01T09:30:00Z", "--geoid-height", "47", "--limits-from", str(tlog)],
+    )  # fmt: skip
+    assert parses[tlog.name] == 1, dict(parses)
     ulg = shared_data / "logs" / "px4_sample_log_small.ulg"
     (tmp_path / "logs").mkdir()
     (tmp_path / "logs" / ulg.name).symlink_to(ulg)
-    CliRunner().invoke(
-        main,
-        ["fleet", "scan", str(tmp_path / "logs"), "--out", str(tmp_path / "scan.parquet"), "--workers", "0"],
-    )
-    assert parses[ulg.name] == 1, dict(parses)
+    (tmp_path / "logs" / tlog.name).symlink_to(tlog)
+    for sub in ("scan", "imu-health", "elements", "nav"):
+        parses.clear()
+        out = tmp_path / f"{sub}.parquet"
+        CliRunner().invoke(main, ["fleet", sub, str(tmp_path / "logs"), "--out", str(out), "--workers", "0"])
+        want = {ulg.name: 1, tlog.name: 1}
+        assert {k: parses[k] for k in want} == want, (sub, dict(parses))
 
 
 def test_declared_views_share_one_pass(shared_data: Path, parses: collections.Counter[str]) -> None:
@@ -233,3 +241,27 @@ def test_written_ulog_with_an_amsl_ekf2_origin(tmp_path: Path) -> None:
     r = _run(["nav", str(p), "--json"])
     ref = json.loads(r.output)["reference"]
     assert ref["datum"] == "ellipsoid" and ref["vertical_rms_m"] <= 3.0
+
+
+def test_open_log_by_url(shared_data: Path, tmp_path: Path) -> None:
+    import functools
+    import http.server
+    import shutil
+    import threading
+
+    shutil.copy(shared_data / "logs" / "px4_sample_log_small.ulg", tmp_path / "x.ulg")
+
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *a: Any) -> None:
+            """No access log on stderr."""
+
+    handler = functools.partial(Quiet, directory=str(tmp_path))
+    srv = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    try:
+        log = open_log(f"http://127.0.0.1:{srv.server_address[1]}/x.ulg")
+        assert log.format_name == "px4-ulog" and log.imu.n > 100
+        direct = open_log(tmp_path / "x.ulg").imu
+        assert np.array_equal(log.imu.gyro, direct.gyro)
+    finally:
+        srv.shutdown()

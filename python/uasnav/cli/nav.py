@@ -175,6 +175,8 @@ def command(
             "source": result.summary["declination_source"],
         },
         "summary": result.summary,
+        # the datum of the heights the filter flew on and compared in (uasnav.geo.datum)
+        "height_datum": str(flight.gnss.alt_datum),
         "excluded_fixes": result.excluded_fixes,
         "alerts": result.alerts,
         "gnss_outages": [{"start_s": s, "duration_s": d} for s, d in outage_list],

@@ -24,11 +24,14 @@ from the extension (``.csv`` flight CSV, ``.tlog``, ``.bin``, ``.ulg``; see
 Writers are atomic: :func:`write_log` by extension (``.csv`` → CSV v1, ``.npz``) for IMU logs,
 :func:`write_csv_table` for any other numeric table (:mod:`uasnav.io.table`).
 
-One module per format: :mod:`~uasnav.io.csv_v1`, :mod:`~uasnav.io.npz`, :mod:`~uasnav.io.px4`
-(ULog), :mod:`~uasnav.io.dataflash`, :mod:`~uasnav.io.tlog`, :mod:`~uasnav.io.xio`,
-:mod:`~uasnav.io.flight` (flight CSV), :mod:`~uasnav.io.table`. Nothing here imports from the
-rest of uasnav except :mod:`uasnav.imu`, :mod:`uasnav.errors`, :mod:`uasnav.units`,
-:mod:`uasnav.limits` and :mod:`uasnav.atomicfile`.
+One class per log format in :mod:`uasnav.io.formats` (which message types each view needs and
+the format's rules: GNSS delay, EKF origin, height datums, declination parameter, field layouts
+across firmware versions) over the record decoders of :mod:`~uasnav.io.csv_v1`,
+:mod:`~uasnav.io.npz`, :mod:`~uasnav.io.px4` (ULog), :mod:`~uasnav.io.dataflash`,
+:mod:`~uasnav.io.tlog`, :mod:`~uasnav.io.xio`, :mod:`~uasnav.io.alfa`, :mod:`~uasnav.io.flight`
+(flight CSV), :mod:`~uasnav.io.table`. Nothing here imports from the rest of uasnav except
+:mod:`uasnav.imu`, :mod:`uasnav.errors`, :mod:`uasnav.units`, :mod:`uasnav.limits`,
+:mod:`uasnav.geo`, :mod:`uasnav.httpfetch` and :mod:`uasnav.atomicfile`.
 
 Hostile files: every reader gives one :class:`~uasnav.errors.DataFormatError` naming the file
 (and for text the line and column) for malformed content: a stray ``"``, an over-long cell, NUL

@@ -89,6 +89,7 @@ class LogFile:
         self._need: set[str] = set()
         self._cache: dict[str, Any] = {}
         self._scan: Any | None = None
+        self._download: Any = None  # the temporary folder of a log fetched by URL
         self.need(*need)
 
     @property
@@ -195,21 +196,51 @@ class LogFile:
         return self.view("identity")
 
 
+#: How long (s) and how large (bytes) a log fetched by URL may be.
+FETCH_TIMEOUT_S = 600.0
+FETCH_MAX_BYTES = 4 * 1024**3
+
+
 def open_log(path: str | os.PathLike[str], *, need: Iterable[str] = (), **options: Any) -> LogFile:
-    """Open the log ``path`` (see the module docs); ``need`` declares the views to decode in
-    the first pass. ``gnss=`` (a GNSS CSV path or :class:`~uasnav.io.navdata.GnssData`) gives
-    a CSV v1 log its fixes, or replaces a log's own.
+    """Open the log ``path`` — a file, an ALFA folder or an ``http(s)://`` URL, fetched first
+    into a temporary folder that lives as long as the :class:`LogFile` — (see the module docs);
+    ``need`` declares the views to decode in the first pass. ``gnss=`` (a GNSS CSV path or
+    :class:`~uasnav.io.navdata.GnssData`) gives a CSV v1 log its fixes, or replaces a log's own.
 
     Raises
     ------
     InputError
-        Unknown format or view.
+        Unknown format or view; a URL that cannot be fetched (:class:`~uasnav.httpfetch.FetchError`).
     DataFormatError
         A missing or unreadable file (when a view is read; a CSV's layout at once).
     """
+    from uasnav.httpfetch import is_url
+
+    keep: Any = None
+    if is_url(str(path)):
+        keep, path = _fetch(str(path))
     p = Path(path)
     fmt = format_class(p)(p, **options)
-    return LogFile(fmt, need)
+    log = LogFile(fmt, need)
+    log._download = keep
+    return log
 
 
-__all__ = ["EXTENSIONS", "LogFile", "format_class", "open_log"]
+def _fetch(url: str) -> tuple[Any, Path]:
+    """The log at ``url`` downloaded into a new temporary folder (kept with its extension: the
+    format follows it); the folder object (removed when collected) and the file."""
+    import re
+    import tempfile
+    from urllib.parse import unquote, urlsplit
+
+    from uasnav.httpfetch import download
+
+    tmp = tempfile.TemporaryDirectory(prefix="uasnav-log-")
+    name = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.basename(unquote(urlsplit(url).path))).lstrip(".")
+    local = Path(tmp.name) / (name[-120:] or "log")
+    with open(local, "wb") as fh:
+        download(url, fh, timeout_s=FETCH_TIMEOUT_S, max_bytes=FETCH_MAX_BYTES)
+    return tmp, local
+
+
+__all__ = ["EXTENSIONS", "FETCH_MAX_BYTES", "FETCH_TIMEOUT_S", "LogFile", "format_class", "open_log"]

@@ -63,17 +63,15 @@ class ReplayConnection:
 
 
 class ULogScan:
-    """A PX4 ULog parsed once by pyulog for the topics ``topics`` (``None``: every topic)."""
+    """A PX4 ULog parsed once by pyulog for the topics ``types`` only."""
 
-    def __init__(self, path: Path, topics: Iterable[str] | None) -> None:
+    def __init__(self, path: Path, types: Iterable[str]) -> None:
         self.path = Path(path)
-        self.topics = None if topics is None else frozenset(topics)
-        self.ulog, self.decoder = parse_ulog(self.path, None if self.topics is None else sorted(self.topics))
+        self.types = frozenset(types)
+        self.ulog, self.decoder = parse_ulog(self.path, sorted(self.types))
 
-    def covers(self, topics: Iterable[str] | None) -> bool:
-        if self.topics is None:
-            return True
-        return topics is not None and set(topics) <= self.topics
+    def covers(self, types: Iterable[str]) -> bool:
+        return set(types) <= self.types
 
 
 def decoder_of(scan: Any) -> LibraryOutput:

@@ -4,7 +4,7 @@ EKF origin, height datums, field layouts across firmware versions) live in its o
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -56,10 +56,20 @@ class LogFormat:
             out.update(self.SOURCES.get("nav" if v in NAV_PARTS else v, ()))
         return out
 
+    #: The decoding pass of a binary format (:mod:`uasnav.io.formats._scan`), and its options;
+    #: None for formats read whole.
+    SCANNER: ClassVar[Callable[..., Any] | None] = None
+    SCAN_OPTIONS: ClassVar[dict[str, Any]] = {}
+
     def scan(self, types: set[str], previous: Any | None) -> Any | None:
-        """Decode the file once for ``types`` (a scan object of :mod:`uasnav.io.formats._scan`);
-        None for formats read whole. ``previous`` is the last scan, to merge with."""
-        return None
+        """The scan that covers ``types``: ``previous`` when it does, else one new decoding pass
+        for ``types`` and what ``previous`` held; None for formats read whole."""
+        if self.SCANNER is None:
+            return None
+        if previous is not None and previous.covers(types):
+            return previous
+        union = set(types) | (set(previous.types) if previous is not None else set())
+        return self.SCANNER(self.path, union, **self.SCAN_OPTIONS)
 
     def build(self, view: str, cache: dict[str, Any]) -> Any:
         """The view ``view`` (called with the scan active; ``cache`` holds views already built)."""

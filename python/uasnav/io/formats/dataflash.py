@@ -219,6 +219,7 @@ class DataflashFormat(LogFormat):
     """ArduPilot DataFlash (see the module docs)."""
 
     name = "ardupilot-dataflash"
+    SCANNER = MavlinkScan
     SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {
         "imus": IMU_TYPES,
         "imu": IMU_TYPES,
@@ -231,11 +232,6 @@ class DataflashFormat(LogFormat):
         "identity": ("MSG", "GPS"),
     }
 
-    def scan(self, types: set[str], previous: Any | None) -> MavlinkScan:
-        if previous is not None and previous.covers(types):
-            return previous  # type: ignore[no-any-return]
-        union = set(types) | (set(previous.types) if previous is not None else set())
-        return MavlinkScan(self.path, union)
 
     def build_imus(self) -> Any:
         return read_dataflash(self.path)

@@ -205,6 +205,8 @@ class TlogFormat(LogFormat):
     """MAVLink telemetry log (see the module docs)."""
 
     name = "mavlink-tlog"
+    SCANNER = MavlinkScan
+    SCAN_OPTIONS: ClassVar[dict[str, Any]] = {"dialect": "ardupilotmega"}
     SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {
         "imus": IMU_TYPES,
         "imu": IMU_TYPES,
@@ -218,11 +220,6 @@ class TlogFormat(LogFormat):
         "identity": ("HEARTBEAT", "AUTOPILOT_VERSION"),
     }  # fmt: skip
 
-    def scan(self, types: set[str], previous: Any | None) -> MavlinkScan:
-        if previous is not None and previous.covers(types):
-            return previous  # type: ignore[no-any-return]
-        union = set(types) | (set(previous.types) if previous is not None else set())
-        return MavlinkScan(self.path, union, dialect="ardupilotmega")
 
     def _messages(self, types: list[str]) -> list[Any]:
         with reading(self.path, dialect="ardupilotmega") as (conn, _):

@@ -205,6 +205,7 @@ class UlogFormat(LogFormat):
     """PX4 ULog (see the module docs)."""
 
     name = "px4-ulog"
+    SCANNER = ULogScan
     SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {
         "imus": _IMU,
         "imu": _IMU,
@@ -223,11 +224,6 @@ class UlogFormat(LogFormat):
         "identity": (*_GNSS, "vehicle_status"),
     }
 
-    def scan(self, types: set[str], previous: Any | None) -> ULogScan:
-        if previous is not None and previous.covers(types):
-            return previous  # type: ignore[no-any-return]
-        union = set(types) | (set(previous.topics) if previous is not None and previous.topics else set())
-        return ULogScan(self.path, union)
 
     def _ulog(self) -> Any:
         from uasnav.io.px4 import _open
