@@ -232,7 +232,6 @@ class DataflashFormat(LogFormat):
         "identity": ("MSG", "GPS"),
     }
 
-
     def build_imus(self) -> Any:
         return read_dataflash(self.path)
 

@@ -220,7 +220,6 @@ class TlogFormat(LogFormat):
         "identity": ("HEARTBEAT", "AUTOPILOT_VERSION"),
     }  # fmt: skip
 
-
     def _messages(self, types: list[str]) -> list[Any]:
         with reading(self.path, dialect="ardupilotmega") as (conn, _):
             return list(messages(conn, types, self.path, "MAVLink"))

@@ -224,7 +224,6 @@ class UlogFormat(LogFormat):
         "identity": (*_GNSS, "vehicle_status"),
     }
 
-
     def _ulog(self) -> Any:
         from uasnav.io.px4 import _open
 
