@@ -83,10 +83,10 @@ def test_train_intent_and_fleet_decode_a_log_once(
     assert parses[tlog.name] == 1, dict(parses)
     parses.clear()
     plan = shared_data / "missions" / "mavsdk_qgroundcontrol_sample.plan"
-    CliRunner().invoke(
-        main,
+    _run(
         ["trajectory", "intent", "--model", str(model), "--plan", str(plan), "--wind", "0@0",
-         "--start", "2026-05-01T09:30:00Z", "--geoid-height", "47", "--limits-from", str(tlog)],
+         "--start", "2026-05-01T09:30:00Z", "--geoid-height", "47", "--limits-from", str(tlog),
+         "--out", str(tmp_path / "intent.json")],
     )  # fmt: skip
     assert parses[tlog.name] == 1, dict(parses)
     ulg = shared_data / "logs" / "px4_sample_log_small.ulg"

@@ -129,9 +129,10 @@ def _tlog_start(log: LogFile) -> dt.datetime | None:
     return dt.datetime.fromtimestamp(t0, tz=dt.timezone.utc)
 
 
-def read_fleet_log(path: str, need: tuple[str, ...] = ()) -> FleetLog:
-    """Read ``path`` once (:func:`uasnav.io.open_log`, one decoding pass for the IMUs, the
-    identity and the views ``need`` that the caller reads next from ``FleetLog.file``)."""
+def read_fleet_log(path: str, need: tuple[str, ...] = (), **options: Any) -> FleetLog:
+    """Read ``path`` once (:func:`uasnav.io.open_log`, with its ``options``: one decoding pass
+    for the IMUs, the identity and the views ``need`` that the caller reads next from
+    ``FleetLog.file``)."""
     from uasnav.io.logfile import open_log
 
     fmt = format_of(path)
@@ -139,10 +140,10 @@ def read_fleet_log(path: str, need: tuple[str, ...] = ()) -> FleetLog:
     vehicle = None
     boot_utc = None
     if fmt in ("csv-v1", "xio-csv", "npz"):
-        log = open_log(path, need=("imu", *need))
+        log = open_log(path, need=("imu", *need), **options)
         imus = {"imu0": log.imu}
     elif fmt in ("px4-ulog", "ardupilot-dataflash"):
-        log = open_log(path, need=("imus", "identity", *need))
+        log = open_log(path, need=("imus", "identity", *need), **options)
         imus = dict(log.imus)
         if fmt == "ardupilot-dataflash":
             ident = log.identity
@@ -150,7 +151,7 @@ def read_fleet_log(path: str, need: tuple[str, ...] = ()) -> FleetLog:
                 vehicle = f"{ident.board} {ident.vehicle_id}"  # the board identity line of MSG
             boot_utc = ident.utc_at_zero
     elif fmt == "mavlink-tlog":
-        log = open_log(path, need=("imus", "flight", *need))
+        log = open_log(path, need=("imus", "flight", *need), **options)
         try:
             imus = dict(log.imus)
         except DataFormatError as imu_error:
@@ -162,7 +163,7 @@ def read_fleet_log(path: str, need: tuple[str, ...] = ()) -> FleetLog:
                 raise imu_error from None
             imus = {}
     else:  # flight CSV: telemetry only
-        log = open_log(path, need=("flight", *need))
+        log = open_log(path, need=("flight", *need), **options)
         log.view("flight")
         imus = {}
     meta = dict(next(iter(imus.values())).meta) if imus else {}

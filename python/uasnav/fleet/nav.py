@@ -1,7 +1,7 @@
 """``uasnav fleet nav``: a GNSS/INS replay of every log with IMU and GNSS, scored against its
 reference — the per-log feature added to the runner as one function (:func:`nav_log`).
 
-Each log is read with :func:`uasnav.io.navlog.read_nav` (a CSV v1 IMU log with its
+Each log is read once with :func:`uasnav.io.open_log` (its ``nav`` view; a CSV v1 IMU log with its
 ``X_gnss.csv``, DataFlash, ULog, ``.tlog``) and replayed by :func:`uasnav.ins.run` (the real
 logs' snapshot IMU streams with :meth:`~uasnav.ins.InsConfig.for_logged_imu`, as ``uasnav nav``
 does), then compared by :func:`uasnav.ins.evaluate.compare` with the log's truth (simulated
@@ -92,16 +92,14 @@ def nav_log(path: str) -> LogRows:
     """The GNSS/INS replay row of one log (module docs); no row without IMU or GNSS."""
     from uasnav import ins
     from uasnav.ins import evaluate
-    from uasnav.io.navlog import read_nav
-
     fmt = format_of(path)
     companion = gnss_companion(path) if fmt == "csv-v1" else None
     if fmt not in _LOGGED and companion is None:
         return LogRows([])
-    log = read_fleet_log(path)
-    if not log.imus:
+    log = read_fleet_log(path, need=("nav",), gnss=companion)
+    if not log.imus or log.file is None:
         return LogRows([], vehicle=log.vehicle, day=log.day)
-    flight = read_nav(path, gnss_csv=companion)
+    flight = log.file.nav
     truth = flight.truth if flight.truth is not None else _truth(flight)
     if truth is not None:
         flight = dataclasses.replace(flight, truth=truth)
