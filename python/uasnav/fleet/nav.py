@@ -92,6 +92,7 @@ def nav_log(path: str) -> LogRows:
     """The GNSS/INS replay row of one log (module docs); no row without IMU or GNSS."""
     from uasnav import ins
     from uasnav.ins import evaluate
+
     fmt = format_of(path)
     companion = gnss_companion(path) if fmt == "csv-v1" else None
     if fmt not in _LOGGED and companion is None:
