@@ -59,7 +59,10 @@ def chunk_bytes() -> int:
 
 def _line_count(raw: bytes) -> int:
     """Line breaks in ``raw`` (``\\n``, ``\\r\\n`` or ``\\r``, like :func:`split_lines`)."""
-    return raw.count(b"\n") + raw.count(b"\r") - raw.count(b"\r\n")
+    n = raw.count(b"\n")
+    if raw.find(b"\r") >= 0:
+        n += raw.count(b"\r") - raw.count(b"\r\n")
+    return n
 
 
 def _cut(buf: bytes) -> int:
@@ -116,8 +119,8 @@ class NumericCsv:
         self.comments: list[str] = []
         self.header: list[str] = []
         self.header_line = 0
-        self._pending = b""  # bytes read and not yet yielded
-        self._line = 1  # file line of self._pending's first byte
+        self._carry = b""  # bytes read and not yet yielded
+        self._line = 1  # file line of self._carry's first byte
         self._eof = False
         self.data_start = 0  # byte offset of the data (after the header row)
 
@@ -169,65 +172,74 @@ class NumericCsv:
 
     def _read_head(self) -> bool:
         raw = self._fh.read(self._chunk)
-        at_end = len(raw) < self._chunk
-        self._eof = at_end
-        n = len(raw) if at_end else _cut(raw)
-        if n == 0:
-            return False
-        head = raw[:n]
-        text = decode(head, self.source)  # BOM, UTF-8, NUL: errors as for the whole text
-        bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
-        lines = split_lines(text)
+        self._eof = len(raw) < self._chunk
+        bom = 3 if raw.startswith(b"\xef\xbb\xbf") else 0
+        # the comment lines and the header row, found in bytes: only they are decoded here (the
+        # data rows are checked chunk by chunk)
+        end = bom
+        for m in _LINE_BREAKS.finditer(raw, bom):
+            line = raw[end : m.start()]
+            end = m.end()
+            if not (line.startswith(b"#") or not line.strip()):
+                break
+        else:
+            if not self._eof:
+                return False  # no header in the first chunk: the whole text decides
+            end = len(raw)
+        head = raw[:end]
+        if b'"' in head:
+            return False  # quoting in the comments or header: the whole text decides
+        lines = split_lines(decode(head, self.source))  # BOM, UTF-8, NUL: as for the whole text
         i = 0
         while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
             i += 1
-        if i >= len(lines):
-            return False  # no header in the first chunk (or an empty file): the whole text decides
-        try:
-            first = next(csv_rows(lines, i, self.source), None)
-        except DataFormatError:
-            return False  # a malformed header row: the whole text names it
-        if first is None:
-            return False
+        first = next(csv_rows(lines, i, self.source), None) if i < len(lines) else None
+        if first is None or first[0] != len(lines):
+            return False  # an empty file, a header row told otherwise: the whole text decides
         self.header_line, cells = first
         self.header = [h.strip() for h in cells]
         self.comments = lines[: self.header_line - 1]
-        # the data start after the header row's line break
-        ends = [m.end() for m, _ in zip(_LINE_BREAKS.finditer(head, bom), range(self.header_line), strict=False)]
-        if len(ends) < self.header_line:
-            if not at_end:
-                return False
-            ends.append(len(head))
-        self.data_start = ends[-1]
-        self._pending = raw[self.data_start :]
+        self.data_start = end
+        self._carry = raw[end:]
         self._line = self.header_line + 1
         return True
 
-    def _chunks(self) -> Iterator[tuple[int, bytes, bytes]]:
-        """(first line, chunk of whole lines, the whole lines of up to :data:`_LOOKAHEAD` bytes
-        that follow). The reading position is kept on ``self`` before each chunk is yielded, so
-        a second iterator (:meth:`fail`) goes on after the chunk the first one yielded last."""
+    def _chunks(self) -> Iterator[tuple[int, bytes]]:
+        """(first line, chunk of whole lines). The reading position is kept on ``self`` before
+        each chunk is yielded, so a second iterator (:meth:`fail`) goes on after the chunk the
+        first one yielded last."""
         while True:
-            while not self._eof and len(self._pending) < 2 * self._chunk + _LOOKAHEAD:
-                more = self._fh.read(self._chunk)
-                self._eof = not more
-                self._pending += more
-            buf = self._pending
+            buf = self._carry
+            if not self._eof and len(buf) < self._chunk:
+                more = self._fh.read(self._chunk - len(buf))
+                self._eof = len(more) < self._chunk - len(buf)
+                buf = buf + more if buf else more
             if not buf:
                 return
-            if self._eof and len(buf) <= self._chunk:
-                n = len(buf)
-            else:
-                n = _cut(buf[: self._chunk]) or _cut(buf[: 4 * self._chunk])
-                if n == 0:  # a line of more than 4 chunks: the row-by-row reader judges it
-                    n = len(buf) if self._eof else min(len(buf), 4 * self._chunk)
-            part, after = buf[:n], buf[n : n + _LOOKAHEAD]
-            if not (self._eof and n + len(after) == len(buf)):
-                after = after[: _cut(after)]
+            n = len(buf) if self._eof else _cut(buf)
+            while n == 0 and not self._eof and len(buf) < 4 * self._chunk:  # a very long line
+                more = self._fh.read(self._chunk)
+                self._eof = len(more) < self._chunk
+                buf += more
+                n = len(buf) if self._eof else _cut(buf)
+            n = n or len(buf)  # a line of more than 4 chunks: the row-by-row reader judges it
+            part = buf if n == len(buf) else buf[:n]
+            self._carry = buf[n:]
             first = self._line
-            self._pending = buf[n:]
             self._line += _line_count(part)
-            yield first, part, after
+            yield first, part
+
+    def _lookahead(self) -> bytes:
+        """The whole lines of up to :data:`_LOOKAHEAD` bytes after the last chunk yielded
+        (read now, yielded later)."""
+        if not self._eof and len(self._carry) < _LOOKAHEAD:
+            more = self._fh.read(_LOOKAHEAD)
+            self._eof = len(more) < _LOOKAHEAD
+            self._carry += more
+        after = self._carry[:_LOOKAHEAD]
+        if self._eof and len(after) == len(self._carry):
+            return after
+        return after[: _cut(after)]
 
     def blocks(self, columns: Sequence[str], *, exact_width: bool = False) -> Iterator[Block]:
         """The data rows, chunk by chunk, as :class:`Block` s of ``columns`` (names in
@@ -239,12 +251,11 @@ class NumericCsv:
         DataFormatError
             The first bad row's error (file, line, column), or an encoding error further on.
         """
-        idx = [self.header.index(c) for c in columns]
-        for line, raw, after in self._chunks():
+        for line, raw in self._chunks():
             try:
                 data = self._fast(raw, columns)
                 if data is None:
-                    data = self._row_by_row(raw, after, line, columns, idx, exact_width)
+                    data = self._row_by_row(raw, line, columns, exact_width)
             except DataFormatError as e:
                 self.fail(e)
             yield Block(data, line, raw, self.header, self.source)
@@ -252,7 +263,7 @@ class NumericCsv:
     def fail(self, error: DataFormatError) -> NoReturn:
         """Raise ``error``, or an encoding error (not UTF-8, NUL) in the rest of the file, which
         the whole-text reader finds first."""
-        for first, raw, _ in self._chunks():
+        for first, raw in self._chunks():
             if not raw.isascii() or b"\x00" in raw:
                 decode_part(raw, self.source, first, self.header)
         raise error
@@ -293,12 +304,11 @@ class NumericCsv:
             return None
         return out
 
-    def _row_by_row(
-        self, raw: bytes, after: bytes, line: int, columns: Sequence[str], idx: list[int], exact_width: bool
-    ) -> NDArray[np.float64]:
+    def _row_by_row(self, raw: bytes, line: int, columns: Sequence[str], exact_width: bool) -> NDArray[np.float64]:
         # A '"' may open a quoted cell that runs into the next chunk: the csv module reads on to
         # its field limit, so the text after the chunk is given too (and its rows dropped).
-        text = decode_part(raw + (after if b'"' in raw else b""), self.source, line, self.header)
+        after = self._lookahead() if b'"' in raw else b""
+        text = decode_part(raw + after, self.source, line, self.header)
         lines = split_lines(text)
         data, row_lines = numeric_rows(
             lines, 0, self.source, self.header, columns, exact_width=exact_width, offset=line - 1, min_rows=0
