@@ -121,8 +121,9 @@ def _where(raw: bytes, offset: int, header: Sequence[str] | None = None) -> tupl
     if given, else the first row of ``raw``); otherwise it is ``None`` and the position within
     the line is given instead.
     """
-    line_start = raw.rfind(b"\n", 0, offset) + 1
-    line = raw.count(b"\n", 0, offset) + 1
+    # lines end at \n, \r\n or \r, as split_lines counts them
+    line_start = max(raw.rfind(b"\n", 0, offset), raw.rfind(b"\r", 0, offset)) + 1
+    line = raw.count(b"\n", 0, offset) + raw.count(b"\r", 0, offset) - raw.count(b"\r\n", 0, offset) + 1
     before = raw[line_start:offset].decode("utf-8", errors="replace")
     cell = before.count(",")
     if header is None:
