@@ -28,7 +28,9 @@ def main(src: str = "/usr/share/proj/egm96_15.gtx") -> None:
     # float32 metres row by row from the south.
     lat0, lon0, dlat, dlon, rows, cols = struct.unpack(">4d2i", raw[:40])
     if (lat0, lon0, dlat, dlon, rows, cols) != (-90.0, -180.0, 0.25, 0.25, 721, 1440):
-        raise SystemExit(f"{src}: not the global EGM96 15′ grid ({lat0}, {lon0}, {dlat}, {dlon}, {rows}, {cols})")
+        raise SystemExit(
+            f"{src}: not the global EGM96 15′ grid ({lat0}, {lon0}, {dlat}, {dlon}, {rows}, {cols})"
+        )
     grid = np.frombuffer(raw[40:], dtype=">f4").reshape(rows, cols)
     cm = np.round(grid.astype(np.float64) * 100.0).astype(np.int32)
     packed = np.diff(np.diff(cm, axis=1, prepend=0), axis=0, prepend=0)

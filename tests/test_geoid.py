@@ -129,7 +129,10 @@ def test_geoid_works_without_proj(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
     model, n = out.stdout.rsplit(" ", 1)
     assert model == GEOID_MODEL and abs(float(n) - 28.7068) <= 0.02
-    assert "pyproj" not in Path(geoid.__file__).read_text() and "/usr/share" not in Path(geoid.__file__).read_text()
+    assert (
+        "pyproj" not in Path(geoid.__file__).read_text()
+        and "/usr/share" not in Path(geoid.__file__).read_text()
+    )
 
 
 def test_the_grid_is_package_data():

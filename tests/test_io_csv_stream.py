@@ -154,7 +154,9 @@ def test_memory_is_checked_on_the_projected_log(tmp_path: Path, monkeypatch) -> 
     p = tmp_path / "a.csv"
     write_csv_v1(_sim_log(20_000), p)  # ≈ 5 MB of text, 20 000 × 12 numbers
     monkeypatch.setenv("UASNAV_MAX_MEMORY", "4M")
-    with pytest.raises(ResourceLimitError, match=r"a\.csv: a CSV v1 log of about 1\.9\de\+04 rows × 12 columns needs about"):
+    with pytest.raises(
+        ResourceLimitError, match=r"a\.csv: a CSV v1 log of about 1\.9\de\+04 rows × 12 columns needs about"
+    ):
         read_csv_v1(p)
     # the log's own size decides, not the text's: 6 MB of numbers pass a 16 MB limit
     monkeypatch.setenv("UASNAV_MAX_MEMORY", "16M")
@@ -192,10 +194,12 @@ def test_streamed_calibration_errors_match_the_in_memory_path(tmp_path: Path, sm
         check_training_temp(read_log(p).temp, f"{p}: temp")
     with pytest.raises(InputError) as got:
         load_training_data(p)
-    assert str(got.value) == str(want.value) and "row 1500" in str(got.value) and "3 such rows" in str(got.value)
+    assert (
+        str(got.value) == str(want.value) and "row 1500" in str(got.value) and "3 such rows" in str(got.value)
+    )
     ok = tmp_path / "ok.csv"
     write_csv_v1(log, ok)
-    with pytest.raises(InputError, match="too short for a log of 39.99 s"):
+    with pytest.raises(InputError, match=r"too short for a log of 39\.99 s"):
         load_training_data(ok, 1e-300)
     nt = tmp_path / "notemp.csv"
     write_csv_v1(ImuLog(t=log.t, gyro=log.gyro, accel=log.accel), nt)

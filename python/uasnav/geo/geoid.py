@@ -99,7 +99,9 @@ def geoid_height(lat_deg: ArrayLike, lon_deg: ArrayLike) -> float | NDArray[np.f
         lon = np.asarray(lon_deg, dtype=np.float64)
         lat, lon = np.broadcast_arrays(lat, lon)
     except (TypeError, ValueError) as e:
-        raise InputError(f"geoid height: latitudes/longitudes must be numbers of matching shapes ({e})") from None
+        raise InputError(
+            f"geoid height: latitudes/longitudes must be numbers of matching shapes ({e})"
+        ) from None
     if not (np.all(np.isfinite(lat)) and np.all(np.isfinite(lon)) and np.all(np.abs(lat) <= 90)):
         raise InputError("geoid height: latitudes/longitudes must be finite, |latitude| ≤ 90°")
     grid = geoid_grid()

@@ -98,7 +98,10 @@ class Block:
     def row_lines(self) -> list[int]:
         """The file line of every row (blank lines skipped), told by the row-by-row reader."""
         text = decode_part(self.raw, self.source, self.first_line, self.header)
-        return [ln for ln, _ in csv_rows(split_lines(text), 0, self.source, self.header, offset=self.first_line - 1)]
+        return [
+            ln
+            for ln, _ in csv_rows(split_lines(text), 0, self.source, self.header, offset=self.first_line - 1)
+        ]
 
 
 class NumericCsv:
@@ -135,7 +138,7 @@ class NumericCsv:
         """
         p = str(path)
         try:
-            fh = open(p, "rb")  # noqa: SIM115 (closed by close() / the context manager)
+            fh = open(p, "rb")
         except FileNotFoundError:
             raise DataFormatError("no such file", path=p) from None
         except IsADirectoryError:
@@ -304,7 +307,9 @@ class NumericCsv:
             return None
         return out
 
-    def _row_by_row(self, raw: bytes, line: int, columns: Sequence[str], exact_width: bool) -> NDArray[np.float64]:
+    def _row_by_row(
+        self, raw: bytes, line: int, columns: Sequence[str], exact_width: bool
+    ) -> NDArray[np.float64]:
         # A '"' may open a quoted cell that runs into the next chunk: the csv module reads on to
         # its field limit, so the text after the chunk is given too (and its rows dropped).
         after = self._lookahead() if b'"' in raw else b""

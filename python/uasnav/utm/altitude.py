@@ -54,7 +54,9 @@ def geoid_heights(lat_deg: np.ndarray, lon_deg: np.ndarray) -> np.ndarray:
         The grid is missing from the installation, or a position is not finite / beyond ±90°.
     """
     if geoid_grid_path() is None:
-        raise InputError(f"no geoid model installed: the EGM96 grid {GEOID_GRID} is missing; reinstall uasnav")
+        raise InputError(
+            f"no geoid model installed: the EGM96 grid {GEOID_GRID} is missing; reinstall uasnav"
+        )
     return np.asarray(geoid.geoid_height(lat_deg, lon_deg), dtype=float)
 
 
