@@ -121,7 +121,10 @@ class CsvV1Stream:
             self.meta = _meta(csv.comments)
             self.columns = _columns(csv.header, csv.header_line, self.source)
         except DataFormatError as e:
-            csv.fail(e)
+            try:
+                csv.fail(e)
+            finally:
+                csv.close()
         if csv.size is not None:
             self.data_bytes = csv.size - csv.data_start
 
