@@ -1,7 +1,9 @@
 """Reading text files for the CSV readers: bounded, decoded with positions, parsed row by row.
 
-Every CSV reader of :mod:`uasnav.io` (log format v1, x-io, flight CSV, numeric tables) reads
-through :func:`read_text` and :func:`csv_rows`, so each hostile input gets one
+The CSV readers of :mod:`uasnav.io` (x-io, flight CSV, numeric tables) read through
+:func:`read_text` and :func:`csv_rows`; log format v1 reads in chunks through pyarrow
+(:mod:`uasnav.io._csvstream`) and comes here, chunk by chunk (:func:`decode_part`,
+:func:`numeric_rows` with ``offset``), to name an error. So each hostile input gets one
 :class:`~uasnav.errors.DataFormatError` naming the file, line and (where it can be told) column:
 
 - more bytes than the memory limit allows (checked on the bytes read, so ``/dev/zero`` or a
@@ -27,9 +29,9 @@ from numpy.typing import NDArray
 from uasnav.errors import DataFormatError, ResourceLimitError
 from uasnav.limits import ENV_MEMORY, format_size, max_memory, read_limited
 
-#: Peak bytes of memory per byte of CSV text while a reader parses it (text, lines, Python
-#: floats, the final arrays; measured ≈ 6 on log format v1). The bytes a reader accepts are
-#: ``max_memory() / TEXT_MEMORY_FACTOR``.
+#: Peak bytes of memory per byte of CSV text while a whole-text reader parses it (text, lines,
+#: Python floats, the final arrays; measured ≈ 6 on log format v1). The bytes such a reader
+#: accepts are ``max_memory() / TEXT_MEMORY_FACTOR``.
 TEXT_MEMORY_FACTOR = 8
 
 _BOMS = {
