@@ -78,7 +78,7 @@ def test_without_the_grid_n_must_be_given(monkeypatch):
     assert w84_altitudes(pts, home_amsl_m=None, geoid_height_m=47.0) == pytest.approx([147.0])
 
 
-# PROJ 9 (pyproj 3.7), "+proj=vgridshift +grids=egm96_15.gtx +multiplier=1" on Debian's
+# PROJ 9.5.1 (pyproj 3.7.2), "+proj=vgridshift +grids=egm96_15.gtx +multiplier=1" on Debian's
 # proj-data grid: N (m) at places spread over the globe, the extremes of N (New Guinea, south of
 # India), both poles' first rows and the antimeridian's last column.
 PROJ_VGRIDSHIFT = [
