@@ -21,8 +21,6 @@ setup: $(VENV)/.built browser
 # (Playwright's own browser download does not work on these machines); installed when missing.
 browser:
 	@command -v chromium >/dev/null || (apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium)
-	@# issue 17: EGM96 geoid grid (/usr/share/proj/egm96_15.gtx) for W84 altitudes of F3548 intents
-	@test -f /usr/share/proj/egm96_15.gtx || (apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q proj-data)
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)

@@ -97,6 +97,41 @@ def bench_io(n: int, repeat: int) -> None:
     )
 
 
+def bench_csv_pyarrow(seconds: float, repeat: int) -> None:
+    """CSV log format v1 against the library it reads through: ``read_log`` (chunks of
+    ``pyarrow.csv.read_csv``, every cell checked, t strictly increasing, an ImuLog built) and
+    ``load_training_data`` (calibration block means while reading) against
+    ``pyarrow.csv.read_csv`` of the same file (all columns, types inferred), one process."""
+    import os
+    import tempfile
+
+    import pyarrow.csv as pacsv
+
+    from uasnav import sim
+    from uasnav.io import read_log, write_log
+    from uasnav.thermal import load_training_data
+
+    log = sim.simulate("ax1", profile="soak", duration=seconds, rate=100.0, seed=1)
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "soak.csv")
+        write_log(log, path)
+        size = os.path.getsize(path)
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16).split(b"\n")
+        skip = next(i for i, ln in enumerate(head) if not ln.startswith(b"#"))  # comment lines
+        opts = pacsv.ReadOptions(skip_rows=skip)
+        t_pa = median_time(lambda: pacsv.read_csv(path, read_options=opts), repeat)
+        t_ours = median_time(lambda: read_log(path), repeat)
+        t_pa2 = median_time(lambda: pacsv.read_csv(path, read_options=opts), repeat)
+        t_cal = median_time(lambda: load_training_data(path, 1.0), repeat)
+    t_pa = min(t_pa, t_pa2)
+    print(
+        f"csv v1 vs pyarrow, soak log {log.n} rows × 29 columns ({size / 1e6:.0f} MB): "
+        f"read_log {t_ours:6.2f} s | calibration block means {t_cal:6.2f} s | "
+        f"pyarrow.csv.read_csv {t_pa:6.2f} s | ratio {t_ours / t_pa:4.2f}x / {t_cal / t_pa:4.2f}x"
+    )
+
+
 def bench_sim(n: int, repeat: int) -> None:
     """Full simulator run (ax1: both triads, thermal terms, truth channels) and its flicker
     generator against allantools' Kasdin–Walter power-law noise generator (one axis)."""
@@ -576,6 +611,7 @@ CASES: dict[str, Callable[[bool], None]] = {
     "redundancy_ardupilot": lambda quick: bench_redundancy_ardupilot(1 if quick else 3),
     "noise": lambda quick: bench_noise(0.5 if quick else 2.0, 3 if quick else 5),
     "io": lambda quick: bench_io(10**4 if quick else 10**5, 1 if quick else 3),
+    "csv_pyarrow": lambda quick: bench_csv_pyarrow(300.0 if quick else 3600.0, 3 if quick else 5),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
     "utm": lambda quick: bench_utm(10**4 if quick else 10**5, 500 if quick else 3000, 3),
     "fleet": lambda quick: bench_fleet(

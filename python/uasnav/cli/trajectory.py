@@ -526,7 +526,7 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
     "--geoid-height",
     type=Real(-120.0, 120.0),
     help="Geoid height N at the site (m; W84 = AMSL + N). Default: the EGM96 geoid at each route "
-    "point (PROJ's egm96_15.gtx grid from Debian's proj-data package); required without that grid.",
+    "point (NGA's 15′ grid, shipped with uasnav).",
 )
 @click.option("--home-alt", type=Real(-1000.0, 9000.0), help="Home altitude AMSL (m) if the plan has none.")
 @click.option("--speed", type=POSITIVE, help="Horizontal speed (m/s); default the plan's, else the model's.")

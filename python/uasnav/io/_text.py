@@ -1,7 +1,9 @@
 """Reading text files for the CSV readers: bounded, decoded with positions, parsed row by row.
 
-Every CSV reader of :mod:`uasnav.io` (log format v1, x-io, flight CSV, numeric tables) reads
-through :func:`read_text` and :func:`csv_rows`, so each hostile input gets one
+The CSV readers of :mod:`uasnav.io` (x-io, flight CSV, numeric tables) read through
+:func:`read_text` and :func:`csv_rows`; log format v1 reads in chunks through pyarrow
+(:mod:`uasnav.io._csvstream`) and comes here, chunk by chunk (:func:`decode_part`,
+:func:`numeric_rows` with ``offset``), to name an error. So each hostile input gets one
 :class:`~uasnav.errors.DataFormatError` naming the file, line and (where it can be told) column:
 
 - more bytes than the memory limit allows (checked on the bytes read, so ``/dev/zero`` or a
@@ -27,9 +29,9 @@ from numpy.typing import NDArray
 from uasnav.errors import DataFormatError, ResourceLimitError
 from uasnav.limits import ENV_MEMORY, format_size, max_memory, read_limited
 
-#: Peak bytes of memory per byte of CSV text while a reader parses it (text, lines, Python
-#: floats, the final arrays; measured ≈ 6 on log format v1). The bytes a reader accepts are
-#: ``max_memory() / TEXT_MEMORY_FACTOR``.
+#: Peak bytes of memory per byte of CSV text while a whole-text reader parses it (text, lines,
+#: Python floats, the final arrays; measured ≈ 6 on log format v1). The bytes such a reader
+#: accepts are ``max_memory() / TEXT_MEMORY_FACTOR``.
 TEXT_MEMORY_FACTOR = 8
 
 _BOMS = {
@@ -84,37 +86,50 @@ def decode(raw: bytes, source: str) -> str:
             raise DataFormatError(f"a {name} text file; save it as UTF-8", path=source, line=1)
     if raw.startswith(_UTF8_BOM):
         raw = raw[len(_UTF8_BOM) :]
+    return decode_part(raw, source)
+
+
+def decode_part(raw: bytes, source: str, first_line: int = 1, header: Sequence[str] | None = None) -> str:
+    """``raw`` (a whole file without its BOM, or the whole lines of a file from line
+    ``first_line`` on, below the ``header`` row) decoded as UTF-8; invalid UTF-8 and NUL bytes
+    are a :class:`DataFormatError` naming the file line and the column (see module)."""
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
-        line, column, at = _where(raw, e.start)
+        line, column, at = _where(raw, e.start, header)
         bad = raw[e.start : e.start + 1].hex()
         raise DataFormatError(
             f"not UTF-8 text: byte 0x{bad}{at} ({e.reason}); save the file as UTF-8",
             path=source,
-            line=line,
+            line=first_line - 1 + line,
             column=column,
         ) from None
     nul = text.find("\x00")
     if nul >= 0:
-        line, column, at = _where(raw, len(text[:nul].encode("utf-8")))
+        line, column, at = _where(raw, len(text[:nul].encode("utf-8")), header)
         raise DataFormatError(
-            f"NUL byte{at}: a binary file, not CSV text", path=source, line=line, column=column
+            f"NUL byte{at}: a binary file, not CSV text",
+            path=source,
+            line=first_line - 1 + line,
+            column=column,
         )
     return text
 
 
-def _where(raw: bytes, offset: int) -> tuple[int, str | None, str]:
+def _where(raw: bytes, offset: int, header: Sequence[str] | None = None) -> tuple[int, str | None, str]:
     """Where byte ``offset`` is: (line, CSV column name, " at character k" or "").
 
-    The column is the header name when the offset lies in a data row after a header; otherwise
-    it is ``None`` and the position within the line is given instead.
+    The column is the header name when the offset lies in a data row after a header (``header``
+    if given, else the first row of ``raw``); otherwise it is ``None`` and the position within
+    the line is given instead.
     """
-    line_start = raw.rfind(b"\n", 0, offset) + 1
-    line = raw.count(b"\n", 0, offset) + 1
+    # lines end at \n, \r\n or \r, as split_lines counts them
+    line_start = max(raw.rfind(b"\n", 0, offset), raw.rfind(b"\r", 0, offset)) + 1
+    line = raw.count(b"\n", 0, offset) + raw.count(b"\r", 0, offset) - raw.count(b"\r\n", 0, offset) + 1
     before = raw[line_start:offset].decode("utf-8", errors="replace")
     cell = before.count(",")
-    header = _header_before(raw[:line_start].decode("utf-8", errors="replace"))
+    if header is None:
+        header = _header_before(raw[:line_start].decode("utf-8", errors="replace"))
     if header is not None and cell < len(header):
         return line, header[cell], ""
     return line, None, f" at character {len(before) + 1}"
@@ -139,9 +154,10 @@ def split_lines(text: str) -> list[str]:
 
 
 def csv_rows(
-    lines: Sequence[str], start: int, source: str, header: Sequence[str] | None = None
+    lines: Sequence[str], start: int, source: str, header: Sequence[str] | None = None, *, offset: int = 0
 ) -> Iterator[tuple[int, list[str]]]:
-    """Parse ``lines[start:]`` as CSV: ``(line, cells)`` per row, ``line`` 1-based in the file.
+    """Parse ``lines[start:]`` as CSV: ``(line, cells)`` per row, ``line`` 1-based in the file
+    (``lines[0]`` being file line ``offset + 1``).
 
     ``header`` (the column names, if known) names the column in errors. Blank lines are
     skipped. A row spanning several lines (a ``"`` that opens a quoted cell) and every
@@ -158,19 +174,19 @@ def csv_rows(
         except csv.Error as e:
             line = start + reader.line_num  # the line being read when the error occurred
             text = lines[line - 1] if 0 < line <= len(lines) else ""
-            raise _csv_error(e, text, source, line, header) from None
+            raise _csv_error(e, text, source, offset + line, header) from None
         last = start + reader.line_num
         if last > first:
             quoted = next((j for j, c in enumerate(row) if "\n" in c), len(row) - 1)
             raise DataFormatError(
                 f"unbalanced '\"': a quoted cell starts here and runs over {last - first + 1} lines",
                 path=source,
-                line=first,
+                line=offset + first,
                 column=_name(header, quoted),
             )
         if not row or all(not c.strip() for c in row):
             continue
-        yield first, row
+        yield offset + first, row
 
 
 def show_cell(cell: str, limit: int = 40) -> str:
@@ -200,20 +216,23 @@ def numeric_rows(
     columns: Sequence[str],
     *,
     exact_width: bool = False,
+    offset: int = 0,
+    min_rows: int = 2,
 ) -> tuple[NDArray[np.float64], list[int]]:
     """The data rows of a CSV table as an (n, len(columns)) float array of ``columns`` (names in
     ``header``), with the file line of each row; every cell must be a finite number.
 
     ``exact_width`` refuses a row whose cell count differs from the header's (log format v1);
-    otherwise only a row too short for a wanted column is refused. Fewer than 2 rows is an
-    error (a log or a track needs at least two samples)."""
+    otherwise only a row too short for a wanted column is refused. Fewer than ``min_rows`` rows
+    is an error (a log or a track needs at least two samples). ``lines[0]`` is file line
+    ``offset + 1`` (a chunk of a file)."""
     idx = [header.index(c) for c in columns]
     fast = _numeric_rows_fast(lines, header_line, len(header), idx, exact_width)
     if fast is not None:
-        return fast
+        return fast[0], [offset + ln for ln in fast[1]]
     rows: list[list[float]] = []
     row_lines: list[int] = []
-    for line, row in csv_rows(lines, header_line, source, header):
+    for line, row in csv_rows(lines, header_line, source, header, offset=offset):
         if exact_width and len(row) != len(header):
             raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=source, line=line)
         vals = []
@@ -223,9 +242,9 @@ def numeric_rows(
             vals.append(finite_cell(row[j].strip(), path=source, line=line, column=c))
         rows.append(vals)
         row_lines.append(line)
-    if len(rows) < 2:
-        raise DataFormatError(f"need at least 2 data rows, got {len(rows)}", path=source)
-    return np.array(rows, dtype=np.float64), row_lines
+    if len(rows) < min_rows:
+        raise DataFormatError(f"need at least {min_rows} data rows, got {len(rows)}", path=source)
+    return np.array(rows, dtype=np.float64).reshape(len(rows), len(columns)), row_lines
 
 
 def _numeric_rows_fast(
@@ -287,7 +306,9 @@ __all__ = [
     "TEXT_MEMORY_FACTOR",
     "csv_rows",
     "decode",
+    "decode_part",
     "max_text_bytes",
+    "numeric_rows",
     "read_text",
     "show_cell",
     "split_lines",

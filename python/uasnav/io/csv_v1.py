@@ -26,24 +26,34 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
+from uasnav.io._csvstream import CHUNK_MEMORY_FACTOR, NumericCsv
 from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
 from uasnav.io.table import as_column, write_rows
+from uasnav.limits import check_memory
 
 REQUIRED = ("t", "gx", "gy", "gz", "ax", "ay", "az")
+OPTIONAL = ("temp", "mx", "my", "mz")
 _AXES = ("x", "y", "z")
+_COMMENT = re.compile(r"#\s*([\w.-]+)\s*:\s*(.*)$")
+#: Copies of the numbers alive at once while :func:`read_csv_v1` assembles a log: the chunks'
+#: columns, the joined columns, the (n, 3) arrays of :class:`ImuLog` (8 bytes each).
+READ_COPIES = 3
 
 
 def read_csv_v1(path: str | os.PathLike[str]) -> ImuLog:
     """Read a CSV v1 log.
+
+    The file is read in chunks through pyarrow's CSV reader (:class:`CsvV1Stream`); memory is
+    about 24 bytes per number of the log's columns plus a bounded working set.
 
     Raises
     ------
@@ -53,31 +63,160 @@ def read_csv_v1(path: str | os.PathLike[str]) -> ImuLog:
         not UTF-8 or holds NUL bytes; the message names the file, line and column. A UTF-8
         byte-order mark is accepted.
     ResourceLimitError
-        If the file is larger than the memory limit allows (see :mod:`uasnav.io._text`).
+        If the log is larger than the memory limit allows (:mod:`uasnav.limits`,
+        ``UASNAV_MAX_MEMORY``).
     """
-    p = Path(path)
-    return parse_csv_v1(read_text(p), source=str(p))
+    with open_csv_v1(path) as stream:
+        k = len(stream.columns)
+        parts: list[NDArray[np.float64]] = []
+        rows = 0
+        largest_chunk = 0
+        for block, done_bytes in stream.blocks_with_progress():
+            parts.append(block)
+            rows += block.shape[0]
+            largest_chunk = max(largest_chunk, done_bytes[1])
+            # the log's size projected from the rows per byte so far (the bytes read so far for
+            # a pipe): refused as soon as it is known to be too large
+            total = stream.data_bytes
+            scale = total / done_bytes[0] if total and done_bytes[0] else 1.0
+            expect = rows * max(scale, 1.0)
+            check_memory(
+                expect * k * 8 * READ_COPIES + largest_chunk * CHUNK_MEMORY_FACTOR,
+                f"{stream.source}: a CSV v1 log of about {expect:.3g} rows × {k} columns",
+            )
+        col: dict[str, NDArray[np.float64]] = {}
+        for j, c in enumerate(stream.columns):
+            col[c] = np.concatenate([b[:, j] for b in parts]) if parts else np.empty(0)
+        del parts
+        return _log(col, stream.meta, stream.source)
+
+
+class CsvV1Stream:
+    """A CSV v1 log opened for reading in chunks (:func:`open_csv_v1`).
+
+    Attributes
+    ----------
+    source : str
+        The file.
+    meta : dict of str → str
+        The ``# key: value`` comments before the header.
+    columns : list of str
+        The columns read, in block order: ``t gx gy gz ax ay az``, then those of ``temp mx my
+        mz`` the file has, then its ``truth_*`` columns.
+    data_bytes : int or None
+        Bytes of data rows (after the header) of a regular file, else None.
+    """
+
+    def __init__(self, path: str | os.PathLike[str]) -> None:
+        p = Path(path)
+        self.source = str(p)
+        self._csv = NumericCsv.open(p)
+        self._whole: NDArray[np.float64] | None = None
+        self.data_bytes: int | None = None
+        if self._csv is None:  # the header lies beyond the first chunk: the whole text decides
+            self.meta, self.columns, self._whole, _ = _parse_text(read_text(p), self.source)
+            return
+        csv = self._csv
+        try:
+            self.meta = _meta(csv.comments)
+            self.columns = _columns(csv.header, csv.header_line, self.source)
+        except DataFormatError as e:
+            try:
+                csv.fail(e)
+            finally:
+                csv.close()
+        if csv.size is not None:
+            self.data_bytes = csv.size - csv.data_start
+
+    def close(self) -> None:
+        """Close the file."""
+        if self._csv is not None:
+            self._csv.close()
+
+    def __enter__(self) -> CsvV1Stream:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def blocks(self) -> Iterator[NDArray[np.float64]]:
+        """The data rows, chunk by chunk: arrays (m, len(:attr:`columns`)) float64, columns
+        contiguous, ``t`` strictly increasing across blocks.
+
+        Raises
+        ------
+        DataFormatError
+            As :func:`read_csv_v1`, after the last block at the latest: the error the whole-text
+            reader reports (encoding errors first, then the first bad row, then fewer than 2
+            rows, then time), so a consumer must not use what it accumulated before the end.
+        """
+        for block, _ in self.blocks_with_progress():
+            yield block
+
+    def blocks_with_progress(self) -> Iterator[tuple[NDArray[np.float64], tuple[int, int]]]:
+        """:meth:`blocks`, each with (bytes of data read so far, bytes of this chunk)."""
+        if self._csv is None:
+            assert self._whole is not None
+            yield self._whole, (0, 0)
+            return
+        prev: float | None = None
+        late: DataFormatError | None = None  # a time error: reported once no other error is found
+        rows = 0
+        done = 0
+        for b in self._csv.blocks(self.columns, exact_width=True):
+            m = b.data.shape[0]
+            rows += m
+            done += len(b.raw)
+            if late is not None or m == 0:
+                continue
+            t = b.data[:, 0]
+            d = np.diff(t, prepend=t[0] if prev is None else prev)
+            bad = np.flatnonzero(d <= 0)
+            if prev is None:
+                bad = bad[bad > 0]
+            if bad.size:
+                r = int(bad[0])
+                before = float(t[r - 1]) if r else prev
+                late = _time_error(before, float(t[r]), self.source, b.row_lines()[r])
+                continue
+            prev = float(t[-1])
+            yield b.data, (done, len(b.raw))
+        if rows < 2:
+            raise DataFormatError(f"need at least 2 data rows, got {rows}", path=self.source)
+        if late is not None:
+            raise late
+
+
+def open_csv_v1(path: str | os.PathLike[str]) -> CsvV1Stream:
+    """Open a CSV v1 log for reading in chunks (for consumers that stream, e.g. block means).
+
+    Raises
+    ------
+    DataFormatError
+        A missing file, or an error in the comment lines or the header (see :func:`read_csv_v1`).
+    """
+    return CsvV1Stream(path)
 
 
 def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
     """Parse CSV v1 text (see :func:`read_csv_v1`)."""
     if not isinstance(text, str):
         raise InputError(f"text: expected the CSV text as str, got {type(text).__name__}")
-    lines = split_lines(text.removeprefix("\ufeff"))
+    meta, columns, data, _ = _parse_text(text, source)
+    return _log({c: data[:, j] for j, c in enumerate(columns)}, meta, source)
+
+
+def _meta(lines: list[str]) -> dict[str, str]:
     meta: dict[str, str] = {}
-    i = 0
-    while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
-        m = re.match(r"#\s*([\w.-]+)\s*:\s*(.*)$", lines[i])
+    for ln in lines:
+        m = _COMMENT.match(ln)
         if m:
             meta[m.group(1)] = m.group(2).strip()
-        i += 1
-    if i >= len(lines):
-        raise DataFormatError("empty file (no header row)", path=source)
-    first = next(csv_rows(lines, i, source), None)
-    if first is None:
-        raise DataFormatError("empty file (no header row)", path=source)
-    header_line = first[0]
-    header = [h.strip() for h in first[1]]
+    return meta
+
+
+def _columns(header: list[str], header_line: int, source: str) -> list[str]:
+    """The columns a CSV v1 reader reads, in order; header errors name the line."""
     missing = [c for c in REQUIRED if c not in header]
     if missing:
         raise DataFormatError(
@@ -88,26 +227,47 @@ def parse_csv_v1(text: str, source: str = "<string>") -> ImuLog:
     if len(set(header)) != len(header):
         dup = sorted({h for h in header if header.count(h) > 1})
         raise DataFormatError(f"duplicated column(s) {', '.join(dup)}", path=source, line=header_line)
-    optional = [c for c in ("temp", "mx", "my", "mz") if c in header]
-    truth_cols = [c for c in header if c.startswith("truth_")]
-    wanted = list(REQUIRED) + optional + truth_cols
-    data, row_lines = numeric_rows(lines, header_line, source, header, wanted, exact_width=True)
-    col = {c: data[:, j] for j, c in enumerate(wanted)}
-    t = col["t"]
+    return [*REQUIRED, *(c for c in OPTIONAL if c in header), *(c for c in header if c.startswith("truth_"))]
+
+
+def _parse_text(text: str, source: str) -> tuple[dict[str, str], list[str], NDArray[np.float64], list[int]]:
+    """The whole-text reader, row by row: (meta, columns, data (n, k), file line of each row)."""
+    lines = split_lines(text.removeprefix("\ufeff"))
+    i = 0
+    while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
+        i += 1
+    if i >= len(lines):
+        raise DataFormatError("empty file (no header row)", path=source)
+    first = next(csv_rows(lines, i, source), None)
+    if first is None:
+        raise DataFormatError("empty file (no header row)", path=source)
+    header_line = first[0]
+    header = [h.strip() for h in first[1]]
+    columns = _columns(header, header_line, source)
+    data, row_lines = numeric_rows(lines, header_line, source, header, columns, exact_width=True)
+    t = data[:, 0]
     d = np.diff(t)
     bad = np.flatnonzero(d <= 0)
     if bad.size:
         r = int(bad[0]) + 1
-        kind = "duplicated" if d[bad[0]] == 0 else "decreasing"
-        raise DataFormatError(
-            f"{kind} time stamp ({float(t[r - 1])!r} then {float(t[r])!r}); t must be strictly increasing",
-            path=source,
-            line=row_lines[r],
-            column="t",
-        )
-    truth = _group_truth(truth_cols, col)
+        raise _time_error(float(t[r - 1]), float(t[r]), source, row_lines[r])
+    return _meta(lines[: header_line - 1]), columns, data, row_lines
+
+
+def _time_error(before: float | None, after: float, source: str, line: int) -> DataFormatError:
+    kind = "duplicated" if before == after else "decreasing"
+    return DataFormatError(
+        f"{kind} time stamp ({before!r} then {after!r}); t must be strictly increasing",
+        path=source,
+        line=line,
+        column="t",
+    )
+
+
+def _log(col: dict[str, NDArray[np.float64]], meta: dict[str, str], source: str) -> ImuLog:
+    truth = _group_truth([c for c in col if c.startswith("truth_")], col)
     return ImuLog(
-        t=t,
+        t=col["t"],
         gyro=np.column_stack([col["gx"], col["gy"], col["gz"]]),
         accel=np.column_stack([col["ax"], col["ay"], col["az"]]),
         temp=col.get("temp"),
@@ -197,4 +357,4 @@ def write_csv_v1(
         write_rows(fh, np.column_stack([a for _, a in cols]))
 
 
-__all__ = ["REQUIRED", "parse_csv_v1", "read_csv_v1", "write_csv_v1"]
+__all__ = ["REQUIRED", "CsvV1Stream", "open_csv_v1", "parse_csv_v1", "read_csv_v1", "write_csv_v1"]

@@ -58,12 +58,18 @@ def check_training_temp(temp: ArrayLike, name: str = "temp") -> FloatArray:
     out = np.flatnonzero((t < TEMP_MIN_C) | (t > TEMP_MAX_C))
     if out.size:
         i = int(out[0])
-        raise InputError(
-            f"{name}: {t[i]:g} °C at row {i} is outside the physical range "
-            f"[{TEMP_MIN_C:g}, {TEMP_MAX_C:g}] °C of a sensor die temperature "
-            f"({out.size} such row{'s' if out.size > 1 else ''})"
-        )
+        raise temp_range_error(name, float(t[i]), i, int(out.size))
     return t
+
+
+def temp_range_error(name: str, value_c: float, row: int, count: int) -> InputError:
+    """The error of :func:`check_training_temp`: ``value_c`` (°C) at ``row`` is the first of
+    ``count`` temperatures outside the physical range."""
+    return InputError(
+        f"{name}: {value_c:g} °C at row {row} is outside the physical range "
+        f"[{TEMP_MIN_C:g}, {TEMP_MAX_C:g}] °C of a sensor die temperature "
+        f"({count} such row{'s' if count > 1 else ''})"
+    )
 
 
 def check_fit_data(temp: ArrayLike, bias: ArrayLike, min_samples: int = 4) -> tuple[FloatArray, FloatArray]:

@@ -136,4 +136,73 @@ def bin_by_time(
     return bin_means(q.astype(np.int64), te, v)
 
 
-__all__ = ["bin_by_temperature", "bin_by_time", "bin_means"]
+class TimeBlockMeans:
+    """:func:`bin_by_time` over a log given piece by piece (a file read in chunks): the same
+    blocks and means, up to the rounding of a block's sum split across two pieces, in memory
+    that grows with the number of blocks only.
+
+    >>> acc = TimeBlockMeans(1.0)
+    >>> acc.add(np.array([0.0, 0.5, 1.0]), np.array([20.0, 20.4, 21.2]), np.array([[1.0], [3.0], [5.0]]))
+    >>> acc.add(np.array([1.5, 2.0]), np.array([21.6, 23.1]), np.array([[7.0], [9.0]]))
+    >>> acc.result()[1].ravel().tolist()
+    [2.0, 6.0, 9.0]
+    """
+
+    def __init__(self, seconds: float) -> None:
+        if not (np.isfinite(seconds) and seconds > 0):
+            raise InputError(f"seconds: expected a block length > 0 s, got {seconds}")
+        self.seconds = float(seconds)
+        self._t0: float | None = None
+        self._t_last = 0.0
+        self._too_fine = False
+        self._q: list[NDArray[np.int64]] = []
+        self._n: list[FloatArray] = []
+        self._temp: list[FloatArray] = []
+        self._values: list[FloatArray] = []
+
+    def add(self, t: FloatArray, temp: FloatArray, values: FloatArray) -> None:
+        """Add samples: ``t`` (m,) s increasing and after those added before, ``temp`` (m,) °C,
+        ``values`` (m, k)."""
+        if t.size == 0:
+            return
+        if self._t0 is None:
+            self._t0 = float(t[0])
+        self._t_last = float(t[-1])
+        if self._too_fine:
+            return
+        q = np.floor((t - self._t0) / self.seconds)
+        if not np.isfinite(q).all() or q.max() >= 2.0**62:
+            self._too_fine = True  # reported by result(), with the log's whole span
+            self._q, self._n, self._temp, self._values = [], [], [], []
+            return
+        qi = q.astype(np.int64)
+        # q never decreases (t increases): a block is a run of equal q
+        starts = np.flatnonzero(np.diff(qi, prepend=qi[0] - 1))
+        idx = np.repeat(np.arange(starts.size), np.diff(np.append(starts, qi.size)))
+        n = np.bincount(idx).astype(np.float64)
+        tsum = np.bincount(idx, temp)
+        vsum = np.stack([np.bincount(idx, col) for col in np.asarray(values).T], 1)
+        self._q.append(qi[starts])
+        self._n.append(n)
+        self._temp.append(tsum)
+        self._values.append(vsum)
+
+    def result(self) -> tuple[FloatArray, FloatArray]:
+        """(mean temperature (m,) °C, mean values (m, k)) per non-empty block, in time order."""
+        if self._too_fine:
+            span = self._t_last - (self._t0 or 0.0)
+            raise InputError(f"seconds: block length {self.seconds:g} s is too short for a log of {span:g} s")
+        if not self._q:
+            return np.empty(0), np.empty((0, 0))
+        q = np.concatenate(self._q)
+        # a block split across two pieces: its sums are added
+        _, inv = np.unique(q, return_inverse=True)
+        inv = inv.ravel()
+        n = np.bincount(inv, np.concatenate(self._n))
+        tm = np.bincount(inv, np.concatenate(self._temp)) / n
+        v = np.concatenate(self._values)
+        vm = np.stack([np.bincount(inv, col) for col in v.T], 1) / n[:, None]
+        return tm, vm
+
+
+__all__ = ["TimeBlockMeans", "bin_by_temperature", "bin_by_time", "bin_means"]

@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -20,15 +21,20 @@ from numpy.typing import ArrayLike
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog, require_log
 from uasnav.io import read_log
+from uasnav.io.csv_v1 import open_csv_v1
+from uasnav.io.xio import is_xio_csv
 from uasnav.thermal._common import (
+    TEMP_MAX_C,
+    TEMP_MIN_C,
     FloatArray,
     SelectionResult,
     TemperatureRangeWarning,
     check_training_temp,
     sr,
+    temp_range_error,
 )
 from uasnav.thermal.base import BiasModel
-from uasnav.thermal.binning import bin_by_time
+from uasnav.thermal.binning import TimeBlockMeans, bin_by_time
 from uasnav.thermal.neural import NeuralBiasModel, select_hidden_neurons
 from uasnav.thermal.polynomial import PolynomialBiasModel, select_polynomial_order
 
@@ -41,6 +47,11 @@ TRUTH_KEYS = ("gyro_bias_thermal", "gyro_bias")
 
 def load_training_data(path: str | os.PathLike[str], average_s: float = 1.0) -> tuple[FloatArray, FloatArray]:
     """Calibration data of a static log: block means of temperature and gyro output.
+
+    A CSV v1 log is averaged while it is read, chunk by chunk (:func:`uasnav.io.csv_v1.open_csv_v1`,
+    :class:`~uasnav.thermal.binning.TimeBlockMeans`): memory grows with the number of blocks,
+    not with the log (a day-long 100 Hz soak log of 1 GB is averaged in about 100 MB). Other
+    formats are read whole.
 
     Parameters
     ----------
@@ -62,18 +73,63 @@ def load_training_data(path: str | os.PathLike[str], average_s: float = 1.0) -> 
     InputError
         The log has no temperature, or fewer than 20 blocks.
     """
-    log = read_log(path)
-    if log.temp is None:
-        raise InputError(f"{path}: no temp column; thermal calibration needs the sensor temperature")
-    # Checked before averaging: the row named is the log's, and 1e308 °C cannot overflow a mean.
-    check_training_temp(log.temp, f"{path}: temp")
-    temp, bias = bin_by_time(log.t, log.temp, log.gyro, average_s)
+    if average_s > 0 and np.isfinite(average_s) and _is_csv_v1(path):
+        temp, bias = _csv_block_means(path, average_s)
+    else:
+        log = read_log(path)
+        if log.temp is None:
+            raise InputError(f"{path}: no temp column; thermal calibration needs the sensor temperature")
+        # Checked before averaging: the row named is the log's, and 1e308 °C cannot overflow a mean.
+        check_training_temp(log.temp, f"{path}: temp")
+        temp, bias = bin_by_time(log.t, log.temp, log.gyro, average_s)
     if temp.size < MIN_TRAINING_SAMPLES:
         raise InputError(
             f"{path}: only {temp.size} samples after {average_s} s averaging; "
             f"need at least {MIN_TRAINING_SAMPLES}"
         )
     return temp, bias
+
+
+def _is_csv_v1(path: str | os.PathLike[str]) -> bool:
+    """Whether :func:`uasnav.io.read_log` reads ``path`` as CSV v1 (and not as x-io CSV)."""
+    p = Path(path)
+    if p.suffix.lower() not in (".csv", ".txt"):
+        return False
+    try:
+        with open(p, "rb") as fh:
+            first = fh.readline(4096).decode("utf-8", errors="replace")
+    except OSError:
+        return False  # read_log names the problem
+    return not is_xio_csv(first)
+
+
+def _csv_block_means(path: str | os.PathLike[str], average_s: float) -> tuple[FloatArray, FloatArray]:
+    """:func:`load_training_data` of a CSV v1 log, averaged chunk by chunk while it is read,
+    with the checks and errors of the whole-log path in the same order."""
+    with open_csv_v1(path) as stream:
+        if "temp" not in stream.columns:
+            for _ in stream.blocks():  # an error in the data rows is reported first, as read_log does
+                pass
+            raise InputError(f"{path}: no temp column; thermal calibration needs the sensor temperature")
+        cols = stream.columns
+        jt, jg = cols.index("temp"), cols.index("gx")
+        means = TimeBlockMeans(average_s)
+        first_bad: tuple[float, int] | None = None
+        n_bad = 0
+        row = 0
+        for block in stream.blocks():
+            temp = block[:, jt]
+            out = np.flatnonzero((temp < TEMP_MIN_C) | (temp > TEMP_MAX_C))
+            if out.size:
+                n_bad += int(out.size)
+                if first_bad is None:
+                    first_bad = (float(temp[out[0]]), row + int(out[0]))
+            elif first_bad is None:
+                means.add(block[:, 0], temp, block[:, jg : jg + 3])
+            row += block.shape[0]
+    if first_bad is not None:
+        raise temp_range_error(f"{path}: temp", first_bad[0], first_bad[1], n_bad)
+    return means.result()
 
 
 @dataclass(frozen=True)

@@ -6,63 +6,38 @@ that needs a terrain model). N varies from −106 m to +85 m over the Earth: it 
 to be 0.
 
 N comes from the user (``geoid_height_m``, ``--geoid-height``: one value for the site, e.g. from
-a national geoid model) or, by default, from the EGM96 geoid at each route point: the 15′ grid
-``egm96_15.gtx`` that Debian's ``proj-data`` package installs (``/usr/share/proj``; the Makefile
-installs it), interpolated bilinearly by PROJ through ``pyproj`` (a ``vgridshift`` step). Against
-GeographicLib's ``GeoidEval`` (EGM96, 5′ grid, cubic) it agrees to 5 mm at Timbuktu and 2 mm at
-the grid's corners and centre (``tests/test_geoid.py``); EGM96 itself is good to about 0.5–1 m.
-Without the grid installed, N must be given, as before. (PyPI has no installable package with
-the data for this Python: ``egm96`` 0.1.0 is a stub and 0.3.0, which bundles the 5′ grid, needs
-Python ≥ 3.12; ``pygeodesy`` reads GeographicLib's ``.pgm`` grids but ships none.)
+a national geoid model) or, by default, from the EGM96 geoid at each route point:
+:func:`uasnav.geo.geoid.geoid_height`, NGA's 15′ grid shipped with uasnav and interpolated
+bilinearly (as PROJ's ``vgridshift`` does; no PROJ data needed). Against GeographicLib's
+``GeoidEval`` (EGM96, 5′ grid, cubic) it agrees to 1 cm at Timbuktu and at the grid's corners
+and centre (``tests/test_geoid.py``); EGM96 itself is good to about 0.5–1 m.
 """
 
 from __future__ import annotations
 
-import functools
 import math
-import os
 from collections.abc import Sequence
+from importlib import resources
 
 import numpy as np
 
 from uasnav.errors import InputError
+from uasnav.geo import geoid
 from uasnav.io.mission_plan import AltitudeFrame, RoutePoint
 
 #: Largest |N| on Earth (EGM2008 ranges from about −107 m to +86 m), with a margin.
 MAX_GEOID_HEIGHT_M = 120.0
-#: The geoid grid used when N is not given (PROJ's name for NGA's EGM96 15′ grid).
-GEOID_GRID = "egm96_15.gtx"
-#: What :func:`geoid_heights` evaluates, as reported to the user.
-GEOID_MODEL = "EGM96 (PROJ grid egm96_15.gtx, 15′, bilinear)"
-#: Where the grid is looked for, after pyproj's own data directories: Debian's proj-data.
-GEOID_DIRS = ("/usr/share/proj",)
+#: The geoid grid used when N is not given (package data of :mod:`uasnav.geo.geoid`).
+GEOID_GRID = geoid.GEOID_DATA
+#: What :func:`geoid_heights` evaluates, as reported to the user (``--json`` key ``geoid``).
+GEOID_MODEL = geoid.GEOID_MODEL
 
 
 def geoid_grid_path() -> str | None:
-    """Path of the installed EGM96 grid (:data:`GEOID_GRID`), or None if none is installed."""
-    try:
-        import pyproj.datadir
-
-        dirs = [*pyproj.datadir.get_data_dir().split(os.pathsep), pyproj.datadir.get_user_data_dir()]
-    except Exception:  # pyproj missing or without data: only the system directories
-        dirs = []
-    for d in [*dirs, *GEOID_DIRS]:
-        p = os.path.join(d, GEOID_GRID)
-        if os.path.isfile(p):
-            return p
-    return None
-
-
-@functools.cache
-def _geoid_transformer(path: str) -> object:
-    from pyproj import Transformer
-
-    # vgridshift with multiplier +1 adds the grid value: z = 0 becomes N
-    return Transformer.from_pipeline(
-        "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad "
-        f"+step +proj=vgridshift +grids={path} +multiplier=1 "
-        "+step +proj=unitconvert +xy_in=rad +xy_out=deg"
-    )
+    """Path of the EGM96 grid shipped with uasnav (:data:`GEOID_GRID`), or None if the
+    installation lacks it."""
+    p = resources.files("uasnav.geo").joinpath("data", GEOID_GRID)
+    return str(p) if p.is_file() else None
 
 
 def geoid_model() -> str | None:
@@ -76,28 +51,13 @@ def geoid_heights(lat_deg: np.ndarray, lon_deg: np.ndarray) -> np.ndarray:
     Raises
     ------
     InputError
-        The grid is not installed, or a position is outside it / not finite.
+        The grid is missing from the installation, or a position is not finite / beyond ±90°.
     """
-    path = geoid_grid_path()
-    if path is None:
+    if geoid_grid_path() is None:
         raise InputError(
-            f"no geoid model installed: the EGM96 grid {GEOID_GRID} comes with Debian's proj-data "
-            "package (apt-get install proj-data)"
+            f"no geoid model installed: the EGM96 grid {GEOID_GRID} is missing; reinstall uasnav"
         )
-    lat = np.asarray(lat_deg, dtype=float)
-    lon = np.asarray(lon_deg, dtype=float)
-    if not (np.all(np.isfinite(lat)) and np.all(np.isfinite(lon)) and np.all(np.abs(lat) <= 90)):
-        raise InputError("geoid height: latitudes/longitudes must be finite, |latitude| ≤ 90°")
-    try:
-        _, _, n = _geoid_transformer(path).transform(  # type: ignore[attr-defined]
-            lon, lat, np.zeros_like(lat), errcheck=True
-        )
-    except Exception as e:  # pyproj.exceptions.ProjError: outside the grid, unreadable grid
-        raise InputError(f"geoid height from {path}: {e}") from None
-    n = np.asarray(n, dtype=float)
-    if not np.all(np.isfinite(n)):
-        raise InputError(f"geoid height from {path}: no value at some positions")
-    return n
+    return np.asarray(geoid.geoid_height(lat_deg, lon_deg), dtype=float)
 
 
 def w84_altitudes(
@@ -128,8 +88,8 @@ def w84_altitudes(
             raise InputError(
                 f"{source}: F3548 altitudes are WGS-84 ellipsoidal and the plan's are "
                 f"{' and '.join(sorted(f.value for f in frames))}: give the geoid height N at the site "
-                "(--geoid-height, m; W84 = AMSL + N) or install the EGM96 grid (Debian package "
-                "proj-data); uasnav never assumes N = 0"
+                f"(--geoid-height, m; W84 = AMSL + N) or reinstall uasnav (its EGM96 grid {GEOID_GRID} "
+                "is missing); uasnav never assumes N = 0"
             )
         n = geoid_heights(np.array([p.lat_deg for p in points]), np.array([p.lon_deg for p in points]))
         return _w84(points, home_amsl_m, n, source)
