@@ -289,7 +289,8 @@ impl<T: Real> ZuptFilter<T> {
         z.fixed_rows_mut::<3>(6).copy_from(&psi);
 
         // H = [I₉ 0]: the shared Joseph-form kernel with H·P and S read off P.
-        let g = strapdown::gain_leading(&self.p, &self.r_diag, "innovation covariance S = HPHᵀ + R")?;
+        let g =
+            strapdown::gain_leading(&self.p, &self.r_diag, "innovation covariance S = HPHᵀ + R")?;
         self.last_nis = z.dot(&g.chol.solve(&z));
         let dx = strapdown::joseph_update(&mut self.p, &z, &g)?;
         // Feedback (δx = estimate − truth) and reset.

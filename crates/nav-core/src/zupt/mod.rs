@@ -80,10 +80,11 @@ pub const N_MEAS: usize = 9;
 /// Which filter of the thesis runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Mode {
-    /// Standard ZUPT: the gyro input is already thermally calibrated; the bias is a random
-    /// walk (eq. 12).
+    /// Classic: the gyro input is already thermally calibrated; the bias is a random walk
+    /// (eq. 12). The thesis calls this filter "standard ZUPT"; Python accepts `"zupt"` for it
+    /// beside the canonical `"classic"`.
     #[default]
-    Zupt,
+    Classic,
     /// TCZUPT: raw gyro input; the bias also follows the temperature model (eqs. 29–31).
     Tczupt,
 }
@@ -165,7 +166,7 @@ pub struct ZuptConfig<T> {
 impl<T: Real> Default for ZuptConfig<T> {
     fn default() -> Self {
         Self {
-            mode: Mode::Zupt,
+            mode: Mode::Classic,
             noise: ProcessNoise::thesis_zupt(),
             meas_std_position_m: lit(1e-3),
             meas_std_velocity_m_s: lit(1e-3),
