@@ -272,8 +272,8 @@ impl<T: Real> ZuptFilter<T> {
     }
 
     /// The ZUPT measurement update (eqs. 19–21): frozen position, zero velocity, frozen
-    /// attitude; Joseph form ([`strapdown::joseph_update`]); feedback into the solution and
-    /// reset.
+    /// attitude; Joseph form (the shared `strapdown::joseph_update`); feedback into the
+    /// solution and reset.
     pub fn update(&mut self) -> Result<(), NavError> {
         // Attitude measurement: q̂ ⊗ q₀* = exp(ψ/2) for Ĉ = (I + [ψ×])·C₀.
         let dq = self.q.into_inner() * self.q0.conjugate().into_inner();
