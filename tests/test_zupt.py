@@ -205,6 +205,13 @@ def test_cli_writes_the_est_csv_contract(tmp_path):
     assert png.stat().st_size > 1000
     r = CliRunner().invoke(main, ["zupt", str(path), "--mode", "tczupt"])
     assert r.exit_code == 2 and "--model is required" in r.output
+    # "classic" is the package's name of the same filter: same estimates, the mode echoed
+    r = CliRunner().invoke(
+        main, ["zupt", str(path), "--residual-bias", "15deg/h", "--json", "--mode", "classic"]
+    )
+    assert r.exit_code == 0, r.output
+    classic = json.loads(r.output)
+    assert classic["mode"] == "classic" and classic["gyro_bias_rad_s"] == out["gyro_bias_rad_s"]
     r = CliRunner().invoke(main, ["zupt", str(path), "--residual-bias", "15 m/s"])
     assert r.exit_code == 2 and "dimension" in r.output
 

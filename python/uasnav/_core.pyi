@@ -15,6 +15,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from uasnav.ins.core import FilterConfig
+
 __version__: str
 __all__ = [
     "__version__",
@@ -136,7 +138,8 @@ def zupt_run(
     zero_gyro_bias: bool = True,
     decimation: int = 1,
 ) -> dict[str, Any]:
-    """Run the ZUPT ('zupt') or TCZUPT ('tczupt') filter over a whole log (GIL released).
+    """Run the ZUPT filter, classic ('classic', also spelled 'zupt') or thermally compensated
+    ('tczupt'), over a whole log (GIL released).
 
     gyro, accel (n, 3) rad/s and m/s² (body); dt_s sample period (s); config: SI floats named
     as nav_core::zupt::ZuptConfig (unknown keys raise); temp (n,) °C; dbias_dtemp (n, 3)
@@ -306,12 +309,7 @@ def ins_run(
     initial_attitude: Sequence[float] | None = None,
     levelling_samples: int = 100,
     gyro_bias0: Sequence[float] = ...,
-    mode: str = "classic",
-    discretisation: str = "first_order",
-    config: dict[str, float] | None = None,
-    lever_arm: Sequence[float] = ...,
-    window_fixes: int = 10,
-    reset_after_exclusions: int = 50,
+    config: FilterConfig,
     decimation: int = 1,
 ) -> dict[str, Any]:
     """Run the GNSS/INS filter over a whole flight (one call, GIL released).
@@ -320,5 +318,8 @@ def ins_run(
     NED velocity (m, 3) m/s, accuracies (m, 3) = horizontal m, vertical m, speed m/s. Returns
     decimated ``llh``, ``vel``, ``attitude``, ``gyro_bias``, ``accel_bias``, ``cov_diag``,
     ``protection`` (HPL, VPL m), ``gnss_used``; per fix ``fix_status`` (0 used, 1/2 excluded,
-    3 masked, 4 unused, 5 reset) and ``fix_nis``; and the update counts.
+    3 masked, 4 unused, 5 reset) and ``fix_nis``; and the update counts. ``config`` is one
+    :class:`uasnav.ins.core.FilterConfig`, read by attribute (nav-core's field names; ``None``
+    keeps nav-core's default); a missing attribute or a wrong type is an ``InputError`` naming
+    the field.
     """

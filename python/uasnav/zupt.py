@@ -7,14 +7,18 @@ bias estimates, the attitude and the covariance diagonal, plus metrics and plott
 
 Modes
 -----
-``"zupt"``
-    Standard ZUPT (Figure 24): the gyro data must be thermally calibrated. With ``model``
+``"classic"`` (also spelled ``"zupt"``)
+    The thesis' standard ZUPT (Figure 24): the gyro data must be thermally calibrated. With ``model``
     the model's bias ``model.predict(temp)`` is subtracted first; without it the gyro data is
     taken as already calibrated. The estimated bias is the *residual* bias after calibration.
 ``"tczupt"``
     TCZUPT (Figure 26, eqs. 29–31): raw gyro data; the bias estimate is propagated with
     ``(∂b/∂T)·(dT/dt)·Ts``, ``∂b/∂T = model.derivative(temp)`` and ``dT/dt`` the sliding-window
     least-squares slope of ``log.temp``. The estimated bias is the *total* bias.
+
+``"classic"`` is the name the whole package uses for the first mode (the GNSS/INS filter's
+:class:`uasnav.ins.InsConfig` too): what sets it apart is its bias model, not the zero-velocity
+updates, which TCZUPT applies as well. ``"zupt"`` is accepted everywhere as the thesis' name.
 
 Both estimate the bias relative to the true body rate, Earth rate included: the filter's
 mechanisation compensates the Earth rate itself, so for a static unit the estimate converges
@@ -51,7 +55,9 @@ if TYPE_CHECKING:
     from uasnav.thermal.base import BiasModel
 
 FloatArray = NDArray[np.float64]
-Mode = Literal["zupt", "tczupt"]
+Mode = Literal["classic", "zupt", "tczupt"]
+#: The figure labels of the modes (the thesis' names of the filters).
+MODE_LABELS = {"classic": "ZUPT", "zupt": "ZUPT", "tczupt": "TCZUPT"}
 
 #: Convergence threshold of the thesis' Table 11 (rad/s).
 CONVERGENCE_THRESHOLD = 1e-5
@@ -197,7 +203,8 @@ class ZuptResult:
         Diagonal of P (order :data:`STATE_NAMES`, SI units).
     temp_rate : ndarray, shape (m,)
         dT/dt (°C/s) used by TCZUPT (zeros for ZUPT).
-    mode : str
+    mode : {"classic", "tczupt"}
+        The filter that ran (``"zupt"`` given is reported as ``"classic"``).
     config : ZuptConfig
     initial_attitude : ndarray, shape (4,)
         Coarse-levelled attitude (the frozen reference).
@@ -266,7 +273,7 @@ class ZuptResult:
             raise InputError(f"axis: expected 0, 1 or 2, got {axis!r}")
         if ax is None:
             _, ax = new_figure()
-        (line,) = ax.plot(self.t, self.gyro_bias[:, axis], lw=1, label=label or self.mode.upper())
+        (line,) = ax.plot(self.t, self.gyro_bias[:, axis], lw=1, label=label or MODE_LABELS[self.mode])
         if sigma:
             s = self.gyro_bias_std[:, axis]
             b = self.gyro_bias[:, axis]
@@ -301,7 +308,7 @@ def _match_rows(name: str, a: ArrayLike, m: int) -> FloatArray:
 
 def run(
     log: ImuLog,
-    mode: Mode = "zupt",
+    mode: Mode = "classic",
     model: BiasModel | None = None,
     config: ZuptConfig | None = None,
     *,
@@ -313,8 +320,8 @@ def run(
     ----------
     log : ImuLog
         Uniformly sampled log; ``temp`` (°C) is required for TCZUPT and for ZUPT with a model.
-    mode : {"zupt", "tczupt"}
-        See the module docs.
+    mode : {"classic", "zupt", "tczupt"}
+        See the module docs (``"zupt"`` is another name of ``"classic"``).
     model : uasnav.thermal.base.BiasModel, optional
         Thermal bias model; only its ``predict(temp)`` (rad/s) and ``derivative(temp)``
         (rad/s/°C) are used. ZUPT: subtracted before filtering (None → data already calibrated).
@@ -339,8 +346,10 @@ def run(
     if not isinstance(log, ImuLog):  # else an AttributeError deep inside, not a clear message
         raise InputError(f"log: expected an ImuLog, got {type(log).__name__}")
     cfg = config or ZuptConfig()
-    if mode not in ("zupt", "tczupt"):
-        raise InputError(f"mode: expected 'zupt' or 'tczupt', got {mode!r}")
+    if mode not in MODE_LABELS:
+        raise InputError(f"mode: expected 'classic' (or 'zupt') or 'tczupt', got {mode!r}")
+    if mode == "zupt":
+        mode = "classic"
     if not isinstance(cfg.decimation, int) or cfg.decimation < 1:
         raise InputError(f"config.decimation: expected an int >= 1, got {cfg.decimation!r}")
     if cfg.derivative not in ("analytic", "network"):

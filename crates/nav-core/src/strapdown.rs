@@ -367,6 +367,26 @@ pub(crate) fn gain<T: Real, const M: usize>(
     Ok(Gain { chol, hp, s })
 }
 
+/// [`gain`] for `H = [I_M 0]` (the first `M` error states measured directly, as the ZUPT's
+/// position, velocity and attitude): `H·P` is the first `M` rows of `P` and `S` their leading
+/// `M×M` block plus `diag(r)`, read off instead of multiplied (no state change).
+// Indices below M, the matrices' compile-time size.
+#[allow(clippy::indexing_slicing)]
+#[inline]
+pub(crate) fn gain_leading<T: Real, const M: usize>(
+    p: &Mat15<T>,
+    r_diag: &SVector<T, M>,
+    what: &'static str,
+) -> Result<Gain<T, M>, NavError> {
+    let hp: SMatrix<T, M, N_STATES> = p.fixed_rows::<M>(0).into_owned();
+    let mut s: SMatrix<T, M, M> = hp.fixed_columns::<M>(0).into_owned();
+    for i in 0..M {
+        s[(i, i)] += r_diag[i];
+    }
+    let chol = s.cholesky().ok_or(NavError::NotPositiveDefinite { what })?;
+    Ok(Gain { chol, hp, s })
+}
+
 /// The Joseph-form update `P ← (I−KH)P(I−KH)ᵀ + K·R·Kᵀ` (symmetrised; `H·P` and `S` from
 /// [`gain`]) for the innovation
 /// `z = h(x̂) − y` (predicted minus measured); returns `δx = K·z`. `P` is left
@@ -599,6 +619,21 @@ mod tests {
         check_chol_solve::<3, 15>(&mut rng);
         check_chol_solve::<2, 15>(&mut rng);
         check_chol_solve::<1, 15>(&mut rng);
+    }
+
+    #[test]
+    fn gain_leading_is_gain_with_a_leading_identity_bit_for_bit() {
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let scale: [f64; N_STATES] = core::array::from_fn(|_| 10f64.powf(rng.sym(4.0)));
+        let a = Mat15::<f64>::from_fn(|i, _| rng.sym(1.0) * scale[i]);
+        let p = a * a.transpose() + Mat15::from_diagonal(&SVector::from(scale)) * 1e-3;
+        let r = SVector::<f64, 9>::from_fn(|i, _| 1e-4 * (i as f64 + 1.0));
+        let h = SMatrix::<f64, 9, N_STATES>::from_fn(|i, j| if i == j { 1.0 } else { 0.0 });
+        let dense = gain(&p, &h, &r, "S").unwrap();
+        let ours = gain_leading(&p, &r, "S").unwrap();
+        assert_eq!(dense.hp, ours.hp);
+        assert_eq!(dense.s, ours.s);
+        assert_eq!(dense.chol.l(), ours.chol.l());
     }
 
     #[test]

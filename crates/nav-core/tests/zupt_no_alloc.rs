@@ -38,7 +38,7 @@ fn per_sample_step_and_batch_do_not_allocate() {
     let v = std::hint::black_box(vec![1u8; 16]);
     assert!(region.change().allocations >= 1);
     drop(v);
-    for mode in [Mode::Zupt, Mode::Tczupt] {
+    for mode in [Mode::Classic, Mode::Tczupt] {
         for disc in [Discretisation::FirstOrder, Discretisation::SecondOrder] {
             let cfg = ZuptConfig {
                 mode,
@@ -121,7 +121,7 @@ fn ins_step_updates_and_batch_do_not_allocate() {
         vec![0u8; m],
         vec![0.0; m],
     );
-    for mode in [Mode::Zupt, Mode::Tczupt] {
+    for mode in [Mode::Classic, Mode::Tczupt] {
         for disc in [Discretisation::FirstOrder, Discretisation::SecondOrder] {
             let cfg = InsConfig {
                 mode,

@@ -1,5 +1,6 @@
 //! numpy ↔ Rust conversions with shape checks that name the argument, and integer arguments
 //! whose out-of-range values raise `InputError` (pyo3's default is `OverflowError`).
+use nav_core::zupt::{Discretisation, Mode};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyOverflowError;
 use pyo3::prelude::*;
@@ -137,6 +138,31 @@ pub fn float_items(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<Vec<(Strin
             Ok((key, x))
         })
         .collect()
+}
+
+/// A filter mode by its Python name: `"classic"` (also `"zupt"`, the thesis' name of the
+/// ZUPT filter's classic mode) or `"tczupt"`.
+pub fn mode(py: Python<'_>, name: &str) -> PyResult<Mode> {
+    match name {
+        "classic" | "zupt" => Ok(Mode::Classic),
+        "tczupt" => Ok(Mode::Tczupt),
+        _ => Err(input_error(
+            py,
+            format!("mode: expected 'classic', 'zupt' or 'tczupt', got {name:?}"),
+        )),
+    }
+}
+
+/// A transition-matrix discretisation by its Python name.
+pub fn discretisation(py: Python<'_>, name: &str) -> PyResult<Discretisation> {
+    match name {
+        "first_order" => Ok(Discretisation::FirstOrder),
+        "second_order" => Ok(Discretisation::SecondOrder),
+        _ => Err(input_error(
+            py,
+            format!("discretisation: expected 'first_order' or 'second_order', got {name:?}"),
+        )),
+    }
 }
 
 /// `repr(obj)`, shortened, for messages ("got -1", not a Rust debug dump).

@@ -1,98 +1,120 @@
 //! Binding of `nav_core::ins`: one call runs a whole flight (GIL released).
-use nav_core::ins::{
-    Discretisation, InsBatchInput, InsBatchOutput, InsConfig, InsFilter, MagnetometerAiding, Mode,
-};
+use nav_core::ins::{InsBatchInput, InsBatchOutput, InsConfig, InsFilter, MagnetometerAiding};
 use nav_core::zupt::{DerivativeTable, NoDerivative};
 use numpy::ndarray::Array1;
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{float_items, rows, slice1};
+use crate::convert::{self, rows, slice1};
 use crate::errors::{input_error, IntoPy};
 use crate::zupt::to2;
 use crate::{floats_arg, uint_arg};
 
 uint_arg!(levelling_arg, "levelling_samples", usize, usize_arg);
 uint_arg!(decimation_arg, "decimation", usize, usize_arg);
-uint_arg!(window_arg, "window_fixes", usize, usize_arg);
-uint_arg!(reset_arg, "reset_after_exclusions", usize, usize_arg);
-floats_arg!(lever_arm_arg, "lever_arm", 3);
 floats_arg!(gyro_bias0_arg, "gyro_bias0", 3);
 
-/// Builds an `InsConfig` from `mode`, `discretisation` and a dict of SI floats named exactly
-/// as the nav-core fields; an unknown key is an error.
-fn config(
-    py: Python<'_>,
-    mode: &str,
-    discretisation: &str,
-    values: Option<&Bound<'_, PyDict>>,
-    lever_arm: [f64; 3],
-    window_fixes: usize,
-) -> PyResult<InsConfig<f64>> {
+/// `uasnav.ins.core.FilterConfig` as it crosses: nav-core's `InsConfig` fields read as
+/// attributes of one object, by the same names, types checked by PyO3; `None` keeps
+/// nav-core's default.
+#[derive(FromPyObject)]
+struct FilterConfig {
+    mode: String,
+    discretisation: String,
+    lever_arm_m: Option<[f64; 3]>,
+    window_fixes: Option<usize>,
+    reset_after_exclusions: Option<usize>,
+    sigma_vrw_m_s_sqrt_s: Option<f64>,
+    sigma_arw_rad_sqrt_s: Option<f64>,
+    sigma_abi_m_s2: Option<f64>,
+    sigma_gbi_rad_s: Option<f64>,
+    sigma_gbt_rad_s_sqrt_c: Option<f64>,
+    init_std_tilt_rad: Option<f64>,
+    init_std_heading_rad: Option<f64>,
+    init_std_accel_bias_m_s2: Option<f64>,
+    init_std_gyro_bias_rad_s: Option<f64>,
+    gnss_min_std_position_m: Option<f64>,
+    gnss_min_std_velocity_m_s: Option<f64>,
+    baro_std_m: Option<f64>,
+    baro_offset_time_constant_s: Option<f64>,
+    zupt_std_velocity_m_s: Option<f64>,
+    zaru_std_rad_s: Option<f64>,
+    zupt_interval_s: Option<f64>,
+    mag_heading_std_rad: Option<f64>,
+    heading_aiding_s: Option<f64>,
+    mag_interval_s: Option<f64>,
+    declination_rad: Option<f64>,
+    course_min_speed_m_s: Option<f64>,
+    gate_chi2: Option<f64>,
+    lambda_undetected: Option<f64>,
+    k_horizontal: Option<f64>,
+    k_vertical: Option<f64>,
+    separation_k_h: Option<f64>,
+    separation_k_v: Option<f64>,
+    temp_slope_window_s: Option<f64>,
+}
+
+/// `slot ← value` unless the value is `None` (nav-core's default stays).
+fn set<T>(slot: &mut T, value: Option<T>) {
+    if let Some(v) = value {
+        *slot = v;
+    }
+}
+
+/// Extracts the `config` argument; a missing attribute or a wrong type is an `InputError`
+/// naming the field (the one mapping of extraction errors).
+fn config_arg(obj: &Bound<'_, PyAny>) -> PyResult<InsConfig<f64>> {
+    let py = obj.py();
+    let a: FilterConfig = obj.extract().map_err(|e: PyErr| {
+        let why = match e.cause(py) {
+            Some(c) => format!(": {}", c.value(py)),
+            None => String::new(),
+        };
+        input_error(py, format!("config: {}{why}", e.value(py)))
+    })?;
     let mut c = InsConfig::<f64> {
-        mode: match mode {
-            "classic" => Mode::Zupt,
-            "tczupt" => Mode::Tczupt,
-            _ => {
-                return Err(input_error(
-                    py,
-                    format!("mode: expected 'classic' or 'tczupt', got {mode:?}"),
-                ))
-            }
-        },
-        discretisation: match discretisation {
-            "first_order" => Discretisation::FirstOrder,
-            "second_order" => Discretisation::SecondOrder,
-            _ => {
-                return Err(input_error(
-                    py,
-                    format!(
-                        "discretisation: expected 'first_order' or 'second_order', got {discretisation:?}"
-                    ),
-                ))
-            }
-        },
-        lever_arm_m: lever_arm,
-        window_fixes,
+        mode: convert::mode(py, &a.mode)?,
+        discretisation: convert::discretisation(py, &a.discretisation)?,
         ..InsConfig::default()
     };
-    if let Some(d) = values {
-        for (key, x) in float_items(py, d)? {
-            let slot = match key.as_str() {
-                "sigma_vrw_m_s_sqrt_s" => &mut c.noise.sigma_vrw_m_s_sqrt_s,
-                "sigma_arw_rad_sqrt_s" => &mut c.noise.sigma_arw_rad_sqrt_s,
-                "sigma_abi_m_s2" => &mut c.noise.sigma_abi_m_s2,
-                "sigma_gbi_rad_s" => &mut c.noise.sigma_gbi_rad_s,
-                "sigma_gbt_rad_s_sqrt_c" => &mut c.sigma_gbt_rad_s_sqrt_c,
-                "init_std_tilt_rad" => &mut c.init_std_tilt_rad,
-                "init_std_heading_rad" => &mut c.init_std_heading_rad,
-                "init_std_accel_bias_m_s2" => &mut c.init_std_accel_bias_m_s2,
-                "init_std_gyro_bias_rad_s" => &mut c.init_std_gyro_bias_rad_s,
-                "gnss_min_std_position_m" => &mut c.gnss_min_std_position_m,
-                "gnss_min_std_velocity_m_s" => &mut c.gnss_min_std_velocity_m_s,
-                "baro_std_m" => &mut c.baro_std_m,
-                "baro_offset_time_constant_s" => &mut c.baro_offset_time_constant_s,
-                "zupt_std_velocity_m_s" => &mut c.zupt_std_velocity_m_s,
-                "zaru_std_rad_s" => &mut c.zaru_std_rad_s,
-                "zupt_interval_s" => &mut c.zupt_interval_s,
-                "mag_heading_std_rad" => &mut c.mag_heading_std_rad,
-                "heading_aiding_s" => &mut c.heading_aiding_s,
-                "mag_interval_s" => &mut c.mag_interval_s,
-                "declination_rad" => &mut c.declination_rad,
-                "course_min_speed_m_s" => &mut c.course_min_speed_m_s,
-                "gate_chi2" => &mut c.gate_chi2,
-                "lambda_undetected" => &mut c.lambda_undetected,
-                "k_horizontal" => &mut c.k_horizontal,
-                "k_vertical" => &mut c.k_vertical,
-                "separation_k_h" => &mut c.separation_k_h,
-                "separation_k_v" => &mut c.separation_k_v,
-                "temp_slope_window_s" => &mut c.temp_slope_window_s,
-                _ => return Err(input_error(py, format!("config: unknown key {key:?}"))),
-            };
-            *slot = x;
-        }
-    }
+    set(&mut c.lever_arm_m, a.lever_arm_m);
+    set(&mut c.window_fixes, a.window_fixes);
+    set(&mut c.reset_after_exclusions, a.reset_after_exclusions);
+    set(&mut c.noise.sigma_vrw_m_s_sqrt_s, a.sigma_vrw_m_s_sqrt_s);
+    set(&mut c.noise.sigma_arw_rad_sqrt_s, a.sigma_arw_rad_sqrt_s);
+    set(&mut c.noise.sigma_abi_m_s2, a.sigma_abi_m_s2);
+    set(&mut c.noise.sigma_gbi_rad_s, a.sigma_gbi_rad_s);
+    set(&mut c.sigma_gbt_rad_s_sqrt_c, a.sigma_gbt_rad_s_sqrt_c);
+    set(&mut c.init_std_tilt_rad, a.init_std_tilt_rad);
+    set(&mut c.init_std_heading_rad, a.init_std_heading_rad);
+    set(&mut c.init_std_accel_bias_m_s2, a.init_std_accel_bias_m_s2);
+    set(&mut c.init_std_gyro_bias_rad_s, a.init_std_gyro_bias_rad_s);
+    set(&mut c.gnss_min_std_position_m, a.gnss_min_std_position_m);
+    set(
+        &mut c.gnss_min_std_velocity_m_s,
+        a.gnss_min_std_velocity_m_s,
+    );
+    set(&mut c.baro_std_m, a.baro_std_m);
+    set(
+        &mut c.baro_offset_time_constant_s,
+        a.baro_offset_time_constant_s,
+    );
+    set(&mut c.zupt_std_velocity_m_s, a.zupt_std_velocity_m_s);
+    set(&mut c.zaru_std_rad_s, a.zaru_std_rad_s);
+    set(&mut c.zupt_interval_s, a.zupt_interval_s);
+    set(&mut c.mag_heading_std_rad, a.mag_heading_std_rad);
+    set(&mut c.heading_aiding_s, a.heading_aiding_s);
+    set(&mut c.mag_interval_s, a.mag_interval_s);
+    set(&mut c.declination_rad, a.declination_rad);
+    set(&mut c.course_min_speed_m_s, a.course_min_speed_m_s);
+    set(&mut c.gate_chi2, a.gate_chi2);
+    set(&mut c.lambda_undetected, a.lambda_undetected);
+    set(&mut c.k_horizontal, a.k_horizontal);
+    set(&mut c.k_vertical, a.k_vertical);
+    set(&mut c.separation_k_h, a.separation_k_h);
+    set(&mut c.separation_k_v, a.separation_k_v);
+    set(&mut c.temp_slope_window_s, a.temp_slope_window_s);
     c.validate().py_err(py)?;
     Ok(c)
 }
@@ -136,8 +158,7 @@ type Hist = (
 #[pyo3(signature = (imu_t, gyro, accel, gnss_t, gnss_llh, gnss_vel, gnss_acc, *,
     gnss_use=None, baro_t=None, baro_h=None, mag_t=None, mag=None, temp=None,
     dbias_dtemp=None, stationary=None, initial_attitude=None, levelling_samples=100,
-    gyro_bias0=[0.0; 3], mode="classic", discretisation="first_order", config=None,
-    lever_arm=[0.0; 3], window_fixes=10, reset_after_exclusions=50, decimation=1))]
+    gyro_bias0=[0.0; 3], config, decimation=1))]
 #[allow(clippy::too_many_arguments)]
 fn ins_run<'py>(
     py: Python<'py>,
@@ -159,26 +180,10 @@ fn ins_run<'py>(
     initial_attitude: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = levelling_arg)] levelling_samples: usize,
     #[pyo3(from_py_with = gyro_bias0_arg)] gyro_bias0: [f64; 3],
-    mode: &str,
-    discretisation: &str,
-    config: Option<Bound<'py, PyDict>>,
-    #[pyo3(from_py_with = lever_arm_arg)] lever_arm: [f64; 3],
-    #[pyo3(from_py_with = window_arg)] window_fixes: usize,
-    #[pyo3(from_py_with = reset_arg)] reset_after_exclusions: usize,
+    #[pyo3(from_py_with = config_arg)] config: InsConfig<f64>,
     #[pyo3(from_py_with = decimation_arg)] decimation: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cfg = self::config(
-        py,
-        mode,
-        discretisation,
-        config.as_ref(),
-        lever_arm,
-        window_fixes,
-    )?;
-    let cfg = InsConfig {
-        reset_after_exclusions,
-        ..cfg
-    };
+    let cfg = config;
     let it = slice1(py, "imu_t", &imu_t)?;
     let g = rows::<3>(py, "gyro", &gyro)?;
     let a = rows::<3>(py, "accel", &accel)?;

@@ -1,14 +1,14 @@
 //! Binding of `nav_core::zupt`: one call runs a whole log (GIL released).
 use nav_core::zupt::{
-    detect_static, BatchInput, BatchOutput, DerivativeTable, Discretisation, HeadingSource, Mode,
-    NoDerivative, StationarityConfig, ZuptConfig, ZuptFilter, N_STATES,
+    detect_static, BatchInput, BatchOutput, DerivativeTable, HeadingSource, NoDerivative,
+    StationarityConfig, ZuptConfig, ZuptFilter, N_STATES,
 };
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{float_items, rows, slice1};
+use crate::convert::{self, float_items, rows, slice1};
 use crate::errors::{input_error, IntoPy};
 use crate::{floats_arg, uint_arg};
 
@@ -27,28 +27,8 @@ fn config(
     values: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<ZuptConfig<f64>> {
     let mut c = ZuptConfig::<f64> {
-        mode: match mode {
-            "zupt" => Mode::Zupt,
-            "tczupt" => Mode::Tczupt,
-            _ => {
-                return Err(input_error(
-                    py,
-                    format!("mode: expected 'zupt' or 'tczupt', got {mode:?}"),
-                ))
-            }
-        },
-        discretisation: match discretisation {
-            "first_order" => Discretisation::FirstOrder,
-            "second_order" => Discretisation::SecondOrder,
-            _ => {
-                return Err(input_error(
-                    py,
-                    format!(
-                        "discretisation: expected 'first_order' or 'second_order', got {discretisation:?}"
-                    ),
-                ))
-            }
-        },
+        mode: convert::mode(py, mode)?,
+        discretisation: convert::discretisation(py, discretisation)?,
         ..ZuptConfig::default()
     };
     if let Some(d) = values {

@@ -14,7 +14,13 @@ if TYPE_CHECKING:
 
 @click.command("zupt")
 @click.argument("log", type=click.Path(dir_okay=False))
-@click.option("--mode", type=click.Choice(["zupt", "tczupt"]), default="zupt", show_default=True)
+@click.option(
+    "--mode",
+    type=click.Choice(["zupt", "classic", "tczupt"]),
+    default="zupt",
+    show_default=True,
+    help="zupt and classic name the same filter (calibrated gyro, random-walk bias).",
+)
 @click.option(
     "--model",
     "model_path",
@@ -43,7 +49,7 @@ if TYPE_CHECKING:
 @click.option("--plot", "plot_path", type=OutputPath(), help="Write a PNG of the gyro bias.")
 def command(
     log: str,
-    mode: Literal["zupt", "tczupt"],
+    mode: Literal["zupt", "classic", "tczupt"],
     model_path: str | None,
     derivative: Literal["analytic", "network"],
     residual_bias: float,

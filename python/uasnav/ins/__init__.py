@@ -18,8 +18,9 @@ True
 """
 
 from uasnav.ins import evaluate, magnetic
-from uasnav.ins.core import FIX_STATUS, TRACK_COLUMNS, InsConfig, InsResult, integrity_thresholds, run
+from uasnav.ins.core import FIX_STATUS, InsConfig, InsResult, integrity_thresholds, run
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
+from uasnav.io.track import TRACK_COLUMNS
 
 __all__ = [
     "FIX_STATUS",

@@ -17,24 +17,25 @@ for a circular error, conservative otherwise) and ``k_V = Φ⁻¹(1 − p_ir/2)`
 
 from __future__ import annotations
 
-import json
+import dataclasses
 import math
 import os
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from uasnav import _core
-from uasnav.atomicfile import atomic_open
 from uasnav.attitude import quat_to_euler
 from uasnav.errors import InputError
 from uasnav.imu import ImuLog
 from uasnav.ins.magnetic import resolve_declination
+from uasnav.io import track
 from uasnav.io.navdata import Flight
 from uasnav.stationary import MAX_WINDOW_SAMPLES, detect_static
+from uasnav.zupt import MODE_LABELS, Mode
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -42,10 +43,7 @@ if TYPE_CHECKING:
     from uasnav.thermal.base import BiasModel
 
 FloatArray = NDArray[np.float64]
-Mode = Literal["classic", "tczupt"]
 
-#: TRACK.csv columns (SI; degrees only for lat/lon/roll/pitch/yaw).
-TRACK_COLUMNS = "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw,bgx,bgy,bgz,bax,bay,baz,hpl,vpl,gnss_used".split(",")
 #: Below this IMU rate (Hz) strapdown integration is refused: a turn of 30 °/s would rotate
 #: the body by more than 6° between samples.
 MIN_IMU_RATE_HZ = 5.0
@@ -120,8 +118,9 @@ class InsConfig:
     Attributes
     ----------
     mode : {"classic", "tczupt"}
-        ``"classic"``: the gyro is calibrated with ``model`` (if given) and its bias is a random
-        walk; ``"tczupt"``: raw gyro, the bias follows ``model``'s ∂b/∂T·dT/dt (eqs. 29–31).
+        ``"classic"`` (also spelled ``"zupt"``): the gyro is calibrated with ``model`` (if
+        given) and its bias is a random walk; ``"tczupt"``: raw gyro, the bias follows
+        ``model``'s ∂b/∂T·dT/dt (eqs. 29–31).
     model : BiasModel or None
         Thermal gyro-bias model (a ``uasnav calibrate`` file); required for ``"tczupt"``.
     sigma_vrw_m_s_sqrt_s, sigma_arw_rad_sqrt_s, sigma_abi_m_s2, sigma_gbi_rad_s : float
@@ -201,9 +200,11 @@ class InsConfig:
         base.update(changes)
         return cls(**base, extra=extra)
 
-    def core_dict(self) -> dict[str, float]:
-        """The nav-core configuration keys (noise, integrity thresholds, extras)."""
-        d = {
+    def filter_config(self, declination_rad: float) -> FilterConfig:
+        """The Rust filter's configuration: noise, the integrity thresholds of ``p_fa``,
+        ``p_md``, ``p_ir``, the lever arm and window, ``extra`` on top, and the magnetic
+        declination (rad, east positive) resolved for the flight."""
+        fields: dict[str, Any] = {
             "sigma_vrw_m_s_sqrt_s": self.sigma_vrw_m_s_sqrt_s,
             "sigma_arw_rad_sqrt_s": self.sigma_arw_rad_sqrt_s,
             "sigma_abi_m_s2": self.sigma_abi_m_s2,
@@ -211,9 +212,89 @@ class InsConfig:
             # a thermal model compensates the bias: no thermal wander on top of it
             "sigma_gbt_rad_s_sqrt_c": 0.0 if self.model is not None else self.sigma_gbt_rad_s_sqrt_c,
         }
-        d.update(integrity_thresholds(self.p_fa, self.p_md, self.p_ir))
-        d.update({k: float(v) for k, v in self.extra.items()})
-        return d
+        fields.update(integrity_thresholds(self.p_fa, self.p_md, self.p_ir))
+        for key, value in self.extra.items():
+            if key not in FilterConfig.FLOAT_FIELDS:
+                raise InputError(f"config: unknown key {key!r} (expected one of FilterConfig.FLOAT_FIELDS)")
+            try:
+                fields[key] = float(value)
+            except (TypeError, ValueError):
+                raise InputError(f"extra[{key!r}]: expected a float, got {value!r}") from None
+        fields["declination_rad"] = declination_rad
+        return FilterConfig(
+            mode=self.mode,
+            discretisation=self.discretisation,
+            lever_arm_m=self.lever_arm_m,
+            window_fixes=self.window_fixes,
+            reset_after_exclusions=self.reset_after_exclusions,
+            **fields,
+        )
+
+
+@dataclass(frozen=True)
+class FilterConfig:
+    """The configuration of the Rust filter (``nav_core::ins::InsConfig``) as it crosses into
+    Rust: one typed object, each field named and in the units of its nav-core namesake (SI,
+    units in the names; see the Rust docs). ``None`` keeps nav-core's default, so defaults live
+    in nav-core alone. :meth:`InsConfig.filter_config` builds it; ``InsConfig.extra`` sets any
+    float field by name.
+
+    Attributes
+    ----------
+    mode : {"classic", "tczupt"}
+        Gyro-bias model (see :class:`InsConfig`).
+    discretisation : {"first_order", "second_order"}
+        Transition-matrix discretisation.
+    lever_arm_m : tuple of 3 floats or None
+        GNSS antenna relative to the IMU, body frame (m).
+    window_fixes, reset_after_exclusions : int or None
+        Fixes in the averaged-innovation test; consecutive exclusions before a GNSS reset.
+    sigma_vrw_m_s_sqrt_s, …, temp_slope_window_s : float or None
+        The float fields (:attr:`FLOAT_FIELDS`): process noise, initial σ, measurement σ and
+        cadences, declination, integrity thresholds, thermal slope window.
+    """
+
+    mode: Mode = "classic"
+    discretisation: Literal["first_order", "second_order"] = "first_order"
+    lever_arm_m: tuple[float, float, float] | None = None
+    window_fixes: int | None = None
+    reset_after_exclusions: int | None = None
+    sigma_vrw_m_s_sqrt_s: float | None = None
+    sigma_arw_rad_sqrt_s: float | None = None
+    sigma_abi_m_s2: float | None = None
+    sigma_gbi_rad_s: float | None = None
+    sigma_gbt_rad_s_sqrt_c: float | None = None
+    init_std_tilt_rad: float | None = None
+    init_std_heading_rad: float | None = None
+    init_std_accel_bias_m_s2: float | None = None
+    init_std_gyro_bias_rad_s: float | None = None
+    gnss_min_std_position_m: float | None = None
+    gnss_min_std_velocity_m_s: float | None = None
+    baro_std_m: float | None = None
+    baro_offset_time_constant_s: float | None = None
+    zupt_std_velocity_m_s: float | None = None
+    zaru_std_rad_s: float | None = None
+    zupt_interval_s: float | None = None
+    mag_heading_std_rad: float | None = None
+    heading_aiding_s: float | None = None
+    mag_interval_s: float | None = None
+    declination_rad: float | None = None
+    course_min_speed_m_s: float | None = None
+    gate_chi2: float | None = None
+    lambda_undetected: float | None = None
+    k_horizontal: float | None = None
+    k_vertical: float | None = None
+    separation_k_h: float | None = None
+    separation_k_v: float | None = None
+    temp_slope_window_s: float | None = None
+
+    #: Names of the float fields (those ``InsConfig.extra`` may set).
+    FLOAT_FIELDS: ClassVar[frozenset[str]]
+
+
+FilterConfig.FLOAT_FIELDS = frozenset(
+    f.name for f in dataclasses.fields(FilterConfig) if f.type == "float | None"
+)
 
 
 @dataclass
@@ -331,114 +412,28 @@ class InsResult:
         return out
 
     def track_table(self) -> FloatArray:
-        """The TRACK.csv rows, shape (n, 19), in :data:`TRACK_COLUMNS` order."""
-        return np.column_stack(
-            [
-                self.t,
-                self.lat,
-                self.lon,
-                self.alt,
-                self.vel,
-                self.euler_deg,
-                self.gyro_bias,
-                self.accel_bias,
-                self.hpl,
-                self.vpl,
-                self.gnss_used.astype(np.float64),
-            ]
-        )
+        """The TRACK.csv rows (:func:`uasnav.io.track.track_table`)."""
+        return track.track_table(self)
 
     def to_csv(self, path: str | os.PathLike[str]) -> None:
-        """Write TRACK.csv (columns :data:`TRACK_COLUMNS`, 17 significant digits), atomically."""
-        table = self.track_table()
-        with atomic_open(path, "w") as fh:
-            fh.write(",".join(TRACK_COLUMNS) + "\n")
-            for row in table:
-                fh.write(",".join(f"{x:.17g}" for x in row[:-1]) + f",{int(row[-1])}\n")
+        """Write TRACK.csv (:func:`uasnav.io.track.write_track_csv`)."""
+        track.write_track_csv(self, path)
 
     def to_geojson(self, max_points: int = 5000) -> dict[str, Any]:
-        """A GeoJSON FeatureCollection: the track as a LineString (lon, lat, alt; decimated to at
-        most ``max_points``), and a Point per excluded fix and per alert start."""
-        step = max(1, math.ceil(self.t.size / max_points))
-        idx = np.r_[np.arange(0, self.t.size, step), self.t.size - 1]
-        coords = [[float(self.lon[i]), float(self.lat[i]), float(self.alt[i])] for i in np.unique(idx)]
-        feats: list[dict[str, Any]] = [
-            {
-                "type": "Feature",
-                "geometry": {"type": "LineString", "coordinates": coords},
-                "properties": {
-                    "name": "uasnav INS track",
-                    "t_start": float(self.t[0]),
-                    "t_end": float(self.t[-1]),
-                },
-            }
-        ]
-        for ev in self.excluded_fixes:
-            i = min(int(np.searchsorted(self.t, ev["t"])), self.t.size - 1)
-            feats.append(
-                {
-                    "type": "Feature",
-                    "geometry": {"type": "Point", "coordinates": [float(self.lon[i]), float(self.lat[i])]},
-                    "properties": {"event": "excluded_fix", **ev},
-                }
-            )
-        for al in self.alerts:
-            i = int(np.searchsorted(self.t, al["t_start"]))
-            feats.append(
-                {
-                    "type": "Feature",
-                    "geometry": {"type": "Point", "coordinates": [float(self.lon[i]), float(self.lat[i])]},
-                    "properties": {"event": "alert", **al},
-                }
-            )
-        return {"type": "FeatureCollection", "features": feats}
+        """The track as GeoJSON (:func:`uasnav.io.track.track_geojson`)."""
+        return track.track_geojson(self, max_points)
 
     def to_kml(self, path: str | os.PathLike[str], max_points: int = 5000) -> None:
-        """Write the track as a KML LineString (absolute altitude = ellipsoidal height)."""
-        from xml.sax.saxutils import escape
-
-        step = max(1, math.ceil(self.t.size / max_points))
-        idx = np.unique(np.r_[np.arange(0, self.t.size, step), self.t.size - 1])
-        coords = " ".join(f"{self.lon[i]:.9f},{self.lat[i]:.9f},{self.alt[i]:.3f}" for i in idx)
-        with atomic_open(path, "w") as fh:
-            fh.write(
-                '<?xml version="1.0" encoding="UTF-8"?>\n<kml xmlns="http://www.opengis.net/kml/2.2">'
-                f"<Document><name>{escape('uasnav INS track')}</name><Placemark><name>track</name>"
-                f"<LineString><altitudeMode>absolute</altitudeMode><coordinates>{coords}</coordinates>"
-                "</LineString></Placemark></Document></kml>\n"
-            )
+        """Write the track as KML (:func:`uasnav.io.track.write_track_kml`)."""
+        track.write_track_kml(self, path, max_points)
 
     def write_geojson(self, path: str | os.PathLike[str]) -> None:
-        """Write :meth:`to_geojson` atomically."""
-        with atomic_open(path, "w") as fh:
-            json.dump(self.to_geojson(), fh)
+        """Write :meth:`to_geojson` (:func:`uasnav.io.track.write_track_geojson`)."""
+        track.write_track_geojson(self, path)
 
     def plot(self, ax: Axes | None = None, *, reference: Any = None) -> Axes:
-        """Plot the horizontal track (east vs north, m from the first point) with excluded
-        fixes; ``reference`` (a :class:`~uasnav.io.navdata.Trajectory`) is drawn beside it."""
-        import matplotlib.pyplot as plt
-
-        if ax is None:
-            _, ax = plt.subplots(figsize=(6, 6))
-        lat0, lon0 = math.radians(self.lat[0]), math.radians(self.lon[0])
-
-        def ne(lat: FloatArray, lon: FloatArray) -> tuple[FloatArray, FloatArray]:
-            r = 6_371_000.0
-            return (np.radians(lat) - lat0) * r, (np.radians(lon) - lon0) * r * math.cos(lat0)
-
-        n, e = ne(self.lat, self.lon)
-        ax.plot(e, n, lw=1.2, label="uasnav INS")
-        if reference is not None:
-            rn, re = ne(reference.lat, reference.lon)
-            ax.plot(re, rn, lw=0.8, ls="--", label=reference.name)
-        for ev in self.excluded_fixes:
-            i = min(int(np.searchsorted(self.t, ev["t"])), self.t.size - 1)
-            ax.plot(e[i], n[i], "rx")
-        ax.set_xlabel("east (m)")
-        ax.set_ylabel("north (m)")
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.legend(loc="best")
-        return ax
+        """Plot the horizontal track (:func:`uasnav.io.track.plot_track`)."""
+        return track.plot_track(self, ax, reference=reference)
 
 
 #: Period (samples) after which the Rust detector recomputes its running window sums from its
@@ -567,8 +562,10 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
     cfg = InsConfig() if config is None else config
     if not isinstance(flight, Flight):
         raise InputError(f"flight: expected a uasnav.ins.Flight, got {type(flight).__name__}")
-    if cfg.mode not in ("classic", "tczupt"):
-        raise InputError(f"mode: expected 'classic' or 'tczupt', got {cfg.mode!r}")
+    if cfg.mode not in MODE_LABELS:
+        raise InputError(f"mode: expected 'classic' (or 'zupt') or 'tczupt', got {cfg.mode!r}")
+    if cfg.mode == "zupt":
+        cfg = cfg.replace(mode="classic")
     g = flight.gnss
     imu = flight.imu
     t_start = max(float(g.t[0]), float(imu.t[0]))
@@ -616,12 +613,12 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
     else:
         gyro0 = np.zeros(3)
     stationary = _static_mask(flight, cfg, rate)
-    core_cfg = cfg.core_dict()
+    filter_cfg = cfg.filter_config(declination_rad=0.0)  # checks `extra` before any look-up
     baro = flight.baro if cfg.use_baro else None
     mag = flight.mag if cfg.use_mag else None
     if "declination_rad" in cfg.extra:  # an explicit nav-core key wins
         declination_deg, declination_source = (
-            math.degrees(core_cfg["declination_rad"]),
+            math.degrees(float(cfg.extra["declination_rad"])),
             "extra['declination_rad']",
         )
     elif mag is None and cfg.declination_deg is None:
@@ -629,7 +626,7 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         declination_deg, declination_source = 0.0, "not used (no magnetometer aiding)"
     else:
         declination_deg, declination_source = resolve_declination(flight, cfg.declination_deg)
-    core_cfg["declination_rad"] = math.radians(declination_deg)
+    filter_cfg = replace(filter_cfg, declination_rad=math.radians(declination_deg))
     llh = np.ascontiguousarray(np.column_stack([np.radians(g.lat), np.radians(g.lon), g.alt]))
     acc = np.ascontiguousarray(np.column_stack([g.h_acc, g.v_acc, g.s_acc]))
     c = np.ascontiguousarray
@@ -647,18 +644,13 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
         mag_t=None if mag is None else c(mag.t),
         mag=None if mag is None else c(mag.field),
         temp=c(temp)
-        if temp is not None and (cfg.mode == "tczupt" or core_cfg["sigma_gbt_rad_s_sqrt_c"] > 0)
+        if temp is not None and (cfg.mode == "tczupt" or (filter_cfg.sigma_gbt_rad_s_sqrt_c or 0.0) > 0)
         else None,
         dbias_dtemp=dbias,
         stationary=stationary,
         levelling_samples=max(1, round(min(2.0, imu.duration / 4) * rate)),
         gyro_bias0=list(gyro0),
-        mode=cfg.mode,
-        discretisation=cfg.discretisation,
-        config=core_cfg,
-        lever_arm=list(cfg.lever_arm_m),
-        window_fixes=cfg.window_fixes,
-        reset_after_exclusions=cfg.reset_after_exclusions,
+        config=filter_cfg,
         decimation=cfg.decimation,
     )
     t = imu.t[:: cfg.decimation]

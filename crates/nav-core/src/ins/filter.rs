@@ -1061,7 +1061,8 @@ impl<T: Real> InsFilter<T> {
         let dt_nominal_s = span / (n - 1) as f64;
         let dt_nominal: T = lit(dt_nominal_s);
         let mut slope = SlopeEstimator::new(config.temp_slope_window_s, dt_nominal);
-        let thermal_wander = config.mode == Mode::Zupt && config.sigma_gbt_rad_s_sqrt_c > T::zero();
+        let thermal_wander =
+            config.mode == Mode::Classic && config.sigma_gbt_rad_s_sqrt_c > T::zero();
         let zupt_every = to_f64(config.zupt_interval_s);
         let mag_every = to_f64(config.mag_interval_s);
         let mag_until = t0 + to_f64(config.heading_aiding_s);

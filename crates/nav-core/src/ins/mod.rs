@@ -104,7 +104,7 @@ pub const WINDOW_CAPACITY: usize = 32;
 /// with struct-update syntax.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InsConfig<T> {
-    /// Classic (`Zupt`: calibrated gyro, random-walk bias) or thermally compensated
+    /// Classic (calibrated gyro, random-walk bias) or thermally compensated
     /// (`Tczupt`: raw gyro, bias follows ∂b/∂T·dT/dt).
     pub mode: Mode,
     /// IMU process noise (σ_VRW, σ_ARW, σ_ABI, σ_GBI; eqs. 22–25).
@@ -181,7 +181,7 @@ impl<T: Real> Default for InsConfig<T> {
     fn default() -> Self {
         let deg = core::f64::consts::PI / 180.0;
         Self {
-            mode: Mode::Zupt,
+            mode: Mode::Classic,
             noise: ProcessNoise {
                 sigma_vrw_m_s_sqrt_s: lit(0.1 / 60.0),
                 sigma_arw_rad_sqrt_s: lit(0.3 * deg / 60.0),

@@ -272,7 +272,8 @@ impl<T: Real> ZuptFilter<T> {
     }
 
     /// The ZUPT measurement update (eqs. 19–21): frozen position, zero velocity, frozen
-    /// attitude; Joseph form, symmetrised; feedback into the solution and reset.
+    /// attitude; Joseph form (the shared `strapdown::joseph_update`); feedback into the
+    /// solution and reset.
     pub fn update(&mut self) -> Result<(), NavError> {
         // Attitude measurement: q̂ ⊗ q₀* = exp(ψ/2) for Ĉ = (I + [ψ×])·C₀.
         let dq = self.q.into_inner() * self.q0.conjugate().into_inner();
@@ -287,37 +288,11 @@ impl<T: Real> ZuptFilter<T> {
         z.fixed_rows_mut::<3>(3).copy_from(&self.vel);
         z.fixed_rows_mut::<3>(6).copy_from(&psi);
 
-        let p9 = self.p.fixed_rows::<N_MEAS>(0).into_owned(); // H·P (9×15)
-        let mut s_mat = p9.fixed_columns::<N_MEAS>(0).into_owned();
-        for i in 0..N_MEAS {
-            s_mat[(i, i)] += self.r_diag[i];
-        }
-        let chol = s_mat.cholesky().ok_or(NavError::NotPositiveDefinite {
-            what: "innovation covariance S = HPHᵀ + R",
-        })?;
-        let kt = chol.solve(&p9); // Kᵀ = S⁻¹·H·P (9×15)
-        let k = kt.transpose(); // 15×9
-        self.last_nis = z.dot(&chol.solve(&z));
-        let dx = k * z;
-        // Joseph form with H = [I₉ 0]: (I−KH)P(I−KH)ᵀ + KRKᵀ.
-        let m = self.p - k * p9;
-        let mk = m.fixed_columns::<N_MEAS>(0) * kt;
-        let mut kr = k;
-        for j in 0..N_MEAS {
-            let r = self.r_diag[j];
-            kr.column_mut(j).scale_mut(r);
-        }
-        let p_new = m - mk + kr * kt;
-        let p_sym = (p_new + p_new.transpose()) * lit::<T>(0.5);
-        for i in 0..N_STATES {
-            let d = p_sym[(i, i)];
-            if !(num_traits::Float::is_finite(d) && d > T::zero()) {
-                return Err(NavError::NotPositiveDefinite {
-                    what: "state covariance P",
-                });
-            }
-        }
-        self.p = p_sym;
+        // H = [I₉ 0]: the shared Joseph-form kernel with H·P and S read off P.
+        let g =
+            strapdown::gain_leading(&self.p, &self.r_diag, "innovation covariance S = HPHᵀ + R")?;
+        self.last_nis = z.dot(&g.chol.solve(&z));
+        let dx = strapdown::joseph_update(&mut self.p, &z, &g)?;
         // Feedback (δx = estimate − truth) and reset.
         self.pos -= dx.fixed_rows::<3>(0);
         self.vel -= dx.fixed_rows::<3>(3);

@@ -243,7 +243,7 @@ fn tczupt_tracks_a_thermal_ramp_that_zupt_lags() {
         }
         ((se / (n / 2) as f64 / 3.0).sqrt(), f.temp_rate_c_s())
     };
-    let (rms_z, _) = run(Mode::Zupt);
+    let (rms_z, _) = run(Mode::Classic);
     let (rms_t, rate) = run(Mode::Tczupt);
     assert!((rate - 2.0 / 60.0).abs() < 1e-9, "{rate}");
     assert!(rms_t < 0.7 * rms_z, "TCZUPT {rms_t} vs ZUPT {rms_z}");
@@ -444,7 +444,7 @@ proptest! {
         // Finite input of any magnitude (up to 1e300): every step returns Ok with a finite
         // state or an Err; nothing panics and no NaN is carried forward silently.
         let cfg = ZuptConfig {
-            mode: if tc { Mode::Tczupt } else { Mode::Zupt },
+            mode: if tc { Mode::Tczupt } else { Mode::Classic },
             ..ZuptConfig::default()
         };
         let mut f = ZuptFilter::new(cfg, UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros(), 0.01)
