@@ -116,6 +116,7 @@ pub fn attitude<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
         let w = Vector3::from(v3::<T>(w));
         timed(p, "attitude.step", || prop.step(&w, dt))?;
         if (k + 1) % EVERY == 0 {
+            p.value(k as f64);
             out_quat(p, prop.attitude());
         }
     }
@@ -154,6 +155,7 @@ pub fn zupt<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
             timed(p, "zupt.update", || z.update())?;
         }
         if (k + 1) % EVERY == 0 {
+            p.value(k as f64);
             zupt_outputs(p, &z);
             p.value(f(z.last_nis()));
         }
@@ -197,16 +199,21 @@ const AXIS_SCALE: [f64; 3] = [1.0, -0.6, 0.8];
 /// TCZUPT on the static log with the MLP's ∂b/∂T, through `step` (slope of the die
 /// temperature, MLP derivative, predict, and the 1 Hz update when due).
 pub fn tczupt<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
-    p.begin("tczupt");
+    p.begin("mlp");
     let mlp = thermal_mlp::<T>()?;
     for k in (0..N).step_by(EVERY) {
         let o = timed(p, "mlp.eval", || mlp.eval(c(inputs::STATIC_TEMP[k])));
+        p.value(k as f64);
         p.value(f(o.value));
         p.value(f(o.derivative));
     }
+    p.end();
+    p.begin("tczupt");
     let cfg = ZuptConfig::<T> {
         mode: nav_core::zupt::Mode::Tczupt,
         noise: nav_core::zupt::ProcessNoise::thesis_tczupt(),
+        // A window the 3 s log fills (the default 30 s would leave dT/dt at zero).
+        temp_slope_window_s: c(1.0),
         ..ZuptConfig::default()
     };
     let dt = c::<T>(DT_S);
@@ -224,6 +231,7 @@ pub fn tczupt<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
         let updated = z.step(&g, &a, temp, true, &mut deriv)?;
         p.toc(if updated { "tczupt.step+update" } else { "tczupt.step" });
         if (k + 1) % EVERY == 0 {
+            p.value(k as f64);
             zupt_outputs(p, &z);
             p.value(f(z.temp_rate_c_s()));
         }
@@ -273,10 +281,14 @@ pub fn ins<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
             let vel = v3::<T>(&[fix[4], fix[5], fix[6]]);
             let acc = v3::<T>(&[fix[7], fix[8], fix[9]]);
             let st = timed(p, "ins.update_gnss", || ins.update_gnss(&llh, &vel, &acc, 0.0))?;
+            p.value(k as f64);
             p.value(f64::from(st as u8));
             ins_outputs(p, &ins);
         }
         if (k + 1) % EVERY == 0 {
+            p.value(k as f64);
+            // Not a fix: status −1.
+            p.value(-1.0);
             ins_outputs(p, &ins);
         }
     }
@@ -293,6 +305,7 @@ pub fn detector<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
         let g = v3::<T>(&inputs::FLIGHT_GYRO[k]);
         let (stat, still) = timed(p, "detector.push", || d.push(&a, &g))?;
         if k % 5 == 0 {
+            p.value(k as f64);
             p.value(f(stat));
             p.value(f64::from(u8::from(still)));
         }
@@ -329,6 +342,7 @@ pub fn fdi<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
         }
         let o = timed(p, "fdi.step", || fuser.step(&z))?;
         if k % 5 == 0 {
+            p.value(k as f64);
             out_vec(p, &o.fused.value);
             p.value(f(o.fused.chi2));
             p.value(f64::from(u8::from(o.valid)));
