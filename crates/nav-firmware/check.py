@@ -371,7 +371,55 @@ def panic_sites(objdump: str, elf: str) -> list[tuple[str, str]]:
     return sites
 
 
+def write_c_inputs(path: str) -> None:
+    """``inputs.h`` for the C interface test: the arrays of ``src/inputs.rs`` as C doubles."""
+    text = (HERE / "src" / "inputs.rs").read_text()
+    lines = ["/* Written by crates/nav-firmware/check.py from src/inputs.rs. */"]
+    for m in re.finditer(r"pub static (\w+): ([^=]+)= \[(.*?)\];", text, re.S):
+        name, ty, body = m.groups()
+        dims = re.findall(r"; (\d+)\]", ty)
+        vals = re.findall(r"[-+0-9.eE]+(?:e[-+]?\d+)?", body)
+        decl = "".join(f"[{d}]" for d in reversed(dims))
+        if len(dims) == 2:
+            w = int(dims[0])
+            rows = [", ".join(vals[i : i + w]) for i in range(0, len(vals), w)]
+            init = ", ".join(f"{{{r}}}" for r in rows)
+        else:
+            init = ", ".join(vals)
+        lines.append(f"static const double {name}{decl} = {{{init}}};")
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
+def check_c_output(path: str, ref: dict) -> bool:
+    """The C program's outputs equal the host reference's f32 outputs bit for bit."""
+    text = Path(path).read_text()
+    vals, _, _ = parse(text)
+    if "done" not in text.split():
+        print(f"error: the C interface test did not finish: {text[-300:]}")
+        return False
+    bad, n = [], 0
+    for case, got in vals["f32"].items():
+        want = ref["f32"][case]
+        if len(got) != len(want):
+            bad.append(f"{case}: {len(got)} values, host {len(want)}")
+            continue
+        for i, (a, b) in enumerate(zip(got, want)):
+            n += 1
+            if struct.pack("<d", a) != struct.pack("<d", b):
+                bad.append(f"{case}[{i}]: {a!r} != host {b!r}")
+    if bad or n == 0:
+        print(f"error: the C interface differs from the host reference in {len(bad)} of {n} values:")
+        for line in bad[:20]:
+            print(f"  {line}")
+        return False
+    print(f"C interface (gcc, nav-ffi): {n} values of {', '.join(vals['f32'])} bit-identical to the host reference")
+    return True
+
+
 def main() -> int:
+    if len(sys.argv) == 3 and sys.argv[1] == "c-inputs":
+        write_c_inputs(sys.argv[2])
+        return 0
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("host")
     ap.add_argument("m4")
@@ -379,6 +427,7 @@ def main() -> int:
     ap.add_argument("--size", default="llvm-size")
     ap.add_argument("--nm", default="llvm-nm")
     ap.add_argument("--objdump", default="llvm-objdump")
+    ap.add_argument("--c-output", help="output of the C interface test, compared with the host")
     args = ap.parse_args()
 
     host = subprocess.run([args.host], capture_output=True, text=True, check=False)
@@ -417,6 +466,9 @@ def main() -> int:
         else:
             print(f"{machine} ({cpu}): {n} values bit-identical to the host reference ({secs:.1f} s in QEMU)")
         runs[key] = (timing, cal)
+
+    if args.c_output and not check_c_output(args.c_output, ref):
+        ok = False
 
     ck = Checker()
     check_precision(ck, ref["f32"], ref["f64"], inp)

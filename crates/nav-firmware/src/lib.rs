@@ -21,9 +21,7 @@ use nav_core::attitude::{euler321_to_quat, AttitudePropagator, PropagatorConfig}
 use nav_core::ins::{InsConfig, InsFilter};
 use nav_core::mlp::{Activation, Affine, LayerSpec, Mlp};
 use nav_core::redundancy::{FdiConfig, FdiFuser, SensorArray};
-use nav_core::zupt::{
-    StationarityConfig, StationarityDetector, ZuptConfig, ZuptFilter,
-};
+use nav_core::zupt::{StationarityConfig, StationarityDetector, ZuptConfig, ZuptFilter};
 use nav_core::{NavError, Real};
 
 /// Samples per case (100 Hz).
@@ -171,8 +169,13 @@ pub fn thermal_mlp<T: Real>() -> Result<Mlp<T>, NavError> {
             *o = c(*x);
         }
     };
-    let (mut w1, mut b1, mut w2, mut b2, mut w3) =
-        ([T::zero(); 6], [T::zero(); 6], [T::zero(); 36], [T::zero(); 6], [T::zero(); 6]);
+    let (mut w1, mut b1, mut w2, mut b2, mut w3) = (
+        [T::zero(); 6],
+        [T::zero(); 6],
+        [T::zero(); 36],
+        [T::zero(); 6],
+        [T::zero(); 6],
+    );
     conv(&inputs::MLP_W1, &mut w1);
     conv(&inputs::MLP_B1, &mut b1);
     conv(&inputs::MLP_W2, &mut w2);
@@ -181,14 +184,32 @@ pub fn thermal_mlp<T: Real>() -> Result<Mlp<T>, NavError> {
     let [b3, in_off, in_gain, out_off, out_scale] = inputs::MLP_NORM;
     let b3 = [c::<T>(b3)];
     let layers = [
-        LayerSpec { weights: &w1, biases: &b1, activation: Activation::Tanh },
-        LayerSpec { weights: &w2, biases: &b2, activation: Activation::Tanh },
-        LayerSpec { weights: &w3, biases: &b3, activation: Activation::Linear },
+        LayerSpec {
+            weights: &w1,
+            biases: &b1,
+            activation: Activation::Tanh,
+        },
+        LayerSpec {
+            weights: &w2,
+            biases: &b2,
+            activation: Activation::Tanh,
+        },
+        LayerSpec {
+            weights: &w3,
+            biases: &b3,
+            activation: Activation::Linear,
+        },
     ];
     Mlp::new(
         &layers,
-        Affine { offset: c(in_off), scale: c(in_gain) },
-        Affine { offset: c(out_off), scale: c(out_scale) },
+        Affine {
+            offset: c(in_off),
+            scale: c(in_gain),
+        },
+        Affine {
+            offset: c(out_off),
+            scale: c(out_scale),
+        },
         (c(-40.0), c(85.0)),
     )
 }
@@ -229,7 +250,11 @@ pub fn tczupt<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
         let temp = Some(c::<T>(inputs::STATIC_TEMP[k]));
         p.tic();
         let updated = z.step(&g, &a, temp, true, &mut deriv)?;
-        p.toc(if updated { "tczupt.step+update" } else { "tczupt.step" });
+        p.toc(if updated {
+            "tczupt.step+update"
+        } else {
+            "tczupt.step"
+        });
         if (k + 1) % EVERY == 0 {
             p.value(k as f64);
             zupt_outputs(p, &z);
@@ -280,7 +305,9 @@ pub fn ins<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
             let llh = [fix[1], fix[2], fix[3]];
             let vel = v3::<T>(&[fix[4], fix[5], fix[6]]);
             let acc = v3::<T>(&[fix[7], fix[8], fix[9]]);
-            let st = timed(p, "ins.update_gnss", || ins.update_gnss(&llh, &vel, &acc, 0.0))?;
+            let st = timed(p, "ins.update_gnss", || {
+                ins.update_gnss(&llh, &vel, &acc, 0.0)
+            })?;
             p.value(k as f64);
             p.value(f64::from(st as u8));
             ins_outputs(p, &ins);

@@ -77,7 +77,10 @@ struct Line {
 
 impl Default for Line {
     fn default() -> Self {
-        Line { bytes: [0; 128], len: 0 }
+        Line {
+            bytes: [0; 128],
+            len: 0,
+        }
     }
 }
 
@@ -136,7 +139,14 @@ impl Probe for Firmware {
             .iter_mut()
             .find(|s| s.is_none_or(|s| s.name == step));
         if let Some(slot) = slot {
-            let s = slot.get_or_insert(Stat { name: step, calls: 0, sum: 0, min: u32::MAX, max: 0, stack: 0 });
+            let s = slot.get_or_insert(Stat {
+                name: step,
+                calls: 0,
+                sum: 0,
+                min: u32::MAX,
+                max: 0,
+                stack: 0,
+            });
             s.calls += 1;
             s.sum += u64::from(ticks);
             s.min = s.min.min(ticks);
@@ -169,7 +179,11 @@ fn main() -> ! {
         (Some(p), Ok(out)) => run(p.SYST, Host(out)),
         _ => false,
     };
-    debug::exit(if ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
     #[allow(clippy::empty_loop)]
     loop {}
 }
@@ -179,13 +193,22 @@ fn run(mut syst: SYST, host: Host) -> bool {
     syst.set_reload(RELOAD);
     syst.clear_current();
     syst.enable_counter();
-    let mut fw = Firmware { host, syst, t0: 0, top: 0, stats: [None; 8] };
+    let mut fw = Firmware {
+        host,
+        syst,
+        t0: 0,
+        top: 0,
+        stats: [None; 8],
+    };
     let n = 1_000_000;
     let ticks = calibrate(n);
-    fw.host.line(format_args!("cal instructions={} ticks={}", 2 * n, ticks));
-    fw.host.line(format_args!("precision {}", precision::<f32>()));
+    fw.host
+        .line(format_args!("cal instructions={} ticks={}", 2 * n, ticks));
+    fw.host
+        .line(format_args!("precision {}", precision::<f32>()));
     let r = run_all::<f32, _>(&mut fw).and_then(|()| {
-        fw.host.line(format_args!("precision {}", precision::<f64>()));
+        fw.host
+            .line(format_args!("precision {}", precision::<f64>()));
         run_all::<f64, _>(&mut fw)
     });
     let _ = &fw.syst;
