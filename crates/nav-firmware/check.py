@@ -94,7 +94,7 @@ BOARDS = {
 }
 BUDGET = 0.25
 
-RECORD = {"attitude": 5, "zupt": 33, "mlp": 3, "tczupt": 33, "ins": 33, "detector": 3, "fdi": 13}
+RECORD = {"position": 9, "attitude": 5, "zupt": 33, "mlp": 3, "tczupt": 33, "ins": 33, "detector": 3, "fdi": 13}
 
 
 def parse(text: str) -> tuple[dict, dict, dict]:
@@ -317,6 +317,19 @@ def check_precision(ck: Checker, v32: dict, v64: dict, inp: dict) -> None:
             ck.equal(f"fdi[k={k}] flag[{i - 5}]", a[i], b[i])
 
 
+def check_position(ck: Checker, v32: dict, v64: dict) -> None:
+    """Geodetic part: f64 in both builds, equal. Local NED position: one multiply and one add
+    per step, |Δp| ≤ k·2u·|p|max + k·u·|v|·dt (the rounded velocity)."""
+    r32, r64 = records("position", v32["position"]), records("position", v64["position"])
+    pmax = max(abs(r[i]) for r in r64 for i in (6, 7, 8))
+    for a, b in zip(r32, r64):
+        k = int(b[0]) + 1
+        for i in range(1, 6):
+            ck.equal(f"position[k={k - 1}] geodetic[{i - 1}]", a[i], b[i])
+        for i in range(6, 9):
+            ck.within(f"position[k={k - 1}] ned[{i - 6}]", a[i], b[i], k * U * (2 * pmax + 10 * DT))
+
+
 def run_qemu(machine: str, cpu: str, elf: str) -> tuple[str, int, float]:
     cmd = [
         "qemu-system-arm", "-machine", machine, "-cpu", cpu, "-nographic", "-monitor", "none",
@@ -472,6 +485,7 @@ def main() -> int:
 
     ck = Checker()
     check_precision(ck, ref["f32"], ref["f64"], inp)
+    check_position(ck, ref["f32"], ref["f64"])
     if ck.failures:
         ok = False
         print(f"error: {len(ck.failures)} of {ck.checked} f32 outputs outside their derived bound:")
@@ -503,6 +517,8 @@ ROWS = [
     ("ins.update_gnss", "INS GNSS update (6 rows)"),
     ("detector.push", "static detector"),
     ("fdi.step", "FDI, 6 triaxial gyros"),
+    ("position.geodetic_f64", "INS position part: f64 lat/lon/h + Earth refresh"),
+    ("position.local", "same, PX4-style NED from a local origin (precision of the column)"),
 ]
 
 
@@ -567,14 +583,16 @@ def print_sizes(args: argparse.Namespace) -> None:
         print()
         print(f"{BOARDS[key][0]} firmware (f32 and f64 cases, harness included): .text {sec.get('.text', 0):,} B, .rodata {sec.get('.rodata', 0):,} B (inputs), .data+.bss {sec.get('.data', 0) + sec.get('.bss', 0):,} B")
         print("  code per module (f32 + f64 instances, non-inlined symbols): " + ", ".join(f"{k} {v:,} B" for k, v in sorted(sizes.items(), key=lambda kv: -kv[1])))
-        by_kind: dict[str, list[str]] = defaultdict(list)
+        print(f"  panic call sites: {len(sites)} (calls into core::panicking and friends), by owner:")
+        by_owner: dict[str, dict[str, set]] = defaultdict(lambda: defaultdict(set))
         for func, kind in sites:
-            by_kind[kind.split("::")[-1].split("<")[0]].append(func)
-        print(f"  panic call sites: {len(sites)}")
-        for kind, funcs in sorted(by_kind.items()):
-            uniq = sorted(set(f.split("<")[0][:90] for f in funcs))
-            print(f"    {kind}: {len(funcs)} in " + "; ".join(uniq[:8]) + (" …" if len(uniq) > 8 else ""))
-
+            name = re.sub(r"::h[0-9a-f]{16}$", "", func).replace("$LT$", "<").replace("$GT$", ">")
+            m = re.match(r"nav_core::(\w+)", name)
+            owner = f"nav-core {m.group(1)}" if m else next((o for o in ("libm", "nalgebra", "nav_firmware", "core") if o in name), "other")
+            by_owner[owner][kind.split("::")[-1].split("<")[0]].add(name)
+        for owner, kinds in sorted(by_owner.items()):
+            funcs = sorted({f for fs in kinds.values() for f in fs if owner.startswith("nav-core")})
+            print(f"    {owner}: " + ", ".join(f"{k} in {len(v)} fn" for k, v in sorted(kinds.items())) + (f" ({'; '.join(funcs)})" if funcs else ""))
 
 if __name__ == "__main__":
     sys.exit(main())

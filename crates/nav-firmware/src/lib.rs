@@ -100,6 +100,7 @@ pub fn run_all<T: Real, P: Probe>(p: &mut P) -> Result<(), (&'static str, NavErr
     ins::<T, P>(p).map_err(|e| ("ins", e))?;
     detector::<T, P>(p).map_err(|e| ("detector", e))?;
     fdi::<T, P>(p).map_err(|e| ("fdi", e))?;
+    position::<T, P>(p);
     Ok(())
 }
 
@@ -381,4 +382,70 @@ pub fn fdi<T: Real, P: Probe>(p: &mut P) -> Result<(), NavError> {
     }
     p.end();
     Ok(())
+}
+
+/// Earth radii and gravity at a reference point, as the INS caches them (f64).
+struct Earth {
+    lat: f64,
+    h: f64,
+    cos_lat: f64,
+    rn: f64,
+    re: f64,
+    gravity: f64,
+    grav_grad: f64,
+}
+
+impl Earth {
+    fn at(lat: f64, h: f64) -> Self {
+        use num_traits::Float;
+        let (sl, cl) = (lat.sin(), lat.cos());
+        let d = 1.0 - nav_core::earth::WGS84_E2 * sl * sl;
+        let re = nav_core::earth::WGS84_A / d.sqrt();
+        let g = nav_core::earth::normal_gravity(lat, h);
+        Earth {
+            lat,
+            h,
+            cos_lat: cl,
+            rn: re * (1.0 - nav_core::earth::WGS84_E2) / d,
+            re,
+            gravity: g,
+            grav_grad: 2.0 * g / nav_core::earth::geocentric_radius(lat),
+        }
+    }
+}
+
+/// The price of the f64 geodetic position on each core: the position part of the INS
+/// mechanisation done as nav-core's INS does it (latitude, longitude, height in f64, the Earth
+/// radii and gravity recomputed in f64 after 1e-6 rad or 1 m of motion), and as PX4's EKF2 does
+/// it (a `T` NED position from a local origin, radii fixed at the origin). A constant velocity
+/// of (10, 5, −1) m/s NED, 300 steps of 10 ms.
+pub fn position<T: Real, P: Probe>(p: &mut P) {
+    p.begin("position");
+    let [lat0, lon0, h0] = inputs::FLIGHT_LLH0;
+    let (mut lat, mut lon, mut h) = (lat0, lon0, h0);
+    let mut e = Earth::at(lat, h);
+    let v64 = [10.0f64, 5.0, -1.0];
+    let v: Vector3<T> = Vector3::from(v3::<T>(&v64));
+    let dt = c::<T>(DT_S);
+    let mut ned = Vector3::<T>::zeros();
+    for k in 0..N {
+        timed(p, "position.geodetic_f64", || {
+            let (rn_h, re_h) = (e.rn + h, e.re + h);
+            h -= v64[2] * DT_S;
+            lat += v64[0] * DT_S / rn_h;
+            lon += v64[1] * DT_S / (re_h * e.cos_lat);
+            if num_traits::Float::abs(lat - e.lat) > 1e-6 || num_traits::Float::abs(h - e.h) > 1.0 {
+                e = Earth::at(lat, h);
+            }
+        });
+        timed(p, "position.local", || ned += v * dt);
+        if (k + 1) % EVERY == 0 {
+            p.value(k as f64);
+            for x in [lat, lon, h, e.gravity, e.grav_grad] {
+                p.value(x);
+            }
+            out_vec(p, &ned);
+        }
+    }
+    p.end();
 }
