@@ -76,14 +76,14 @@ typedef struct UasnavZuptConfig {
   float temp_slope_window_s;
 } UasnavZuptConfig;
 
-// A ZUPT or TCZUPT filter in caller-owned memory (about 4.8 KiB). Create or reset it with
+// A ZUPT or TCZUPT filter in caller-owned memory (4,808 bytes). Create or reset it with
 // [`uasnav_zupt_init`]; never copy it with `memcpy` while another call uses it.
 typedef struct UasnavZupt {
   uint64_t tag;
   uint64_t storage[UASNAV_ZUPT_WORDS];
 } UasnavZupt;
 
-// A thermal MLP in caller-owned memory (about 1.6 KiB). Create it with [`uasnav_mlp_init`].
+// A thermal MLP in caller-owned memory (1,608 bytes). Create it with [`uasnav_mlp_init`].
 typedef struct UasnavMlp {
   uint64_t tag;
   uint64_t storage[UASNAV_MLP_WORDS];
@@ -140,7 +140,7 @@ typedef struct UasnavInsConfig {
   float gate_chi2;
 } UasnavInsConfig;
 
-// A GNSS/INS filter in caller-owned memory (about 12.8 KiB). Create or reset it with
+// A GNSS/INS filter in caller-owned memory (12,808 bytes). Create or reset it with
 // [`uasnav_ins_init`].
 typedef struct UasnavIns {
   uint64_t tag;

@@ -96,7 +96,7 @@ pub const UASNAV_INS_WORDS: usize = 1600;
 /// 64-bit words of storage in a [`UasnavMlp`].
 pub const UASNAV_MLP_WORDS: usize = 200;
 
-/// A ZUPT or TCZUPT filter in caller-owned memory (about 4.8 KiB). Create or reset it with
+/// A ZUPT or TCZUPT filter in caller-owned memory (4,808 bytes). Create or reset it with
 /// [`uasnav_zupt_init`]; never copy it with `memcpy` while another call uses it.
 #[repr(C)]
 pub struct UasnavZupt {
@@ -104,7 +104,7 @@ pub struct UasnavZupt {
     storage: [u64; UASNAV_ZUPT_WORDS],
 }
 
-/// A GNSS/INS filter in caller-owned memory (about 12.8 KiB). Create or reset it with
+/// A GNSS/INS filter in caller-owned memory (12,808 bytes). Create or reset it with
 /// [`uasnav_ins_init`].
 #[repr(C)]
 pub struct UasnavIns {
@@ -112,7 +112,7 @@ pub struct UasnavIns {
     storage: [u64; UASNAV_INS_WORDS],
 }
 
-/// A thermal MLP in caller-owned memory (about 1.6 KiB). Create it with [`uasnav_mlp_init`].
+/// A thermal MLP in caller-owned memory (1,608 bytes). Create it with [`uasnav_mlp_init`].
 #[repr(C)]
 pub struct UasnavMlp {
     tag: u64,
