@@ -131,7 +131,7 @@ def _check_views(log: Any, gnss_datum: HeightDatum) -> None:
     est = log.autopilot_estimate
     # the estimate is given in the fixes' datum: the heights compare directly
     assert isinstance(est, Trajectory) and est.alt_datum is g.alt_datum
-    assert isinstance(log.flight, FlightLog)
+    assert isinstance(log.flight, FlightLog) and log.flight.alt_datum is HeightDatum.AMSL
     assert isinstance(log.params, dict) and len(log.params) > 10
     assert isinstance(log.modes, ModeTimeline) and len(log.modes.names) >= 1
     assert isinstance(log.identity, Identity) and log.identity.autopilot
@@ -163,6 +163,7 @@ def test_views_of_the_shared_tlog(shared_data: Path) -> None:
     _check_views(log, HeightDatum.AMSL)  # GPS_RAW_INT.alt / GLOBAL_POSITION_INT.alt, both AMSL
     assert isinstance(log.plan, MissionPlan)
     assert log.identity.clock == "wall" and log.identity.autopilot == "ArduPilot"
+    assert {"AUTO", "STABILIZE"} <= set(log.modes.names)
 
 
 def test_views_of_the_shared_dataflash(shared_data: Path) -> None:

@@ -23,6 +23,7 @@ from uasnav.io._mavlink import messages, reading
 from uasnav.io.alfa import isa_pressure_altitude
 from uasnav.io.formats._scan import MavlinkScan
 from uasnav.io.formats.base import LogFormat
+from uasnav.io.formats.dataflash import COPTER_MODES
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.io.tlog import IMU_TYPES
 from uasnav.io.views import Identity, ModeTimeline, changes
@@ -262,7 +263,14 @@ class TlogFormat(LogFormat):
     def build_modes(self) -> ModeTimeline:
         beats = [m for m in self._messages(["HEARTBEAT"]) if int(m.type) != _GCS]
         t = np.array([float(m._timestamp) for m in beats], dtype=np.float64)
-        names = [f"MODE_{int(m.custom_mode)}" for m in beats]
+        # ArduCopter's custom_mode numbers are its mode numbers (the DataFlash MODE.Mode)
+        copter = [int(m.autopilot) == 3 and MAV_TYPES.get(int(m.type)) == "multirotor" for m in beats]
+        names = [
+            COPTER_MODES.get(int(m.custom_mode), f"MODE_{int(m.custom_mode)}")
+            if c
+            else f"MODE_{int(m.custom_mode)}"
+            for m, c in zip(beats, copter, strict=True)
+        ]
         if t.size and np.any(np.diff(t) < 0):
             order = np.argsort(t, kind="stable")
             t, names = t[order], [names[i] for i in order]
