@@ -14,6 +14,7 @@ import pytest
 from click.testing import CliRunner
 
 from uasnav.cli import main
+from uasnav.errors import DataFormatError
 from uasnav.geo.datum import HeightDatum, receiver_undulation
 from uasnav.io import open_log
 from uasnav.io.flight import FlightLog
@@ -131,7 +132,7 @@ def _check_views(log: Any, gnss_datum: HeightDatum) -> None:
     est = log.autopilot_estimate
     # the estimate is given in the fixes' datum: the heights compare directly
     assert isinstance(est, Trajectory) and est.alt_datum is g.alt_datum
-    assert isinstance(log.flight, FlightLog)
+    assert isinstance(log.flight, FlightLog) and log.flight.alt_datum is HeightDatum.AMSL
     assert isinstance(log.params, dict) and len(log.params) > 10
     assert isinstance(log.modes, ModeTimeline) and len(log.modes.names) >= 1
     assert isinstance(log.identity, Identity) and log.identity.autopilot
@@ -163,6 +164,7 @@ def test_views_of_the_shared_tlog(shared_data: Path) -> None:
     _check_views(log, HeightDatum.AMSL)  # GPS_RAW_INT.alt / GLOBAL_POSITION_INT.alt, both AMSL
     assert isinstance(log.plan, MissionPlan)
     assert log.identity.clock == "wall" and log.identity.autopilot == "ArduPilot"
+    assert {"AUTO", "STABILIZE"} <= set(log.modes.names)
 
 
 def test_views_of_the_shared_dataflash(shared_data: Path) -> None:
@@ -265,3 +267,16 @@ def test_open_log_by_url(shared_data: Path, tmp_path: Path) -> None:
         assert np.array_equal(log.imu.gyro, direct.gyro)
     finally:
         srv.shutdown()
+
+
+def test_a_gnss_csv_replaces_the_logs_fixes(shared_data: Path, tmp_path: Path) -> None:
+    from uasnav.io.gnss_csv import write_gnss_csv
+
+    p = shared_data / "flights" / "px4_s500_mission_land.ulg"
+    own = open_log(p).gnss
+    fixes = own.select(np.arange(own.n) % 2 == 0)
+    write_gnss_csv(tmp_path / "g.csv", fixes)
+    nav = open_log(p, gnss=str(tmp_path / "g.csv")).nav
+    assert nav.gnss.n == fixes.n and nav.imu.n > 1000
+    with pytest.raises(DataFormatError, match="carries no plan"):
+        open_log(shared_data / "imu" / "xio_fusion_sensor_data.csv").view("plan")

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import DataFormatError, InputError
+from uasnav.geo.datum import HeightDatum
 from uasnav.io._common import nothing_valid, report_corruption, salvage
 from uasnav.io._quiet import LibraryOutput
 from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
@@ -67,6 +68,10 @@ class FlightLog:
         Mission/waypoint speed (m/s), if logged.
     source : str
         The file read.
+    alt_datum : HeightDatum
+        What ``alt`` is measured from: AMSL for the log readers (ULog ``vehicle_global_position``
+        / ``vehicle_gps_position.alt``, DataFlash ``GPS.Alt``, ``GLOBAL_POSITION_INT.alt``), not
+        stated by a flight CSV (``unknown``).
     """
 
     t: FloatArray
@@ -79,8 +84,10 @@ class FlightLog:
     wind_ne: FloatArray | None = None
     cruise_ms: float | None = None
     source: str = ""
+    alt_datum: HeightDatum = HeightDatum.UNKNOWN
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "alt_datum", HeightDatum(self.alt_datum))
         src = self.source or "flight log"
         arrays: dict[str, FloatArray] = {}
         for k in _SAMPLE_FIELDS:
@@ -175,11 +182,13 @@ def flight_from_fixes(
     wind: Sequence[FloatArray | tuple[float, float]],
     cruise_ms: float | None = None,
     decoder: LibraryOutput | None = None,
+    alt_datum: HeightDatum = HeightDatum.AMSL,
 ) -> FlightLog:
     """A :class:`FlightLog` from position fixes ``(t, lat, lon, alt, v_N, v_E, v_D)`` (rows of a
     sequence or an array (k, 7)) and events.
 
-    ``wind`` holds the log's wind estimates (north, east; m/s): their mean becomes ``wind_ne``.
+    ``alt_datum`` is the heights' datum (the log readers': AMSL). ``wind`` holds the log's wind
+    estimates (north, east; m/s): their mean becomes ``wind_ne``.
     Corrupt fixes (:func:`valid_fixes`) are dropped; if any were, or the ``decoder`` reported
     problems, one :class:`~uasnav.errors.CorruptDataWarning` says so.
 
@@ -209,6 +218,7 @@ def flight_from_fixes(
             wind_ne=np.mean(np.asarray(wind, dtype=np.float64), axis=0) if wind else None,
             cruise_ms=cruise_ms,
             source=src,
+            alt_datum=alt_datum,
         )
     except InputError as e:
         raise DataFormatError(str(e).removeprefix(f"{src}: "), path=src) from None

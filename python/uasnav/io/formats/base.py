@@ -60,6 +60,8 @@ class LogFormat:
     #: None for formats read whole.
     SCANNER: ClassVar[Callable[..., Any] | None] = None
     SCAN_OPTIONS: ClassVar[dict[str, Any]] = {}
+    #: Views read by one reader function of the path (called with the scan active).
+    READERS: ClassVar[dict[str, Callable[[Path], Any]]] = {}
 
     def scan(self, types: set[str], previous: Any | None) -> Any | None:
         """The scan that covers ``types``: ``previous`` when it does, else one new decoding pass
@@ -78,14 +80,36 @@ class LogFormat:
             if nav is None:
                 nav = cache["nav"] = self.build("nav", cache)
             return getattr(nav, NAV_PARTS[view])
-        if view == "nav" and self.options.get("gnss") is not None and self.name != "csv-v1":
-            return self._with_gnss(self.build_nav())  # type: ignore[attr-defined]
-        fn = getattr(self, f"build_{view}", None)
-        if fn is None or view not in self.SOURCES:
+        if view not in self.SOURCES:
             raise DataFormatError(
                 f"a {self.name} log carries no {view.replace('_', ' ')}", path=str(self.path)
             )
-        return fn()
+        if view in self.READERS:
+            value = self.READERS[view](self.path)
+        else:
+            value = getattr(self, f"build_{view}")()
+        if view == "nav" and self.options.get("gnss") is not None and self.name != "csv-v1":
+            value = self._with_gnss(value)  # the fixes of a GNSS CSV replace the log's own
+        return value
+
+    def build_imu(self) -> Any:
+        """The primary IMU: the first stream by name."""
+        logs = self.build("imus", {})
+        return logs[sorted(logs)[0]]
+
+    def limit_parameters(self, params: dict[str, float]) -> dict[str, tuple[str, float]]:
+        """The parameter table of :mod:`uasnav.io.autopilot_params` the limits are read with."""
+        from uasnav.io.autopilot_params import ARDUPILOT_PARAMS
+
+        return ARDUPILOT_PARAMS
+
+    def build_limits(self) -> Any:
+        """The navigation limits from the parameters
+        (:func:`~uasnav.io.autopilot_params.limits_from_params`)."""
+        from uasnav.io.autopilot_params import limits_from_params
+
+        params = self.build("params", {})
+        return limits_from_params(params, self.limit_parameters(params))
 
     def _with_gnss(self, nav: Any) -> Any:
         """``nav`` with the GNSS fixes of the option ``gnss`` (a GNSS CSV path or GnssData)."""

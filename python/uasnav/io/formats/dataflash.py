@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -25,10 +26,17 @@ from numpy.typing import NDArray
 from uasnav.errors import DataFormatError, InputError
 from uasnav.geo.datum import HeightDatum
 from uasnav.geo.frames import ned_to_geodetic
-from uasnav.io.dataflash import IMU_TYPES, read_dataflash, read_dataflash_messages
+from uasnav.io.dataflash import (
+    IMU_TYPES,
+    read_dataflash,
+    read_dataflash_flight,
+    read_dataflash_identity,
+    read_dataflash_messages,
+)
 from uasnav.io.formats._scan import MavlinkScan
 from uasnav.io.formats.base import LogFormat
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory, strictly_increasing
+from uasnav.io.plan_formats.logs import read_dataflash_plan
 from uasnav.io.views import Identity, ModeTimeline, changes
 
 FloatArray = NDArray[np.float64]
@@ -231,26 +239,12 @@ class DataflashFormat(LogFormat):
         "modes": ("MODE", "MSG"),
         "identity": ("MSG", "GPS"),
     }
-
-    def build_imus(self) -> Any:
-        return read_dataflash(self.path)
-
-    def build_imu(self) -> Any:
-        logs = read_dataflash(self.path)
-        return logs[sorted(logs)[0]]
-
-    def build_nav(self) -> Flight:
-        return read_dataflash_nav(self.path)
-
-    def build_flight(self) -> Any:
-        from uasnav.io.dataflash import read_dataflash_flight
-
-        return read_dataflash_flight(self.path)
-
-    def build_plan(self) -> Any:
-        from uasnav.io.plan_formats.logs import read_dataflash_plan
-
-        return read_dataflash_plan(self.path)
+    READERS: ClassVar[dict[str, Callable[[Path], Any]]] = {
+        "imus": read_dataflash,
+        "nav": read_dataflash_nav,
+        "flight": read_dataflash_flight,
+        "plan": read_dataflash_plan,
+    }
 
     def build_params(self) -> dict[str, float]:
         from uasnav.io._mavlink import messages, reading
@@ -260,11 +254,6 @@ class DataflashFormat(LogFormat):
             for m in messages(conn, ["PARM"], self.path, "DataFlash"):
                 out[str(m.Name).rstrip("\x00")] = float(m.Value)  # the last value logged wins
         return out
-
-    def build_limits(self) -> Any:
-        from uasnav.io.autopilot_params import ARDUPILOT_PARAMS, limits_from_params
-
-        return limits_from_params(self.build_params(), ARDUPILOT_PARAMS)
 
     def _texts(self) -> list[str]:
         from uasnav.io._mavlink import messages, reading
@@ -285,8 +274,6 @@ class DataflashFormat(LogFormat):
         return changes(modes["t"], names, "MODE.Mode")
 
     def build_identity(self) -> Identity:
-        from uasnav.io.dataflash import read_dataflash_identity
-
         fields: dict[str, Any] = {"autopilot": "ArduPilot", "clock": "boot"}
         for text in self._texts():
             fw = _FIRMWARE.match(text)

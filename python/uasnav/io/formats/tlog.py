@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import datetime as dt
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -21,10 +22,13 @@ from uasnav.imu import ImuLog
 from uasnav.io._common import because
 from uasnav.io._mavlink import messages, reading
 from uasnav.io.alfa import isa_pressure_altitude
+from uasnav.io.autopilot_params import ARDUPILOT_PARAMS, PX4_PARAMS
 from uasnav.io.formats._scan import MavlinkScan
 from uasnav.io.formats.base import LogFormat
+from uasnav.io.formats.dataflash import COPTER_MODES
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
-from uasnav.io.tlog import IMU_TYPES
+from uasnav.io.plan_formats.logs import read_tlog_plan
+from uasnav.io.tlog import IMU_TYPES, read_tlog, read_tlog_flight
 from uasnav.io.views import Identity, ModeTimeline, changes
 from uasnav.units import STANDARD_GRAVITY
 
@@ -219,32 +223,16 @@ class TlogFormat(LogFormat):
         "modes": ("HEARTBEAT",),
         "identity": ("HEARTBEAT", "AUTOPILOT_VERSION"),
     }  # fmt: skip
+    READERS: ClassVar[dict[str, Callable[[Path], Any]]] = {
+        "imus": read_tlog,
+        "nav": read_tlog_nav,
+        "flight": read_tlog_flight,
+        "plan": read_tlog_plan,
+    }
 
     def _messages(self, types: list[str]) -> list[Any]:
         with reading(self.path, dialect="ardupilotmega") as (conn, _):
             return list(messages(conn, types, self.path, "MAVLink"))
-
-    def build_imus(self) -> Any:
-        from uasnav.io.tlog import read_tlog
-
-        return read_tlog(self.path)
-
-    def build_imu(self) -> Any:
-        logs = self.build_imus()
-        return logs[sorted(logs)[0]]
-
-    def build_nav(self) -> Flight:
-        return read_tlog_nav(self.path)
-
-    def build_flight(self) -> Any:
-        from uasnav.io.tlog import read_tlog_flight
-
-        return read_tlog_flight(self.path)
-
-    def build_plan(self) -> Any:
-        from uasnav.io.plan_formats.logs import read_tlog_plan
-
-        return read_tlog_plan(self.path)
 
     def build_params(self) -> dict[str, float]:
         out = {}
@@ -252,17 +240,22 @@ class TlogFormat(LogFormat):
             out[str(m.param_id).rstrip("\x00")] = float(m.param_value)  # the last value wins
         return out
 
-    def build_limits(self) -> Any:
-        from uasnav.io.autopilot_params import ARDUPILOT_PARAMS, PX4_PARAMS, limits_from_params
-
-        params = self.build_params()
+    def limit_parameters(self, params: dict[str, float]) -> dict[str, tuple[str, float]]:
+        # a PX4 vehicle's telemetry carries PX4's parameters
         px4 = any(k.startswith(("MPC_", "EKF2_")) for k in params)
-        return limits_from_params(params, PX4_PARAMS if px4 else ARDUPILOT_PARAMS)
+        return PX4_PARAMS if px4 else ARDUPILOT_PARAMS
 
     def build_modes(self) -> ModeTimeline:
         beats = [m for m in self._messages(["HEARTBEAT"]) if int(m.type) != _GCS]
         t = np.array([float(m._timestamp) for m in beats], dtype=np.float64)
-        names = [f"MODE_{int(m.custom_mode)}" for m in beats]
+        # ArduCopter's custom_mode numbers are its mode numbers (the DataFlash MODE.Mode)
+        copter = [int(m.autopilot) == 3 and MAV_TYPES.get(int(m.type)) == "multirotor" for m in beats]
+        names = [
+            COPTER_MODES.get(int(m.custom_mode), f"MODE_{int(m.custom_mode)}")
+            if c
+            else f"MODE_{int(m.custom_mode)}"
+            for m, c in zip(beats, copter, strict=True)
+        ]
         if t.size and np.any(np.diff(t) < 0):
             order = np.argsort(t, kind="stable")
             t, names = t[order], [names[i] for i in order]

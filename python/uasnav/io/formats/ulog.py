@@ -22,6 +22,7 @@ ellipsoidal height leaves both in AMSL.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -31,9 +32,12 @@ from numpy.typing import NDArray
 from uasnav.errors import DataFormatError
 from uasnav.geo.datum import HeightDatum, receiver_undulation
 from uasnav.geo.frames import ned_to_geodetic
+from uasnav.io.autopilot_params import PX4_PARAMS
 from uasnav.io.formats._scan import ULogScan
 from uasnav.io.formats.base import LogFormat
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory, strictly_increasing
+from uasnav.io.plan_formats.ulog import read_ulog_plan
+from uasnav.io.px4 import _open, _start_utc, read_ulog, read_ulog_flight, read_ulog_imus
 from uasnav.io.views import Identity, ModeTimeline, changes
 
 FloatArray = NDArray[np.float64]
@@ -87,8 +91,6 @@ def read_ulog_nav(path: str | Path) -> Flight:
     DataFormatError
         No GNSS topic, fewer than 2 3-D fixes, or the IMU reader's errors.
     """
-    from uasnav.io.px4 import _open, read_ulog
-
     p = Path(path)
     imu = read_ulog(p)
     ulog, _ = _open(p)
@@ -223,34 +225,16 @@ class UlogFormat(LogFormat):
         "modes": ("vehicle_status",),
         "identity": (*_GNSS, "vehicle_status"),
     }
+    READERS: ClassVar[dict[str, Callable[[Path], Any]]] = {
+        "imus": read_ulog_imus,
+        "imu": read_ulog,
+        "nav": read_ulog_nav,
+        "flight": read_ulog_flight,
+        "plan": read_ulog_plan,
+    }
 
     def _ulog(self) -> Any:
-        from uasnav.io.px4 import _open
-
         return _open(self.path)[0]
-
-    def build_imus(self) -> Any:
-        from uasnav.io.px4 import read_ulog_imus
-
-        return read_ulog_imus(self.path)
-
-    def build_imu(self) -> Any:
-        from uasnav.io.px4 import read_ulog
-
-        return read_ulog(self.path)
-
-    def build_nav(self) -> Flight:
-        return read_ulog_nav(self.path)
-
-    def build_flight(self) -> Any:
-        from uasnav.io.px4 import read_ulog_flight
-
-        return read_ulog_flight(self.path)
-
-    def build_plan(self) -> Any:
-        from uasnav.io.plan_formats.ulog import read_ulog_plan
-
-        return read_ulog_plan(self.path)
 
     def build_params(self) -> dict[str, float]:
         out = {}
@@ -261,10 +245,8 @@ class UlogFormat(LogFormat):
                 continue
         return out
 
-    def build_limits(self) -> Any:
-        from uasnav.io.autopilot_params import PX4_PARAMS, limits_from_params
-
-        return limits_from_params(self.build_params(), PX4_PARAMS)
+    def limit_parameters(self, params: dict[str, float]) -> dict[str, tuple[str, float]]:
+        return PX4_PARAMS
 
     def build_modes(self) -> ModeTimeline:
         vs = _topic(self._ulog(), "vehicle_status")
@@ -274,8 +256,6 @@ class UlogFormat(LogFormat):
         return changes(vs["timestamp"] * 1e-6, names, "vehicle_status.nav_state")
 
     def build_identity(self) -> Identity:
-        from uasnav.io.px4 import _start_utc
-
         ulog = self._ulog()
         info = getattr(ulog, "msg_info_dict", None) or {}
         version = None
