@@ -23,7 +23,7 @@ from uasnav.cli._common import (
     parse_float_list,
     warnings_after_success,
 )
-from uasnav.errors import InputError
+from uasnav.errors import DataFormatError, InputError
 
 if TYPE_CHECKING:
     from uasnav.io.autopilot_limits import AutopilotLimits
@@ -330,10 +330,14 @@ def _log_limits(flights: Sequence[str], logs: Any) -> tuple[AutopilotLimits, str
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed, as_json):  # type: ignore[no-untyped-def]
-    """e% (eq. 59) per element and per run of LVQ vs the baselines.
+    """ETA and per-waypoint errors of the predictors on real flights, or the thesis' experiment.
 
-    Real FLIGHT...: leave-one-run-out (each mission run predicted by a model trained on the
-    others). --simulated: the thesis' experiment, 7 flights per trajectory train, 3 test.
+    Real FLIGHT... (.tlog, .bin, .ulg with their mission): every AUTO run predicted by the
+    autopilot's mission execution model with the log's own parameters (one flight is enough;
+    no training), beside QGroundControl's mission-time estimate and plan length ÷ speed; the
+    element methods (LVQ, kinematic point mass …, e% of eq. 59) by leave-one-run-out where the
+    logs hold two runs or more. --simulated: the thesis' experiment, 7 flights per trajectory
+    train, 3 test.
     """
     if simulated:
         from uasnav.experiments.trajectory import run_phantom4
@@ -352,47 +356,9 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         t17 = [{"piece": p.piece, "t_nn_s": p.t_nn_s, "t_real_s": list(p.t_real_s)} for p in r.table17]
         out = {"methods": table, "table17": t17, "n_train": len(r.train), "n_test": len(r.test)}
     else:
-        from uasnav.trajectory.flights import flight_samples, leave_one_run_out
-
         if not flights:
             raise click.UsageError("give FLIGHT files or --simulated")
-        wind = parse_wind(wind_text) if wind_text else None
-        # warnings (telemetry gaps) are shown once the evaluation succeeded: a failed run
-        # prints its one error line only
-        with warnings_after_success():
-            fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
-            limits, _ = _log_limits(flights, fs.logs)
-            errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
-        table = {
-            e.name: {
-                "applicable": True,
-                "element_e_pct_mean": float(np.mean(e.element_pct)),
-                "element_e_pct_median": float(np.median(e.element_pct)),
-                "run_e_pct_mean": float(np.mean(e.run_pct)),
-                # per-run ETA error |e%|: median, 95th percentile, worst (issue 17)
-                "run_abs_e_pct_median": float(np.median(np.abs(e.run_pct))),
-                "run_abs_e_pct_p95": float(np.percentile(np.abs(e.run_pct), 95)),
-                "run_abs_e_pct_worst": float(np.max(np.abs(e.run_pct))),
-                "run_e_pct": list(e.run_pct),
-            }
-            if e.applicable
-            else {"applicable": False, "reason": e.reason}
-            for e in errors
-        }
-        from uasnav.trajectory.models import DEFAULT_METHOD
-
-        out = {
-            "methods": table,
-            # the method `train` fits by default (chosen by this leave-one-run-out measurement)
-            "default_method": {"kinematic": "kinematic point mass", "lvq": "LVQ (thesis)"}[DEFAULT_METHOD],
-            "n_runs": len(fs),
-            "n_elements": fs.n_elements,
-            # the kinematic models' limits: from the logs' parameters, else the stated defaults
-            "limits": {
-                "accel_ms2": limits.accel_ms2,
-                "from_log": "accel_ms2" in limits.source,
-            },
-        }
+        out = _evaluate_flights(flights, plan, speed, wind_text, segment, max_gap, seed)
     if as_json:
         echo_json(out)
         return
@@ -406,12 +372,113 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             if "run_abs_e_pct_median" in d
             else ""
         )
-        click.echo(f"{name:24s} element e% mean {d['element_e_pct_mean']:6.2f}{extra}")
+        element = f" element e% mean {d['element_e_pct_mean']:6.2f}" if "element_e_pct_mean" in d else ""
+        click.echo(f"{name:24s}{element}{extra}")
+    for r in out.get("runs", []):
+        wp = r["waypoint_errors"]
+        worst = max((abs(w["error_s"]) for w in wp), default=float("nan"))
+        click.echo(
+            f"run {Path(r['log']).name} @ {r['start_s']:.1f} s ({r['stack']}"
+            f"{'' if r['landed'] else ', cut'}): real {r['eta_real_s']:.1f} s, "
+            + ", ".join(f"{k} {v:.1f} s" for k, v in r["eta_pred_s"].items())
+            + f"; {len(wp)} waypoints, worst arrival error {worst:.1f} s"
+        )
     for row in out.get("table17", []):
         click.echo(
             f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
             + ", ".join(f"{x:.2f}" for x in row["t_real_s"])
         )
+
+
+def _evaluate_flights(
+    flights: Sequence[str],
+    plan: str | None,
+    speed: float | None,
+    wind_text: str | None,
+    segment: float,
+    max_gap: float,
+    seed: int,
+) -> dict[str, Any]:
+    """``evaluate FLIGHT…``: every AUTO run predicted by the autopilot's mission execution
+    model with the log's own parameters (no training: one flight is enough) beside
+    QGroundControl's estimate and plan length ÷ speed; and, where the logs allow, the
+    element methods (LVQ, kinematic point mass …) by leave-one-run-out."""
+    from uasnav.io.logfile import open_log
+    from uasnav.trajectory.flights import flight_samples, leave_one_run_out
+    from uasnav.trajectory.mission_runs import MISSION_VIEWS, MODEL, evaluate_logs
+
+    wind = parse_wind(wind_text) if wind_text else None
+    # one decoding pass per log serves both evaluations
+    opened: list[Any] = [
+        open_log(f, need=(*MISSION_VIEWS, "limits"))
+        if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg") and Path(f).is_file()
+        else f
+        for f in flights
+    ]
+    table: dict[str, Any] = {}
+    mission: dict[str, Any] | None = None
+    mission_error = None
+    logs_with_plan = [lf for lf in opened if not isinstance(lf, str)]
+    if logs_with_plan and plan is None and speed is None:
+        try:
+            mission = evaluate_logs(logs_with_plan)
+            table.update(mission["methods"])
+        except (InputError, DataFormatError) as e:
+            mission_error = str(e)
+    element_error = None
+    fs = None
+    limits = None
+    # warnings (telemetry gaps) are shown once the evaluation succeeded: a failed run prints
+    # its one error line only
+    with warnings_after_success():
+        try:
+            fs = flight_samples(opened, plan, speed, wind, segment, max_gap)
+            limits, _ = _log_limits(flights, fs.logs)
+            errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
+        except InputError as e:
+            if mission is None:
+                raise
+            element_error, errors = str(e), []
+    for e in errors:
+        table[e.name] = (
+            {
+                "applicable": True,
+                "element_e_pct_mean": float(np.mean(e.element_pct)),
+                "element_e_pct_median": float(np.median(e.element_pct)),
+                "run_e_pct_mean": float(np.mean(e.run_pct)),
+                # per-run ETA error |e%|: median, 95th percentile, worst
+                "run_abs_e_pct_median": float(np.median(np.abs(e.run_pct))),
+                "run_abs_e_pct_p95": float(np.percentile(np.abs(e.run_pct), 95)),
+                "run_abs_e_pct_worst": float(np.max(np.abs(e.run_pct))),
+                "run_e_pct": list(e.run_pct),
+            }
+            if e.applicable
+            else {"applicable": False, "reason": e.reason}
+        )
+    from uasnav.trajectory.models import DEFAULT_METHOD
+
+    out: dict[str, Any] = {
+        "methods": table,
+        # the mission execution model when the logs carry their missions; else the element
+        # method `train` fits by default (chosen by leave-one-run-out)
+        "default_method": MODEL
+        if mission is not None
+        else {"kinematic": "kinematic point mass", "lvq": "LVQ (thesis)"}[DEFAULT_METHOD],
+        "n_runs": len(fs) if fs is not None else len(mission["runs"]) if mission else 0,
+        "n_elements": fs.n_elements if fs is not None else 0,
+    }
+    if limits is not None:
+        # the kinematic models' limits: from the logs' parameters, else the stated defaults
+        out["limits"] = {"accel_ms2": limits.accel_ms2, "from_log": "accel_ms2" in limits.source}
+    if mission is not None:
+        out["runs"] = mission["runs"]
+        out["per_stack"] = mission["per_stack"]
+        out["parameters"] = mission["parameters"]
+    if element_error is not None:
+        out["element_methods"] = f"not evaluated: {element_error}"
+    if mission_error is not None:
+        out["mission_model"] = f"not evaluated: {mission_error}"
+    return out
 
 
 @command.command("calibrate")
