@@ -481,6 +481,81 @@ def _evaluate_flights(
     return out
 
 
+@command.command("mission")
+@click.argument("plan_path", metavar="PLAN", type=click.Path(dir_okay=False))
+@click.option(
+    "--autopilot",
+    type=click.Choice(["arducopter", "px4-mc", "plane"]),
+    help="Autopilot family that flies the plan; default the log's (--params-from), else from the "
+    "plan (fixed-wing/VTOL commands: plane), else arducopter.",
+)
+@click.option("--firmware", help="Firmware version (e.g. 3.6, 4.5, 1.14); default the log's or current.")
+@click.option(
+    "--params-from",
+    "params_log",
+    type=click.Path(dir_okay=False),
+    help="Flight log (.tlog .bin .ulg) of the vehicle: its parameters replace the firmware defaults.",
+)
+@click.option("--home-alt", type=Real(-1000.0, 9000.0), help="Home altitude AMSL (m) for AMSL items.")
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # type: ignore[no-untyped-def]
+    """When each item of PLAN (.plan, .waypoints, a log's mission) is reached and when the
+    mission ends, as the autopilot flies it (no training: the firmware's mission execution with
+    the vehicle's parameters or the firmware defaults, each with its source), beside
+    QGroundControl's own mission-time estimate."""
+    from uasnav.io.plans import read_plan
+    from uasnav.trajectory.autopilot import (
+        family_of,
+        mission_params,
+        predict_mission,
+        qgc_mission_time,
+    )
+
+    plan = read_plan(plan_path)
+    log_params: dict[str, float] = {}
+    ident = None
+    if params_log:
+        from uasnav.io.logfile import open_log
+
+        lf = open_log(params_log, need=("params", "identity"))
+        log_params, ident = lf.params, lf.identity
+    if autopilot is None:
+        if ident is not None:
+            autopilot = family_of(ident, log_params)
+        elif any(it.command in (84, 85) for it in plan.items) or plan.vehicle_type == 1:
+            autopilot = "plane"
+        else:
+            autopilot = "arducopter"
+    version = firmware or (getattr(ident, "firmware_version", None) if ident is not None else None)
+    params = mission_params(autopilot, version, log_params)
+    pred = predict_mission(plan, params, home_amsl_m=home_alt)
+    qgc = qgc_mission_time(plan, params.cruise_ms, home_alt)
+    out = {
+        "autopilot": autopilot,
+        "firmware": params.version,
+        "eta_s": pred.eta_s,
+        "landed": pred.landed,
+        "qgc_estimate_s": qgc,
+        "items": [
+            {"item": int(i), "command": int(c), "arrive_s": float(t)}
+            for i, c, t in zip(pred.items, pred.commands, pred.arrive_s, strict=True)
+        ],
+        "parameters": {k: {"value": params.values[k], "source": params.sources[k]} for k in params.values},
+    }
+    if as_json:
+        echo_json(out)
+        return
+    for r in out["items"]:
+        click.echo(f"item {r['item']:>3} (MAV_CMD {r['command']:>3}) reached at {r['arrive_s']:8.1f} s")
+    end = "touch-down" if pred.landed else "last item"
+    click.echo(
+        f"ETA ({end}) {pred.eta_s:.1f} s, {autopilot} {params.version or ''}".rstrip()
+        + f"; QGroundControl's estimate {qgc:.1f} s"
+    )
+    from_log = sorted(k for k, v in params.sources.items() if v == "log")
+    click.echo(f"parameters from the log: {', '.join(from_log) or 'none'}; others the firmware defaults")
+
+
 @command.command("calibrate")
 @click.option(
     "--model", "model_path", required=True, type=click.Path(dir_okay=False), help="Model JSON (from train)."
