@@ -359,7 +359,7 @@ PX4_MC_DEFAULTS: dict[str, Default] = {
     ),
     "RTL_RETURN_ALT": Default(60.0, "rtl_params.c v1.11–1.14: RTL_RETURN_ALT 60 m"),
     "RTL_DESCEND_ALT": Default(30.0, "rtl_params.c v1.11–1.14: RTL_DESCEND_ALT 30 m"),
-    "RTL_LAND_DELAY": Default(0.0, "rtl_params.c v1.11–1.14: RTL_LAND_DELAY 0 s"),
+    "RTL_LAND_DELAY": Default(0.0, "rtl_params.c v1.13–1.14: RTL_LAND_DELAY 0 s (−1 before: hover)"),
 }
 
 #: ArduPlane / QuadPlane defaults (SI). Sources: ArduPilot ``ArduPlane/Parameters.cpp``
@@ -497,7 +497,7 @@ def mission_params(
     else:
         raise InputError(f"unknown autopilot family {family!r} (known: {', '.join(FAMILIES)})")
     for k, v in values.items():
-        if not math.isfinite(v) or (v < 0 and k != "MIS_YAW_TMT"):
+        if not math.isfinite(v) or (v < 0 and k not in ("MIS_YAW_TMT", "RTL_LAND_DELAY")):
             raise InputError(f"parameter {k} = {v}: must be finite and ≥ 0")
     return MissionParams(family, version, values, sources)
 
@@ -906,7 +906,9 @@ def _rtl(p: MissionParams, s: _State, home_ne: np.ndarray, cruise: float) -> boo
         loiter, final = p["RTL_LOIT_TIME"], p["RTL_ALT_FINAL"]
     elif p.family == "px4-mc":
         rtl_alt, v = p["RTL_RETURN_ALT"], cruise
-        loiter, final = p["RTL_LAND_DELAY"], 0.0
+        # RTL_LAND_DELAY < 0: hover at RTL_DESCEND_ALT instead of landing
+        loiter = max(p["RTL_LAND_DELAY"], 0.0)
+        final = p["RTL_DESCEND_ALT"] if p["RTL_LAND_DELAY"] < 0 else 0.0
     else:
         rtl_alt, v, loiter, final = s.h, cruise, 0.0, 0.0
     if s.h < rtl_alt:
