@@ -229,3 +229,21 @@ def test_arducopter_4x_rtl_closed_form_and_final_altitude_hover() -> None:
     hover = ap.mission_params("arducopter", "4.5.7", {"RTL_ALT_FINAL": 500.0})
     h = ap.predict_mission(_plan(items), hover)
     assert not h.landed and h.eta_s - h.arrive_s[1] == pytest.approx(t_leg + 5.0 + 15 / 1.5, rel=2e-3)
+
+
+def test_time_bounds_from_the_vehicles_own_flights(shared_data: Path) -> None:
+    from uasnav.errors import InputError
+    from uasnav.trajectory.mission_runs import calibrate_from_flights, simulated_scores
+
+    ulg = shared_data / "flights" / "px4_s500_mission_land.ulg"
+    b = calibrate_from_flights([ulg])
+    assert b.n_runs == 1 and "1 AUTO runs of the vehicle (px4_s500_mission_land.ulg)" == b.source
+    # one run cannot give 95 % coverage (19 are needed): refused, not a silent band
+    with pytest.raises(InputError, match="at least 19 calibration runs"):
+        b.quantile(0.95)
+    assert b.quantile(0.5) == b.scores[0]
+    # without flights: simulated executions of the plan; the nominal parameters score 0
+    p = ap.mission_params("arducopter", "4.5.7")
+    plan = _plan([MissionItem(22, 3, alt_m=20.0), MissionItem(21, 3, alt_m=0.0)])
+    s = simulated_scores(plan, p, n_runs=50, seed=1)
+    assert s.shape == (50,) and np.all(s >= 0) and np.all(s < 1.0) and s.max() > 0

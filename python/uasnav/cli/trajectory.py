@@ -383,6 +383,13 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             + ", ".join(f"{k} {v:.1f} s" for k, v in r["eta_pred_s"].items())
             + f"; {len(wp)} waypoints, worst arrival error {worst:.1f} s"
         )
+    tb = out.get("time_bounds")
+    if tb:
+        lo, hi = tb["covered_ci95"]
+        click.echo(
+            f"{tb['coverage']:.0%} time bounds ({tb['source']}): {tb['covered']}/{tb['n_runs']} real runs "
+            f"within (Clopper–Pearson 95 %: {lo:.3f}–{hi:.3f})"
+        )
     for row in out.get("table17", []):
         click.echo(
             f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
@@ -425,20 +432,31 @@ def _evaluate_flights(
             table.update(mission["methods"])
         except (InputError, DataFormatError) as e:
             mission_error = str(e)
-    element_error = None
+    element_error: str | None = None
     fs = None
     limits = None
     # warnings (telemetry gaps) are shown once the evaluation succeeded: a failed run prints
     # its one error line only
     with warnings_after_success():
         try:
-            fs = flight_samples(opened, plan, speed, wind, segment, max_gap)
+            # the element methods measure elements between waypoints the telemetry names:
+            # logs without them (PX4 keeps its mission out of the telemetry) are left to the
+            # mission model when it evaluates them
+            element_logs = [
+                lf
+                for lf in opened
+                if isinstance(lf, str) or plan is not None or mission is None or lf.flight.waypoints
+            ]
+            skipped = [Path(str(lf.path)).name for lf in opened if lf not in element_logs]
+            if skipped:
+                element_error = f"{', '.join(skipped)}: no waypoints in the telemetry"
+            fs = flight_samples(element_logs, plan, speed, wind, segment, max_gap)
             limits, _ = _log_limits(flights, fs.logs)
             errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
         except InputError as e:
             if mission is None:
                 raise
-            element_error, errors = str(e), []
+            element_error, errors, fs = str(e), [], None
     for e in errors:
         table[e.name] = (
             {
@@ -474,8 +492,9 @@ def _evaluate_flights(
         out["runs"] = mission["runs"]
         out["per_stack"] = mission["per_stack"]
         out["parameters"] = mission["parameters"]
+        out["time_bounds"] = mission["time_bounds"]
     if element_error is not None:
-        out["element_methods"] = f"not evaluated: {element_error}"
+        out["element_methods"] = f"not evaluated on {element_error}"
     if mission_error is not None:
         out["mission_model"] = f"not evaluated: {mission_error}"
     return out
@@ -584,11 +603,25 @@ def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # t
     show_default=True,
     help="Coverage reported for the held-out runs.",
 )
+@click.option(
+    "--flights",
+    "flight_logs",
+    multiple=True,
+    type=click.Path(dir_okay=False),
+    help="The vehicle's own earlier flights (.tlog .bin .ulg with their mission; repeat the option): "
+    "the bounds come from their AUTO runs instead of simulation.",
+)
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # type: ignore[no-untyped-def]
-    """Calibrate the time bounds of a model (split-conformal on simulated 3D runs with truth:
-    random routes with take-off, sloped legs, holds and landing, scored at every element)."""
+def calibrate(model_path, out, runs, test_runs, coverage, flight_logs, seed, as_json):  # type: ignore[no-untyped-def]
+    """Calibrate the time bounds of a model: split-conformal on the vehicle's own earlier
+    flights (--flights: each AUTO run scored at its waypoint arrivals and its end, predicted by
+    the autopilot's mission execution model), else on simulated 3D runs with truth (random
+    routes with take-off, sloped legs, holds and landing, scored at every element). The source
+    is kept in the model and stated in the intents made with it."""
+    if flight_logs:
+        _calibrate_from_flights(model_path, out, flight_logs, coverage, as_json)
+        return
     from uasnav.trajectory.calibration import calibrate as fit_bounds
     from uasnav.trajectory.calibration import covered
     from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
@@ -627,6 +660,36 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
         click.echo(
             f"held-out coverage {res['covered']}/{test_runs} (Clopper–Pearson 95 %: {lo:.3f}–{hi:.3f})"
         )
+
+
+def _calibrate_from_flights(
+    model_path: str, out: str, flight_logs: Sequence[str], coverage: float, as_json: bool
+) -> None:
+    """``calibrate --flights``: the model's time bounds from the vehicle's own AUTO runs."""
+    from uasnav.trajectory.mission_runs import calibrate_from_flights
+    from uasnav.trajectory.models import load_model, method_of
+
+    check_outputs([model_path, *flight_logs], {"--out": out})
+    model = load_model(model_path)
+    bounds = calibrate_from_flights(flight_logs)
+    q = bounds.quantile(coverage)  # refuses a coverage that too few runs cannot give
+    model.time_bounds_ = bounds
+    model.save(out)
+    res = {
+        "method": method_of(model),
+        "runs": bounds.n_runs,
+        "coverage": coverage,
+        "quantile": q,
+        "tau_s": bounds.tau_s,
+        "source": bounds.source,
+    }
+    if as_json:
+        echo_json(res)
+        return
+    click.echo(
+        f"{res['method']} model, time bounds: ±{q:.3f}·(t + {bounds.tau_s:g} s) at {coverage:.0%} "
+        f"coverage from {bounds.source}"
+    )
 
 
 @command.command("intent")
@@ -783,6 +846,8 @@ def intent(  # type: ignore[no-untyped-def]
         "descent_ms": down,
         "accel_z_ms2": a_z,
         "limits_from_log": from_log,
+        # what calibrated the time bounds: the vehicle's own flights or simulation
+        "time_bounds_source": b.time_bounds_source,
         # where the W84 altitudes' geoid heights came from: the user's N, or the installed model
         "geoid": "given" if geoid_height is not None else geoid_model(),
     }
@@ -798,5 +863,6 @@ def intent(  # type: ignore[no-untyped-def]
         return
     click.echo(
         f"{len(b.details.volumes)} volumes; ETA {b.eta_s:.0f} s "
-        f"({b.eta_bounds_s[0]:.0f}–{b.eta_bounds_s[1]:.0f} s at {coverage:.0%}); wrote {out}"
+        f"({b.eta_bounds_s[0]:.0f}–{b.eta_bounds_s[1]:.0f} s at {coverage:.0%}, bounds from "
+        f"{b.time_bounds_source or 'calibration'}); wrote {out}"
     )

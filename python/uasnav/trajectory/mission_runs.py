@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -32,10 +33,14 @@ from uasnav.trajectory.autopilot import (
     predict_mission,
     qgc_mission_time,
 )
+from uasnav.trajectory.timebounds import DEFAULT_TAU_S, TimeBounds
 
 #: Mode names that run a mission, and those that continue a run once started.
 MISSION_MODES = frozenset({"AUTO", "AUTO_MISSION"})
 CONTINUING_MODES = frozenset({"AUTO", "AUTO_MISSION", "AUTO_LAND", "AUTO_RTL", "AUTO_TAKEOFF", "LAND", "RTL"})
+#: Simulated runs that calibrate each log's time bounds, and their coverage.
+SIM_RUNS = 200
+COVERAGE = 0.95
 #: The views of a log the mission evaluation reads.
 MISSION_VIEWS = ("flight", "plan", "params", "modes", "identity")
 #: Height above the ground (m) that counts as lift-off / touch-down.
@@ -282,13 +287,21 @@ def evaluate_logs(logs: Sequence[Any]) -> dict[str, Any]:
     scores: list[tuple[str, RunScore]] = []
     stacks: dict[str, str] = {}
     sources: dict[str, Any] = {}
+    covered: list[bool] = []
     for item in logs:
         log = item if isinstance(item, LogFile) else open_log(item, need=MISSION_VIEWS)
         path = str(log.path)
         p = log_mission_params(log)
         stacks[path] = f"{p.family} {p.version or ''}".strip()
         sources[path] = {k: {"value": p.values[k], "source": p.sources[k]} for k in p.values}
-        scores += [(path, s) for s in score_runs(log, p)]
+        log_scores = score_runs(log, p)
+        scores += [(path, s) for s in log_scores]
+        # time bounds calibrated on simulated executions of this log's mission (the vehicle's
+        # own earlier flights calibrate them with `trajectory calibrate --flights`)
+        bounds = TimeBounds(
+            simulated_scores(log.plan, p, SIM_RUNS), DEFAULT_TAU_S, f"{SIM_RUNS} simulated runs"
+        )
+        covered += [covered_run(bounds, s, COVERAGE) for s in log_scores]
     if not scores:
         raise InputError("no scorable AUTO run in the logs")
     methods: dict[str, Any] = {}
@@ -324,7 +337,26 @@ def evaluate_logs(logs: Sequence[Any]) -> dict[str, Any]:
             "run_abs_e_pct_worst": float(np.max(np.abs(v)))}
         for k, v in per_stack.items()
     }  # fmt: skip
-    return {"methods": methods, "runs": runs, "per_stack": stack_table, "parameters": sources}
+    from uasnav.trajectory.timebounds import clopper_pearson
+
+    k = int(sum(covered))
+    lo, hi = clopper_pearson(k, len(covered))
+    bounds_report = {
+        "coverage": COVERAGE,
+        "source": f"{SIM_RUNS} simulated runs of each log's mission (perturbed parameters)",
+        "covered": k,
+        "n_runs": len(covered),
+        "covered_ci95": [lo, hi],
+    }
+    for r, c in zip(runs, covered, strict=True):
+        r["within_time_bounds"] = c
+    return {
+        "methods": methods,
+        "runs": runs,
+        "per_stack": stack_table,
+        "parameters": sources,
+        "time_bounds": bounds_report,
+    }
 
 
 __all__ = [
@@ -332,10 +364,87 @@ __all__ = [
     "MODEL",
     "NAIVE",
     "QGC",
+    "SIM_SPREAD",
     "MissionRun",
     "RunScore",
+    "calibrate_from_flights",
+    "covered_run",
     "evaluate_logs",
     "log_mission_params",
     "mission_runs",
+    "run_nonconformity",
     "score_runs",
+    "simulated_scores",
 ]
+
+
+# --------------------------------------------------------------------------- time bounds
+def run_nonconformity(s: RunScore, tau_s: float = DEFAULT_TAU_S) -> float:
+    """The score r of a real run for the mission model (the form of
+    :func:`uasnav.trajectory.timebounds.score`): max over its waypoint arrivals and its end of
+    |T − T̂| / (T̂ + τ)."""
+    pairs = [(w["real_s"], w["pred_s"]) for w in s.waypoint_errors_s]
+    pairs.append((s.eta_real_s, s.eta_pred_s[MODEL]))
+    return max(abs(t - p) / (p + tau_s) for t, p in pairs)
+
+
+#: The perturbations of the simulated runs that calibrate the mission model's time bounds
+#: when the vehicle has no flights of its own: each parameter of the firmware's waypoint,
+#: climb and landing control scaled by a uniform factor in [1 − x, 1 + x] (speeds 10 %,
+#: accelerations and jerk 30 %, acceptance radii and land altitudes 50 %), and a start delay
+#: uniform in [0, 2] s (the pilot's throttle, the motors spooling up).
+SIM_SPREAD = {"speed": 0.10, "accel": 0.30, "radius": 0.50}
+SIM_START_DELAY_S = 2.0
+
+
+def _spread_of(name: str) -> float:
+    if any(k in name for k in ("ACC", "JERK")):
+        return SIM_SPREAD["accel"]
+    if any(k in name for k in ("RAD", "ALT", "LOIT")):
+        return SIM_SPREAD["radius"]
+    if any(k in name for k in ("SPEED", "CRUISE", "V_AUTO", "VEL", "ARSPD", "CLMB", "SINK")):
+        return SIM_SPREAD["speed"]
+    return 0.0
+
+
+def simulated_scores(
+    plan: MissionPlan, params: MissionParams, n_runs: int = 200, seed: int = 0, tau_s: float = DEFAULT_TAU_S
+) -> np.ndarray:
+    """Scores r of ``n_runs`` simulated executions of ``plan`` (truth: the model with perturbed
+    parameters, :data:`SIM_SPREAD`; prediction: the nominal parameters)."""
+    rng = np.random.default_rng(seed)
+    nominal = predict_mission(plan, params)
+    out = np.empty(n_runs)
+    for k in range(n_runs):
+        vals = {n: v * (1.0 + _spread_of(n) * rng.uniform(-1.0, 1.0)) for n, v in params.values.items()}
+        truth = predict_mission(plan, MissionParams(params.family, params.version, vals, params.sources))
+        delay = rng.uniform(0.0, SIM_START_DELAY_S)
+        t_true = np.r_[truth.arrive_s, truth.eta_s] + delay
+        t_pred = np.r_[nominal.arrive_s, nominal.eta_s]
+        m = min(t_true.size, t_pred.size)
+        out[k] = float(np.max(np.abs(t_true[:m] - t_pred[:m]) / (t_pred[:m] + tau_s)))
+    return out
+
+
+def calibrate_from_flights(logs: Sequence[Any], tau_s: float = DEFAULT_TAU_S) -> TimeBounds:
+    """Time bounds of the mission model from the vehicle's own flights: one score per AUTO run
+    (:func:`run_nonconformity`)."""
+    from uasnav.io.logfile import LogFile, open_log
+
+    scores: list[float] = []
+    names = []
+    for item in logs:
+        log = item if isinstance(item, LogFile) else open_log(item, need=MISSION_VIEWS)
+        names.append(Path(str(log.path)).name)
+        scores += [run_nonconformity(s, tau_s) for s in score_runs(log)]
+    if not scores:
+        raise InputError("no scorable AUTO run in the flights")
+    return TimeBounds(np.array(scores), tau_s, f"{len(scores)} AUTO runs of the vehicle ({', '.join(names)})")
+
+
+def covered_run(bounds: TimeBounds, s: RunScore, coverage: float) -> bool:
+    """Whether every waypoint arrival and the end of a real run lie within the bounds."""
+    q = bounds.quantile(coverage)
+    pairs = [(w["real_s"], w["pred_s"]) for w in s.waypoint_errors_s]
+    pairs.append((s.eta_real_s, s.eta_pred_s[MODEL]))
+    return all(abs(t - p) <= q * (p + bounds.tau_s) for t, p in pairs)
