@@ -247,3 +247,32 @@ def test_time_bounds_from_the_vehicles_own_flights(shared_data: Path) -> None:
     plan = _plan([MissionItem(22, 3, alt_m=20.0), MissionItem(21, 3, alt_m=0.0)])
     s = simulated_scores(plan, p, n_runs=50, seed=1)
     assert s.shape == (50,) and np.all(s >= 0) and np.all(s < 1.0) and s.max() > 0
+
+
+def test_px4_auto_vertical_speeds_win_in_the_limits() -> None:
+    from uasnav.io.autopilot_params import PX4_PARAMS, limits_from_params
+
+    lim = limits_from_params(
+        {"MPC_Z_V_AUTO_UP": 2.0, "MPC_Z_VEL_MAX_UP": 3.0, "MPC_Z_VEL_MAX_DN": 1.0}, PX4_PARAMS
+    )
+    assert lim.climb_ms == 2.0 and lim.descent_ms == 1.0  # 1.11 logs have only the _VEL_MAX_ pair
+
+
+def test_evaluate_cli_on_a_px4_log_keeps_the_keys_and_adds_waypoints(shared_data: Path) -> None:
+    ulg = shared_data / "flights" / "px4_s500_mission_land.ulg"
+    r = CliRunner().invoke(main, ["trajectory", "evaluate", str(ulg), "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["default_method"] == "autopilot model"
+    m = out["methods"]["autopilot model"]
+    assert m["applicable"] and m["run_abs_e_pct_median"] <= 15.0 and len(m["run_e_pct"]) == 1
+    assert out["methods"]["QGroundControl estimate"]["run_abs_e_pct_median"] >= 2 * m["run_abs_e_pct_median"]
+    (run,) = out["runs"]
+    assert [w["item"] for w in run["waypoint_errors"]] == list(range(11))
+    assert all(abs(w["error_s"]) < 5.0 for w in run["waypoint_errors"])
+    tb = out["time_bounds"]
+    assert tb["n_runs"] == 1 and 0.0 <= tb["covered_ci95"][0] < tb["covered_ci95"][1] <= 1.0
+    # the element methods need waypoints in the telemetry, which a PX4 log keeps out of it
+    assert "no waypoints in the telemetry" in out["element_methods"]
+    r = CliRunner().invoke(main, ["trajectory", "evaluate", str(ulg)])
+    assert r.exit_code == 0 and "autopilot model" in r.output and "Clopper–Pearson" in r.output

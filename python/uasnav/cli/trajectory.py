@@ -450,13 +450,16 @@ def _evaluate_flights(
             skipped = [Path(str(lf.path)).name for lf in opened if lf not in element_logs]
             if skipped:
                 element_error = f"{', '.join(skipped)}: no waypoints in the telemetry"
+            if not element_logs:
+                raise InputError(element_error or "no flights")
             fs = flight_samples(element_logs, plan, speed, wind, segment, max_gap)
             limits, _ = _log_limits(flights, fs.logs)
             errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
         except InputError as e:
             if mission is None:
                 raise
-            element_error, errors, fs = str(e), [], None
+            element_error = "; ".join(dict.fromkeys(x for x in (element_error, str(e)) if x))
+            errors, fs = [], None
     for e in errors:
         table[e.name] = (
             {
@@ -494,7 +497,7 @@ def _evaluate_flights(
         out["parameters"] = mission["parameters"]
         out["time_bounds"] = mission["time_bounds"]
     if element_error is not None:
-        out["element_methods"] = f"not evaluated on {element_error}"
+        out["element_methods"] = f"not evaluated: {element_error}"
     if mission_error is not None:
         out["mission_model"] = f"not evaluated: {mission_error}"
     return out
@@ -750,7 +753,8 @@ def _calibrate_from_flights(
     "limits_log",
     type=click.Path(dir_okay=False),
     help="Flight log (.tlog .bin .ulg) of the vehicle: its WPNAV_SPEED_UP/DN, WPNAV_ACCEL_Z or "
-    "MPC_Z_VEL_MAX_UP/DN, MPC_ACC_UP_MAX replace the model's vertical limits, its WPNAV_SPEED or "
+    "MPC_Z_V_AUTO_UP/DN (MPC_Z_VEL_MAX_UP/DN before PX4 1.12), MPC_ACC_UP_MAX replace the model's "
+    "vertical limits, its WPNAV_SPEED or "
     "MPC_XY_CRUISE the model's speed (explicit options and the plan's own speed win).",
 )
 @click.option(
