@@ -276,3 +276,16 @@ def test_evaluate_cli_on_a_px4_log_keeps_the_keys_and_adds_waypoints(shared_data
     assert "no waypoints in the telemetry" in out["element_methods"]
     r = CliRunner().invoke(main, ["trajectory", "evaluate", str(ulg)])
     assert r.exit_code == 0 and "autopilot model" in r.output and "Clopper–Pearson" in r.output
+
+
+def test_web_prediction_takes_the_dalby_plan_with_its_short_vtol_leg(shared_data: Path) -> None:
+    from uasnav.web.default_model import default_model
+    from uasnav.web.prediction import predict_plan, read_uploaded_plan
+
+    data = (shared_data / "missions" / "ardupilot_autotest_dalby_obc2016.waypoints").read_bytes()
+    up = read_uploaded_plan("dalby.waypoints", data)
+    legs = np.hypot(*np.diff(up.route_ne, axis=0).T)
+    assert legs.min() < 10.0  # the VTOL landing's 1.85 m leg, shorter than L
+    r = predict_plan(default_model(), up.route_ne, up.origin, 3.0, 0.0, 20.0, "default")
+    times = [w["time_s"] for w in r.waypoints]
+    assert len(times) == len(up.route_ne) and np.all(np.diff(times) >= 0) and r.eta_s > 0
