@@ -455,26 +455,26 @@ def _evaluate_flights(
             fs = flight_samples(element_logs, plan, speed, wind, segment, max_gap)
             limits, _ = _log_limits(flights, fs.logs)
             errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
-        except InputError as e:
+        except InputError as why:
             if mission is None:
                 raise
-            element_error = "; ".join(dict.fromkeys(x for x in (element_error, str(e)) if x))
+            element_error = "; ".join(dict.fromkeys(x for x in (element_error, str(why)) if x))
             errors, fs = [], None
-    for e in errors:
-        table[e.name] = (
+    for res in errors:
+        table[res.name] = (
             {
                 "applicable": True,
-                "element_e_pct_mean": float(np.mean(e.element_pct)),
-                "element_e_pct_median": float(np.median(e.element_pct)),
-                "run_e_pct_mean": float(np.mean(e.run_pct)),
+                "element_e_pct_mean": float(np.mean(res.element_pct)),
+                "element_e_pct_median": float(np.median(res.element_pct)),
+                "run_e_pct_mean": float(np.mean(res.run_pct)),
                 # per-run ETA error |e%|: median, 95th percentile, worst
-                "run_abs_e_pct_median": float(np.median(np.abs(e.run_pct))),
-                "run_abs_e_pct_p95": float(np.percentile(np.abs(e.run_pct), 95)),
-                "run_abs_e_pct_worst": float(np.max(np.abs(e.run_pct))),
-                "run_e_pct": list(e.run_pct),
+                "run_abs_e_pct_median": float(np.median(np.abs(res.run_pct))),
+                "run_abs_e_pct_p95": float(np.percentile(np.abs(res.run_pct), 95)),
+                "run_abs_e_pct_worst": float(np.max(np.abs(res.run_pct))),
+                "run_e_pct": list(res.run_pct),
             }
-            if e.applicable
-            else {"applicable": False, "reason": e.reason}
+            if res.applicable
+            else {"applicable": False, "reason": res.reason}
         )
     from uasnav.trajectory.models import DEFAULT_METHOD
 

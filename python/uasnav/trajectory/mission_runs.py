@@ -315,7 +315,7 @@ def evaluate_logs(logs: Sequence[Any]) -> dict[str, Any]:
             "run_abs_e_pct_worst": float(np.max(np.abs(e))),
             "run_e_pct_mean": float(np.mean(e)),
         }
-    runs = [
+    runs: list[dict[str, Any]] = [
         {
             "log": path,
             "stack": stacks[path],
