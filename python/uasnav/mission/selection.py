@@ -90,9 +90,9 @@ class RankedPair:
     category: str | None = None
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Selection:
-    """Everything the output interface of Figure 70 shows."""
+    """Everything the output interface of Figure 70 shows (built from keywords)."""
 
     requirements: Requirements
     mission_name: str
@@ -125,6 +125,9 @@ class Selection:
     #: Every operation the candidate UAS imply (one per VLOS/EVLOS/BVLOS present), least
     #: demanding first, each with its best configuration; ``operation`` is the chosen one's.
     operations: list[OperationChoice] = field(default_factory=list)
+    #: Height (m above ground) the cameras' field of view and resolution were tested at, and
+    #: the rule that chose it (``planned`` or ``regulatory-max``, :attr:`Requirements.camera_height`).
+    camera_height_m: float | None = None
 
     @property
     def authorisation(self) -> dict:
@@ -239,6 +242,16 @@ class Selection:
                 "legal_basis": self.operation.legal_basis if self.operation else None,
             },
             "required_hfov_deg": self.required_hfov_deg,
+            "camera_height": {
+                "rule": r.camera_height,
+                "height_m": self.camera_height_m,
+                "explained": (
+                    "field of view and resolution tested at the planned height (--altitude)"
+                    if r.camera_height == "planned"
+                    else "field of view and resolution tested at the highest height the category "
+                    "allows (thesis §5.2.3.4)"
+                ),
+            },
             "feasible_uas": self.feasible_uas,
             "feasible_cameras": self.feasible_cameras,
             "rejections": [x.__dict__ for x in self.rejections],
@@ -523,9 +536,12 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
             f"{req.jurisdiction}/{category}: VLOS required ({cat.source}); "
             f"{op.max_distance_m:g} m from the pilot, within the {op.vlos_distance_m:g} m kept in sight"
         )
-    # eq. 60 at the highest height the regulations allow (thesis §5.2.3.4); if the category sets
-    # no height limit the required altitude is used instead.
-    h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
+    # eq. 60 at the planned height, or at the highest height the regulations allow (the
+    # thesis' rule, §5.2.3.4; the required altitude when the category sets no limit)
+    if req.camera_height == "regulatory-max":
+        h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
+    else:
+        h_cam = req.altitude_m
     uas_ok, rej = _reject(
         uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids, members
     )
@@ -787,26 +803,27 @@ def select(
                     )
                 )
     return Selection(
-        req,
-        mission.name,
-        dict(mission.features),
-        equipment,
-        main.h_reg,
-        required_hfov_deg(req.image_size_m[0], main.h_cam),
-        main.vlos_required,
-        uas_ok,
-        cam_ok,
-        pair_ok,
-        rejections,
-        ranking,
-        scores,
-        db,
-        notes,
-        op,
-        sora,
-        zone_check,
-        scenarios,
-        withheld,
-        window,
-        operations,
+        requirements=req,
+        mission_name=mission.name,
+        features=dict(mission.features),
+        equipment=equipment,
+        regulatory_height_m=main.h_reg,
+        required_hfov_deg=required_hfov_deg(req.image_size_m[0], main.h_cam),
+        vlos_required=main.vlos_required,
+        uas_ok=uas_ok,
+        camera_ok=cam_ok,
+        pair_ok=pair_ok,
+        rejections=rejections,
+        ranking=ranking,
+        scores=scores,
+        database=db,
+        notes=notes,
+        operation=op,
+        sora=sora,
+        zones=zone_check,
+        scenarios=scenarios,
+        withheld=withheld,
+        flight_window=window,
+        operations=operations,
+        camera_height_m=float(main.h_cam),
     )
