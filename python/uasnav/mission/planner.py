@@ -109,10 +109,18 @@ class PlanResult:
 _LOCK = threading.Lock()
 
 
-@functools.lru_cache(maxsize=8)
-def _predictor_at(speed_key: float) -> Any:
-    """The built-in kinematic predictor with time bounds calibrated on simulated 3D runs at
-    ``speed_key`` m/s (cached per speed for the life of the process)."""
+#: Speeds (m/s) the shipped survey models are calibrated at (``data/survey_models.json``).
+MODEL_SPEEDS = (3.0, 5.0, 7.0, 9.0, 11.0, 13.0, 15.0)
+#: The shipped survey models: the built-in kinematic predictor with its time bounds calibrated
+#: at each of :data:`MODEL_SPEEDS` (regenerate with ``scripts/make_survey_models.py``).
+MODELS_FILE = Path(__file__).parent / "data" / "survey_models.json"
+
+
+def build_predictor(speed_ms: float, runs: int = CALIBRATION_RUNS) -> Any:
+    """The built-in survey predictor at ``speed_ms``: the kinematic point mass (the default
+    method) fitted on the thesis' two Phantom-4 trajectories simulated in calm air and in a
+    5 m/s wind, its time bounds calibrated (split-conformal) on ``runs`` simulated 3D runs
+    (take-off, sloped legs, holds, landing) flown at ``speed_ms``. Deterministic."""
     import warnings
 
     from uasnav.trajectory.calibration import calibrate, simulated_route_runs
@@ -125,7 +133,7 @@ def _predictor_at(speed_key: float) -> Any:
         for w, (speed, from_deg) in enumerate(((0.0, 0.0), (5.0, 200.0))):
             tel = simulate_flight(
                 plan_ne,
-                params=MultirotorParams(cruise_ms=speed_key),
+                params=MultirotorParams(cruise_ms=speed_ms),
                 wind=WindModel(speed_ms=speed, from_deg=from_deg),
                 seed=10 * k + w,
             )
@@ -136,13 +144,33 @@ def _predictor_at(speed_key: float) -> Any:
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", category=UserWarning)
         model = make_predictor("kinematic").fit(ElementSamples.concat(parts))
-    runs = simulated_route_runs(model, CALIBRATION_RUNS, seed=0, cruise_ms=speed_key)
-    model.time_bounds_ = calibrate(runs, source=f"{CALIBRATION_RUNS} simulated 3D runs at {speed_key:g} m/s")
+    cal = simulated_route_runs(model, runs, seed=0, cruise_ms=speed_ms)
+    model.time_bounds_ = calibrate(cal, source=f"{runs} simulated 3D runs at {speed_ms:g} m/s, seed 0")
     return model
 
 
+@functools.lru_cache(maxsize=1)
+def _shipped() -> dict[str, Any]:
+    from uasnav import jsoncheck as jc
+
+    with jc.reraise_in(str(MODELS_FILE)):
+        return jc.obj(jc.parse(MODELS_FILE.read_text(), "invalid JSON"), "")
+
+
+@functools.lru_cache(maxsize=16)
+def _predictor_at(speed_key: float) -> Any:
+    from uasnav.trajectory.models import model_from_dict
+
+    if MODELS_FILE.exists():
+        models = _shipped()["models"]
+        nearest = min(models, key=lambda k: abs(float(k) - speed_key))
+        return model_from_dict(models[nearest], source=f"{MODELS_FILE.name}[{nearest}]")
+    return build_predictor(speed_key)
+
+
 def survey_predictor(speed_ms: float) -> Any:
-    """The trajectory model a survey flown at ``speed_ms`` is timed with (see :func:`_predictor_at`)."""
+    """The trajectory model a survey flown at ``speed_ms`` is timed with: the shipped model
+    calibrated at the nearest of :data:`MODEL_SPEEDS` (:func:`build_predictor`)."""
     with _LOCK:
         return _predictor_at(round(float(speed_ms), 1))
 
@@ -312,7 +340,6 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
         "selection": sel.to_dict(),
     }
     if sel.chosen is None:
-        base["authorisation"] = _unflyable(sel)
         files = {"result.json": _json(base)}
         return PlanResult(to_jsonable(base), files, sel, None)
     best = sel.chosen
@@ -399,23 +426,6 @@ def _legal_height(regs: Any, req: Any) -> float:
     except Exception:
         h = math.inf
     return h if math.isfinite(h) else 120.0
-
-
-def _unflyable(sel: Any) -> dict[str, Any]:
-    """The authorisation verdict when no configuration ranks: say what nothing meets."""
-    auth = dict(sel.authorisation)
-    tests: dict[str, int] = {}
-    for r in sel.rejections:
-        tests[r.test] = tests.get(r.test, 0) + 1
-    cams = [r for r in sel.rejections if r.kind == "camera"]
-    if len(sel.database.cameras) and not sel.camera_ok.any():
-        worst = sorted({r.test for r in cams})
-        auth["verdict"] = f"no camera meets the requirements ({', '.join(worst)})"
-    elif len(sel.database.uas) and not sel.uas_ok.any():
-        worst = sorted({r.test for r in sel.rejections if r.kind == "uas"})
-        auth["verdict"] = f"no UAS meets the requirements ({', '.join(worst)})"
-    auth["failed_tests"] = tests
-    return auth
 
 
 def _deconflict(flights: list[FlightResult], others: list[Any]) -> list[dict[str, Any]]:
