@@ -341,12 +341,58 @@ def equipment_tests(u, req: Requirements, equipment: list[EquipmentNeed]) -> lis
     return _equipment_tests(u, req.gnss_autopilot, need)
 
 
-def _flight_duration(u, req: Requirements, ranking: list[RankedPair]) -> tuple[float, str]:
+def _survey_duration(db: Database, req: Requirements, best: RankedPair, area) -> tuple[float, str] | None:
+    """(duration s, how) of a survey of the polygon ``area`` by ``best`` at the resolution, from
+    the take-off point at the area's centroid: the survey planner's flight-time estimate of
+    every flight plus the turnarounds between them; None if no survey can be laid out."""
+    from uasnav.errors import UasnavError
+    from uasnav.mission.survey import Camera, plan_survey
+
+    u, c = db.uas, db.cameras
+    i, j = u.ids.index(best.uas_id), c.ids.index(best.camera_id)
+    lon0, lat0 = area.centre()
+    g = area.local(lon0, lat0)
+    if g.geom_type != "Polygon":
+        g = g.convex_hull
+    try:
+        sp = plan_survey(
+            g,
+            Camera(
+                c.label(j), float(c.hfov_deg[j]), float(c.resolution_w_px[j]), float(c.resolution_h_px[j])
+            ),
+            resolution_m=req.resolution_m,
+            origin=(lat0, lon0),
+            takeoff_en=(g.centroid.x, g.centroid.y),
+            altitude_m=req.altitude_m,
+            cruise_ms=req.cruise_fraction * float(u.max_speed_ms[i]),
+            endurance_s=float(u.endurance_min[i]) * 60.0 * (1.0 - req.reserve),
+        )
+    except UasnavError:
+        return None
+    n = len(sp.flights)
+    total = sum(sp.estimated_time_s) + SURVEY_TURNAROUND_S * (n - 1)
+    return float(total), (
+        f"survey of the area by {best.uas} + {best.camera}: {len(sp.lines)} lines, {n} flight(s) "
+        f"at {sp.speed_ms:.1f} m/s (conservative estimate; `uasnav plan` predicts it with bounds)"
+    )
+
+
+#: Time between two flights of a survey (landing, battery change, take-off), s.
+SURVEY_TURNAROUND_S = 600.0
+
+
+def _flight_duration(
+    u, req: Requirements, ranking: list[RankedPair], area=None, db: Database | None = None
+) -> tuple[float, str]:
     """(duration s, how it was obtained) of the flight: ``req.flight_duration_s`` when given,
     else the mission time (out and back over the range against the wind at the cruise airspeed,
     :func:`mission_time_s`) of the best-ranked UAS, else the longest finite one in the database."""
     if req.flight_duration_s is not None:
         return float(req.flight_duration_s), "--flight-duration"
+    if ranking and area is not None and db is not None and any(k == "poly" for k, _ in area.parts):
+        got = _survey_duration(db, req, ranking[0], area)
+        if got is not None:
+            return got
     t = mission_time_s(req.range_m, req.cruise_fraction * u.max_speed_ms, req.wind_ms)
     if ranking:
         i = u.ids.index(ranking[0].uas_id)
@@ -853,7 +899,7 @@ def select(
 
         until = None
         if when is not None:
-            duration, how = _flight_duration(u, req, ranking)
+            duration, how = _flight_duration(u, req, ranking, area, db)
             until = when + _dt.timedelta(seconds=duration)
             window = {
                 "start": when.isoformat(),
