@@ -227,16 +227,6 @@ def _read_intents(items: Sequence[Any], now: dt.datetime) -> list[Any]:
     return found
 
 
-def _camera(sel: Any, j: int) -> Camera:
-    c = sel.database.cameras
-    return Camera(
-        name=c.label(j),
-        hfov_deg=float(c.hfov_deg[j]),
-        width_px=float(c.resolution_w_px[j]),
-        height_px=float(c.resolution_h_px[j]),
-    )
-
-
 def _field_polygon(area: Any, lat0: float, lon0: float) -> Any:
     """The field to photograph in the local east/north frame about the take-off point: the
     area's polygons (a plan's route: its convex hull)."""
@@ -346,7 +336,7 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     u = sel.database.uas
     i = u.ids.index(best.uas_id)
     j = sel.database.cameras.ids.index(best.camera_id)
-    camera = _camera(sel, j)
+    camera = Camera.from_table(sel.database.cameras, j)
     cruise = req.cruise_fraction * float(u.max_speed_ms[i])
     endurance = float(u.endurance_min[i]) * 60.0 * (1.0 - req.reserve)
     field_en = _field_polygon(area, lat0, lon0)

@@ -357,9 +357,7 @@ def _survey_duration(db: Database, req: Requirements, best: RankedPair, area) ->
     try:
         sp = plan_survey(
             g,
-            Camera(
-                c.label(j), float(c.hfov_deg[j]), float(c.resolution_w_px[j]), float(c.resolution_h_px[j])
-            ),
+            Camera.from_table(c, j),
             resolution_m=req.resolution_m,
             origin=(lat0, lon0),
             takeoff_en=(g.centroid.x, g.centroid.y),
