@@ -10,6 +10,7 @@ import numpy as np
 
 from uasnav.mission.database import Database, load_database
 from uasnav.mission.feasibility import (
+    MIN_SURVEY_HEIGHT_M,
     Rejection,
     Requirements,
     TestResult,
@@ -222,6 +223,14 @@ class Selection:
             tests_of.setdefault(r.kind, set()).add(r.test)
         parts = []
         if len(self.database.cameras) and not self.camera_ok.any():
+            # the tests that alone keep some camera out (a camera failing only them), else all
+            fails: dict[str, set[str]] = {}
+            for r in self.rejections:
+                if r.kind == "camera":
+                    fails.setdefault(r.item, set()).add(r.test)
+            binding = {next(iter(t)) for t in fails.values() if len(t) == 1}
+            if binding:
+                tests_of["camera"] = binding
             best = {}
             for r in self.rejections:
                 if r.kind == "camera" and r.test == "resolution":
@@ -305,7 +314,10 @@ class Selection:
                 "rule": r.camera_height,
                 "height_m": self.camera_height_m,
                 "explained": (
-                    "field of view and resolution tested at the planned height (--altitude)"
+                    "a survey: no field-of-view test; the resolution is reachable at or above "
+                    f"{MIN_SURVEY_HEIGHT_M:g} m (the survey flies at the height that gives it)"
+                    if r.mosaic
+                    else "field of view and resolution tested at the planned height (--altitude)"
                     if r.camera_height == "planned"
                     else "field of view and resolution tested at the highest height the category "
                     "allows (thesis §5.2.3.4)"
@@ -671,7 +683,9 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
         )
     # eq. 60 at the planned height, or at the highest height the regulations allow (the
     # thesis' rule, §5.2.3.4; the required altitude when the category sets no limit)
-    if req.camera_height == "regulatory-max":
+    if req.mosaic:  # a survey: the resolution is tested at the lowest survey height
+        h_cam = MIN_SURVEY_HEIGHT_M
+    elif req.camera_height == "regulatory-max":
         h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
     else:
         h_cam = req.altitude_m
