@@ -6,6 +6,7 @@ import ipaddress
 
 import click
 
+from uasnav.errors import InputError
 from uasnav.web.security import LOOPBACK_HOSTS
 
 
@@ -48,7 +49,9 @@ def command(
     import uvicorn
 
     from uasnav.web.app import create_app, load_documents
+    from uasnav.web.server_limits import harden, uvicorn_settings
 
+    _check_bindable(host, port)
     docs = load_documents(db, matrices, regulations)
     extra = tuple(allow_hosts)
     if host.strip("[]").lower() not in LOOPBACK_HOSTS and host not in ("0.0.0.0", "::"):
@@ -63,4 +66,29 @@ def command(
         )
     shown = f"[{host}]" if ":" in host else host
     click.echo(f"uasnav serve: http://{shown}:{port}/  (Ctrl-C to stop)", err=True)
-    uvicorn.run(create_app(docs, extra), host=host, port=port, log_level="warning", server_header=False)
+    uvicorn.run(
+        harden(create_app(docs, extra)),
+        host=host,
+        port=port,
+        log_level="warning",
+        server_header=False,
+        **uvicorn_settings(),
+    )
+
+
+def _check_bindable(host: str, port: int) -> None:
+    """Refuse, in one line, a host that names no address or a port that is taken (before the
+    documents are loaded and before uvicorn logs its own multi-line failure)."""
+    import socket
+
+    try:
+        infos = socket.getaddrinfo(host.strip("[]"), port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except (OSError, UnicodeError) as e:
+        raise InputError(f"--host {host}: not an address this machine can bind ({e})") from None
+    family, kind, proto, _, addr = infos[0]
+    with socket.socket(family, kind, proto) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            s.bind(addr)
+        except OSError as e:
+            raise InputError(f"--host {host} --port {port}: cannot bind ({e.strerror or e})") from None
