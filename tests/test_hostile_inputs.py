@@ -288,3 +288,49 @@ def test_warnings_of_a_failed_run_fold_into_its_error_line() -> None:
     assert line == "error: the input is wrong (warnings: corrupt data skipped)"
     res = CliRunner().invoke(grp, ["good"])
     assert res.exit_code == 0 and res.stderr.strip() == "warning: corrupt data skipped"
+
+
+def test_a_failed_command_changes_no_output(tmp_path: Path) -> None:
+    """Every command's outputs are one set: the first file of a command that fails on its second
+    (``trajectory intent --out i.json --geojson BAD``) is not written and the old one is kept."""
+    import click
+
+    from uasnav.atomicfile import atomic_write_text
+    from uasnav.cli import _Group, _guarded
+
+    @click.group(cls=_Group)
+    def grp() -> None:
+        pass
+
+    @grp.command()
+    @click.option("--out")
+    @click.option("--geojson")
+    def two(out: str, geojson: str) -> None:
+        atomic_write_text(out, "new\n")
+        atomic_write_text(geojson, "{}\n")
+
+    _guarded(grp)
+    first = tmp_path / "i.json"
+    first.write_text("old\n")
+    bad = tmp_path / "x.geojson"
+    bad.mkdir()  # a directory where the second file should go
+    line = _one_error_line(CliRunner().invoke(grp, ["two", "--out", str(first), "--geojson", str(bad)]))
+    assert "x.geojson" in line
+    assert first.read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["i.json", "x.geojson"]  # nothing staged left
+    res = CliRunner().invoke(grp, ["two", "--out", str(first), "--geojson", str(tmp_path / "ok.geojson")])
+    assert res.exit_code == 0 and first.read_text() == "new\n"
+
+
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["db", "validate", "http://[::1"], "not a valid URL"),
+        (["simulate", "--profile", "flight", "--duration", "1e308", "--out", "{tmp}/x.csv"], "range"),
+    ],
+)
+def test_internal_errors_become_input_errors(tmp_path: Path, args: list[str], needle: str) -> None:
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in args]
+    line = _one_error_line(CliRunner().invoke(main, argv))
+    assert needle in line and "internal error" not in line
+    assert not (tmp_path / "x.csv").exists()

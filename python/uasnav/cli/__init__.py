@@ -104,6 +104,11 @@ class _Group(click.Group):
             message = str(e)
         except OSError as e:
             message = _os_error_message(e)
+        except OverflowError as e:
+            # only numbers the user gave reach the float/int/date range: an input error
+            message = f"a value is outside the representable range ({e}); check the options and inputs"
+        except RecursionError:
+            message = "input nested too deeply to process"
         except MemoryError:
             message = "out of memory (the input or the options ask for more than this machine has)"
         except (KeyboardInterrupt, SystemExit, GeneratorExit):
@@ -153,23 +158,29 @@ def _guarded(cmd: click.Command) -> None:
     """Wrap ``cmd`` (and its subcommands) so that, before the command opens anything, the
     resource limits of the environment are valid (:func:`uasnav.limits.check_environment`) and
     every input path is checked by :func:`uasnav.limits.check_input_file`: one check for every
-    subcommand, so a FIFO never blocks a reader. ``--help`` needs neither."""
+    subcommand, so a FIFO never blocks a reader. ``--help`` needs neither. The files the
+    command writes form one :func:`uasnav.atomicfile.output_set`: all written, or none."""
     if isinstance(cmd, click.Group):
         for sub in cmd.commands.values():
             _guarded(sub)
     names = _input_paths(cmd)
     callback = cmd.callback
-    if callback is None:
-        return
+    if callback is None or isinstance(cmd, click.Group):
+        return  # a group's callback runs before its subcommand's, which is guarded itself
 
     def checked(*args: Any, **kwargs: Any) -> Any:
+        from uasnav.atomicfile import output_set
+
         check_environment()
         for name in names:
             value = kwargs.get(name)
             for v in value if isinstance(value, list | tuple) else [value]:
                 if isinstance(v, str | os.PathLike):
                     check_input_file(v)
-        return callback(*args, **kwargs)
+        # every file the command writes is committed together when it succeeds: a failure
+        # (a bad second output, an error after the first file) leaves every output as it was
+        with output_set():
+            return callback(*args, **kwargs)
 
     cmd.callback = functools.update_wrapper(checked, callback)
 
