@@ -204,6 +204,47 @@ def test_allan_honours_the_work_limit(tmp_path: Path) -> None:
     assert "UASNAV_MAX_WORK" in line and "operations" in line
 
 
+def test_simulated_runs_are_refused_up_front_with_their_estimate(tmp_path: Path) -> None:
+    from uasnav.errors import ResourceLimitError
+    from uasnav.trajectory.calibration import simulated_route_runs, simulated_runs
+
+    for fn in (simulated_runs, simulated_route_runs):
+        with pytest.raises(ResourceLimitError, match=r"100000 simulated calibration runs needs about 4e\+12"):
+            fn(None, 100_000)  # type: ignore[arg-type]
+    model = tmp_path / "m.json"
+    model.write_text("{}")
+    out = tmp_path / "o.json"
+    t0 = time.perf_counter()
+    res = CliRunner().invoke(
+        main, ["trajectory", "calibrate", "--model", str(model), "--runs", "100000", "--out", str(out)]
+    )
+    line = _one_error_line(res)
+    assert "--runs + --test-runs" in line and "UASNAV_MAX_WORK" in line
+    assert not out.exists() and time.perf_counter() - t0 < 30
+
+
+def test_fleet_simulate_is_refused_up_front_with_its_estimate(tmp_path: Path) -> None:
+    out = tmp_path / "fleet"
+    res = CliRunner().invoke(
+        main,
+        [
+            "fleet",
+            "simulate",
+            "--vehicles",
+            "100",
+            "--flights",
+            "1",
+            "--nav-flights",
+            "100",
+            "--out",
+            str(out),
+        ],
+    )
+    line = _one_error_line(res)
+    assert "100 GNSS/INS flight(s) needs about" in line and "--nav-flights" in line
+    assert not out.exists()
+
+
 # -- 5. FIFOs and special files ----------------------------------------------------------------
 
 
