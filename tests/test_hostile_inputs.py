@@ -375,3 +375,17 @@ def test_internal_errors_become_input_errors(tmp_path: Path, args: list[str], ne
     line = _one_error_line(CliRunner().invoke(main, argv))
     assert needle in line and "internal error" not in line
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_an_outage_sweep_of_thousands_is_refused_up_front() -> None:
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from uasnav.errors import ResourceLimitError
+    from uasnav.ins.evaluate import outage_experiment
+
+    flight = SimpleNamespace(imu=SimpleNamespace(t=np.zeros(60_000)), gnss=SimpleNamespace(t=np.arange(2.0)),
+                             airborne=(0.0, 600.0))  # fmt: skip
+    with pytest.raises(ResourceLimitError, match=r"outage sweep of 5000 duration\(s\) × 5 start\(s\)"):
+        outage_experiment(flight, list(np.linspace(1, 100, 5000)))  # type: ignore[arg-type]
