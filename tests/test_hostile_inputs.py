@@ -389,3 +389,31 @@ def test_an_outage_sweep_of_thousands_is_refused_up_front() -> None:
                              airborne=(0.0, 600.0))  # fmt: skip
     with pytest.raises(ResourceLimitError, match=r"outage sweep of 5000 duration\(s\) × 5 start\(s\)"):
         outage_experiment(flight, list(np.linspace(1, 100, 5000)))  # type: ignore[arg-type]
+
+
+# -- 8/9. silent answers and the Python API's limits --------------------------------------------
+
+
+def test_drift_of_a_huge_duration_is_refused_in_the_api() -> None:
+    from uasnav.attitude import drift
+    from uasnav.errors import ResourceLimitError
+
+    with pytest.raises(ResourceLimitError, match="attitude drift over 1e\\+09 s"):
+        drift([1e-5, 0, 0], 0.01, 1e9)
+    assert drift([1e-5, 0, 0], 0.01, 10.0).theta.shape == (1000,)
+
+
+def test_quantities_beyond_the_float_range_are_refused() -> None:
+    from uasnav.units import parse_quantity
+
+    with pytest.raises(InputError, match="not a finite quantity"):
+        parse_quantity("1e999 m", "m")
+    with pytest.raises(InputError, match="not a finite quantity"):
+        parse_quantity("1e308 km", "m")
+
+
+def test_an_output_name_ending_in_a_separator_is_a_usage_error(tmp_path: Path) -> None:
+    out = str(tmp_path / "m.json") + "/"
+    res = CliRunner().invoke(main, ["simulate", "--profile", "static", "--duration", "1", "--out", out])
+    assert res.exit_code == 2 and "names a directory" in res.stderr
+    assert not (tmp_path / "m.json").exists()
