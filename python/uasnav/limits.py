@@ -97,18 +97,25 @@ def max_memory() -> int:
     return min(DEFAULT_MAX_MEMORY, ram // 2) if ram else DEFAULT_MAX_MEMORY
 
 
-def max_work() -> float:
-    """The work limit (elementary operations): ``$UASNAV_MAX_WORK`` or 2·10¹¹."""
-    env = os.environ.get(ENV_WORK)
+def env_positive(name: str, default: float, what: str) -> float:
+    """The positive finite number in the environment variable ``name``, or ``default`` if it
+    is unset; a set but invalid value (``abc``, ``-1``, ``0``, ``nan``, ``inf``, empty) is an
+    :class:`InputError` naming the variable, ``what`` it expects and the value."""
+    env = os.environ.get(name)
     if env is None:
-        return DEFAULT_MAX_WORK
+        return default
     try:
         value = float(env)
     except ValueError:
         value = math.nan
     if not (math.isfinite(value) and value > 0):
-        raise InputError(f"{ENV_WORK}: expected a positive number of operations such as 1e12, got {env!r}")
+        raise InputError(f"{name}: expected a positive number of {what}, got {env!r}")
     return value
+
+
+def max_work() -> float:
+    """The work limit (elementary operations): ``$UASNAV_MAX_WORK`` or 2·10¹¹."""
+    return env_positive(ENV_WORK, DEFAULT_MAX_WORK, "operations such as 1e12")
 
 
 def check_environment() -> None:
@@ -257,6 +264,7 @@ __all__ = [
     "check_input_file",
     "check_memory",
     "check_work",
+    "env_positive",
     "format_size",
     "max_memory",
     "max_work",

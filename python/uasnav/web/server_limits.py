@@ -57,20 +57,9 @@ MAX_HEAD_BYTES = 16 * 1024
 
 
 def _seconds(env: str, default: float) -> float:
-    import math
+    from uasnav.limits import env_positive
 
-    from uasnav.errors import InputError
-
-    text = os.environ.get(env)
-    if text is None:
-        return default
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise InputError(f"{env}: expected a positive number of seconds, got {text!r}")
-    return value
+    return env_positive(env, default, "seconds")
 
 
 async def _answer(
