@@ -154,15 +154,18 @@ def _input_paths(cmd: click.Command) -> list[str]:
     ]
 
 
-def _guarded(cmd: click.Command) -> None:
+def _guarded(cmd: click.Command, staged: bool = True) -> None:
     """Wrap ``cmd`` (and its subcommands) so that, before the command opens anything, the
     resource limits of the environment are valid (:func:`uasnav.limits.check_environment`) and
     every input path is checked by :func:`uasnav.limits.check_input_file`: one check for every
     subcommand, so a FIFO never blocks a reader. ``--help`` needs neither. The files the
-    command writes form one :func:`uasnav.atomicfile.output_set`: all written, or none."""
+    command writes form one :func:`uasnav.atomicfile.output_set`: all written, or none —
+    except under a command marked ``incremental_outputs`` (the fleet's datasets, committed log
+    by log and read back by the same run, keep their own manifest)."""
+    staged = staged and not getattr(cmd, "incremental_outputs", False)
     if isinstance(cmd, click.Group):
         for sub in cmd.commands.values():
-            _guarded(sub)
+            _guarded(sub, staged)
     names = _input_paths(cmd)
     callback = cmd.callback
     if callback is None or isinstance(cmd, click.Group):
@@ -179,6 +182,8 @@ def _guarded(cmd: click.Command) -> None:
                     check_input_file(v)
         # every file the command writes is committed together when it succeeds: a failure
         # (a bad second output, an error after the first file) leaves every output as it was
+        if not staged:
+            return callback(*args, **kwargs)
         with output_set():
             return callback(*args, **kwargs)
 

@@ -24,6 +24,11 @@ def command() -> None:
     """
 
 
+# A run commits each log's table as it finishes and reads its dataset back at the end (scores,
+# report): its outputs are not one staged set (the manifest makes a run resumable instead).
+command.incremental_outputs = True  # type: ignore[attr-defined]
+
+
 def _check_scheduler(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
     if value is not None and "://" not in value:
         raise click.BadParameter(f"expected an address like tcp://HOST:8786, got {value!r}")
