@@ -626,11 +626,12 @@ def calibrate(model_path, out, runs, test_runs, coverage, flight_logs, seed, as_
         _calibrate_from_flights(model_path, out, flight_logs, coverage, as_json)
         return
     from uasnav.trajectory.calibration import calibrate as fit_bounds
-    from uasnav.trajectory.calibration import covered
+    from uasnav.trajectory.calibration import check_runs, covered
     from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
     from uasnav.trajectory.timebounds import clopper_pearson
 
+    check_runs(runs + test_runs, "--runs + --test-runs")
     check_outputs([model_path], {"--out": out})
     model = load_model(model_path)
     with click.progressbar(
@@ -811,6 +812,9 @@ def intent(  # type: ignore[no-untyped-def]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
     if model.time_bounds_ is None:
+        from uasnav.trajectory.calibration import check_runs
+
+        check_runs(calibration_runs, "--calibration-runs")
         with click.progressbar(
             length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
         ) as bar:
