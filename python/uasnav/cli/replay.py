@@ -22,9 +22,19 @@ from uasnav.cli._common import POSITIVE, Real
 @click.option(
     "--duplicate", type=Real(0.0, 1.0, hi_open=True), default=0.0, help="Fraction of packets to send twice."
 )
-@click.option("--from", "start_s", type=Real(0.0, None), default=0.0, help="Start T s (log time) after the first message.")
-@click.option("--stop-after", type=Real(0.0, None), help="Stop sending T s (log time) after the first message.")
-@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of --drop/--duplicate.")
+@click.option(
+    "--from",
+    "start_s",
+    type=Real(0.0, None),
+    default=0.0,
+    help="Start T s (log time) after the first message.",
+)
+@click.option(
+    "--stop-after", type=Real(0.0, None), help="Stop sending T s (log time) after the first message."
+)
+@click.option(
+    "--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of --drop/--duplicate."
+)
 def command(log, target, speed, loop, offset_text, drop, duplicate, start_s, stop_after, seed):  # type: ignore[no-untyped-def]
     """Send LOG (.tlog as recorded; .bin/.ulg converted to the MAVLink messages a ground station
     receives) to a UDP address in its recorded timing, scaled by --speed."""
@@ -51,6 +61,7 @@ def command(log, target, speed, loop, offset_text, drop, duplicate, start_s, sto
         sock.close()
     click.echo(
         f"sent {stats.packets} packets ({stats.bytes} bytes, {stats.log_s:.1f} s of log at {speed:g}×; "
-        f"{stats.dropped} dropped, {stats.duplicated} duplicated; sender at most {stats.max_late_s * 1e3:.0f} ms late)",
+        f"{stats.dropped} dropped, {stats.duplicated} duplicated; "
+        f"sender at most {stats.max_late_s * 1e3:.0f} ms late)",
         err=True,
     )

@@ -85,7 +85,7 @@ def _encoded(pk: Packet, offset: Offset | None, t0: float, mav: Any) -> bytes:
         mav.seq = msg.get_seq()
         return bytes(msg.pack(mav))
     buf = msg.get_msgbuf()
-    if buf is None:  # a converted message: encode it as vehicle 1, autopilot component
+    if not buf:  # a converted message: encode it as vehicle 1, autopilot component
         mav.srcSystem, mav.srcComponent = 1, 1
         return bytes(msg.pack(mav))
     return bytes(buf)
@@ -134,7 +134,7 @@ def replay(
     while True:
         it: Iterator[Packet] = iter(packets())
         t0: float | None = None
-        start = clock()
+        start: float | None = None
         for pk in it:
             if t0 is None:
                 t0 = pk.t_s
@@ -143,6 +143,8 @@ def replay(
                 continue
             if stop_after_s is not None and rel > stop_after_s:
                 break
+            if start is None:
+                start = clock()
             due = start + (rel - start_s) / speed
             wait = due - clock()
             if wait > 0:

@@ -80,23 +80,36 @@ def log_packets(path: str | os.PathLike[str]) -> Iterator[Packet]:
     p = Path(path)
     ext = p.suffix.lower()
     if ext not in LOG_EXTENSIONS:
-        raise InputError(f"{p}: cannot replay {ext or 'a file without extension'} (supported: .tlog, .bin, .ulg)")
+        raise InputError(
+            f"{p}: cannot replay {ext or 'a file without extension'} (supported: .tlog, .bin, .ulg)"
+        )
     if ext == ".tlog":
         return _tlog_packets(p)
     return _converted_packets(p)
 
 
 def _tlog_packets(p: Path) -> Iterator[Packet]:
-    from uasnav.io._mavlink import reading
+    from uasnav.errors import DataFormatError
+    from uasnav.io._mavlink import connect
 
-    with reading(p, dialect="ardupilotmega", fresh=True) as (conn, _out):
+    # read lazily (a long log is never held in memory); pymavlink's own printing is not
+    # captured here, since a capture would swallow the caller's output while the generator lives
+    conn = connect(p, dialect="ardupilotmega")
+    try:
         while True:
-            msg = conn.recv_msg()
+            try:
+                msg = conn.recv_msg()
+            except Exception as e:  # struct.error, IndexError … on a truncated or corrupt log
+                raise DataFormatError(
+                    f"corrupt MAVLink message ({type(e).__name__}: {e})", path=str(p)
+                ) from None
             if msg is None:
                 return
             if msg.get_type() == "BAD_DATA":
                 continue
             yield Packet(float(msg._timestamp), msg)
+    finally:
+        conn.close()
 
 
 def _amsl(lat: np.ndarray, lon: np.ndarray, alt: np.ndarray, datum: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -123,7 +136,7 @@ def _decimate(t: np.ndarray, rate_hz: float) -> np.ndarray:
 
 
 def _i(x: float) -> int:
-    return int(round(float(x)))
+    return round(float(x))
 
 
 def _converted_packets(p: Path) -> Iterator[Packet]:
@@ -156,11 +169,14 @@ def _converted_packets(p: Path) -> Iterator[Packet]:
     streams.append(imu_packets())
 
     def clock_packets() -> Iterator[Packet]:
-        base = (_MAV_MODE_FLAG_SAFETY_ARMED | _MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
+        base = _MAV_MODE_FLAG_SAFETY_ARMED | _MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
         autopilot = _MAV_AUTOPILOT_PX4 if px4 else _MAV_AUTOPILOT_ARDUPILOTMEGA
         t = t_first
         while t <= t_last:
-            yield Packet(t, mav.MAVLink_heartbeat_message(_MAV_TYPE_QUADROTOR, autopilot, base, 0, _MAV_STATE_ACTIVE, 3))
+            yield Packet(
+                t,
+                mav.MAVLink_heartbeat_message(_MAV_TYPE_QUADROTOR, autopilot, base, 0, _MAV_STATE_ACTIVE, 3),
+            )
             unix_us = _i((utc0_s + t) * 1e6) if utc0 is not None else 0
             yield Packet(t, mav.MAVLink_system_time_message(unix_us, _i(t * 1000.0) & 0xFFFFFFFF))
             t += 1.0
@@ -173,7 +189,7 @@ def _converted_packets(p: Path) -> Iterator[Packet]:
 
         def gnss_packets() -> Iterator[Packet]:
             for k in range(len(gnss.t)):
-                vn, ve, vd = (float(x) for x in gnss.vel[k])
+                vn, ve = float(gnss.vel[k][0]), float(gnss.vel[k][1])
                 speed = math.hypot(vn, ve)
                 cog = math.degrees(math.atan2(ve, vn)) % 360.0
                 m = mav.MAVLink_gps_raw_int_message(
