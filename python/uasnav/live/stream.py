@@ -59,6 +59,23 @@ def stop_on_signals() -> Iterator[list[bool]]:
             signal.signal(s, h)
 
 
+#: Messages held between the reading thread and the processing (bounded memory); beyond, the
+#: oldest are dropped and counted.
+QUEUE_MESSAGES = 100_000
+#: Receive buffer asked of the kernel for a UDP socket (bytes): bursts of a fast replay.
+UDP_RCVBUF = 8 * 1024 * 1024
+
+
+def _enlarge_buffer(conn: Any) -> None:
+    import contextlib
+    import socket
+
+    sock = getattr(conn, "port", None)
+    if isinstance(sock, socket.socket) and sock.type == socket.SOCK_DGRAM:
+        with contextlib.suppress(OSError):
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, UDP_RCVBUF)
+
+
 def receive(
     conn: Any,
     on_message: Callable[[Any, float], Any],
@@ -67,20 +84,52 @@ def receive(
     stop: list[bool],
     idle_timeout_s: float | None = None,
     done: Callable[[], bool] = lambda: False,
-) -> None:
+) -> int:
     """Call ``on_message(msg, wall_s)`` for every message and ``on_tick(wall_s)`` at least every
     :data:`POLL_S`, until ``stop[0]``, ``done()``, or ``idle_timeout_s`` of wall time without a
-    message (after the first)."""
+    message (after the first). Returns the messages dropped from a full queue.
+
+    A thread only reads and decodes (``wall_s`` is its receive time), so the processing never
+    keeps the socket waiting: a slow step (the filter releases the GIL) does not lose packets.
+    """
+    import queue
+    import threading
+
+    _enlarge_buffer(conn)
+    q: queue.Queue[tuple[Any, float]] = queue.Queue(maxsize=QUEUE_MESSAGES)
+    dropped = [0]
+    halt = threading.Event()
+
+    def reader() -> None:
+        while not halt.is_set():
+            try:
+                msg = conn.recv_match(blocking=True, timeout=POLL_S)
+            except (OSError, ConnectionError):
+                msg = None
+            if msg is None or msg.get_type() == "BAD_DATA":
+                continue
+            try:
+                q.put_nowait((msg, time.monotonic()))
+            except queue.Full:
+                dropped[0] += 1
+
+    th = threading.Thread(target=reader, name="uasnav-mavlink-reader", daemon=True)
+    th.start()
     last_msg: float | None = None
-    while not stop[0] and not done():
-        try:
-            msg = conn.recv_match(blocking=True, timeout=POLL_S)
-        except (OSError, ConnectionError):
-            msg = None
-        now = time.monotonic()
-        if msg is not None and msg.get_type() != "BAD_DATA":
-            last_msg = now
-            on_message(msg, now)
-        on_tick(now)
-        if idle_timeout_s is not None and last_msg is not None and now - last_msg > idle_timeout_s:
-            return
+    try:
+        while not stop[0] and not done():
+            try:
+                msg, wall = q.get(timeout=POLL_S)
+            except queue.Empty:
+                msg = None
+            now = time.monotonic()
+            if msg is not None:
+                last_msg = now
+                on_message(msg, wall)
+            on_tick(now)
+            if idle_timeout_s is not None and last_msg is not None and now - last_msg > idle_timeout_s:
+                break
+    finally:
+        halt.set()
+        th.join(timeout=1.0)
+    return dropped[0]
