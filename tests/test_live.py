@@ -64,6 +64,7 @@ def flown(shared_data):
     arms: list[tuple[float, float]] = []  # (log s, boot s)
     climbs, descents, last_wp = [], [], None
     boot = 0.0
+    clock: list[tuple[float, float]] = []  # (log s, boot s)
     while True:
         msg = m.recv_match(type=["SYSTEM_TIME", "HEARTBEAT", "MISSION_ITEM_REACHED"])
         if msg is None:
@@ -72,6 +73,7 @@ def flown(shared_data):
         t = msg._timestamp - t0
         if msg.get_type() == "SYSTEM_TIME":
             boot = msg.time_boot_ms * 1e-3
+            clock.append((t, boot))
             if msg.time_unix_usec:
                 offset = msg.time_unix_usec * 1e-6 - boot
         elif msg.get_type() == "HEARTBEAT" and msg.get_srcSystem() == 1:
@@ -93,6 +95,7 @@ def flown(shared_data):
         "utc": datetime.fromtimestamp(offset + second, timezone.utc),
         "climb_ms": alt / float(np.mean(climbs)),
         "descent_ms": alt / float(np.mean(descents)),
+        "boot_at": lambda log_s: float(np.interp(log_s, *np.array(clock).T)),
     }
 
 
@@ -145,27 +148,25 @@ def test_replayed_flight_stays_activated_and_ends_on_landing(shared_data, intent
     assert states(ev) == ["Accepted", "Activated", "Ended"], ev
     act = next(e for e in ev if e["state"] == "Activated")
     assert act["margin_m"] > 0 and act["volume"] == 0
-    assert all(e["latency_ms"] < 100 for e in ev if "latency_ms" in e)
+    # each event on a message carries its latency (measured, not asserted: see BENCHMARKS.md)
+    assert all(e["latency_ms"] >= 0 for e in ev if e["event"] == "state" and e["state"] != "Accepted")
 
 
-def test_offset_goes_nonconforming_and_back(shared_data, intent):
-    # 100 m east from 30 s after arming (in the climb) until the end: outside, then Ended;
-    # a shift that ends is modelled by a second replay below
+def test_offset_goes_nonconforming_and_back(shared_data, intent, flown):
+    # 100 m east from 30 s into the window (after take-off) for 20 s: outside, back, Ended
+    t_on, t_off = RUN[0] + 30, RUN[0] + 50
     ev = monitor_events(
-        shared_data, intent, "--stop-after", str(RUN[1]), "--offset-after", f"{RUN[0] + 20}:0,100"
-    )
-    s = states(ev)
-    assert s[:3] == ["Accepted", "Activated", "Nonconforming"], ev
+        shared_data, intent, "--stop-after", str(RUN[1]), "--offset-after", f"{t_on}:0,100",
+        "--offset-until", str(t_off),
+    )  # fmt: skip
+    assert states(ev) == ["Accepted", "Activated", "Nonconforming", "Activated", "Ended"], ev
     nc = next(e for e in ev if e["state"] == "Nonconforming")
     assert nc["margin_m"] < 0 and "horizontally" in nc["reason"]
-    # the first report after the shift is judged at once: within one report interval (≈ 1 s)
-    assert nc["time_boot_s"] - _boot_at(ev, RUN[0] + 20) <= 1.5
-    assert s[-1] == "Ended"
-
-
-def _boot_at(ev: list[dict], log_s: float) -> float:
-    act = next(e for e in ev if e["state"] == "Activated")
-    return act["time_boot_s"] + (log_s - 289.2)
+    # judged at the first report after the shift: within one report interval (≈ 1 s, vehicle time)
+    assert 0 <= nc["time_boot_s"] - flown["boot_at"](t_on) <= 1.0
+    back = [e for e in ev if e["state"] == "Activated"][1]
+    assert 0 <= back["time_boot_s"] - flown["boot_at"](t_off) <= 1.0
+    assert back["reason"] == "back inside the intent" and back["margin_m"] > 0
 
 
 def test_cut_stream_gives_telemetry_loss_then_contingent(shared_data, intent):
@@ -242,7 +243,7 @@ def test_live_page_shows_the_state_change_in_chromium(shared_data, intent, monke
     import shutil
     import time
 
-    from playwright.sync_api import sync_playwright
+    from playwright.sync_api import expect, sync_playwright
 
     from uasnav.web.process import running_server
 
@@ -275,14 +276,14 @@ def test_live_page_shows_the_state_change_in_chromium(shared_data, intent, monke
             )  # fmt: skip
             try:
                 cell = "#live-vehicles tbody tr[data-vehicle='1'] td:nth-child(2)"
-                page.wait_for_function(f"document.querySelector(\"{cell}\")?.textContent === 'Activated'")
+                expect(page.locator(cell)).to_have_text("Activated", timeout=60_000)
                 # snapshots arrive at ≥ 5 Hz
                 n = page.evaluate(
                     "() => new Promise(done => { let n = 0; const s = new EventSource('/live/events');"
                     " s.onmessage = () => n++; setTimeout(() => { s.close(); done(n); }, 2000); })"
                 )
                 assert n >= 10, n
-                page.wait_for_function(f"document.querySelector(\"{cell}\")?.textContent === 'Ended'")
+                expect(page.locator(cell)).to_have_text("Ended", timeout=60_000)
                 assert "Ended" in page.inner_text("#live-events")
                 assert page.locator("#veh-1").count() == 1
             finally:

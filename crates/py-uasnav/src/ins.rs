@@ -385,19 +385,21 @@ impl PyInsStream {
         let inner = &mut self.inner;
         let out = py.detach(|| -> Result<Vec<StreamSolution<f64>>, nav_core::NavError> {
             let mut out = Vec::with_capacity(n);
-            let mut j = 0usize;
+            let mut fixes = gt.iter().zip(gl).zip(gv).zip(ga).zip(gb).peekable();
+            let mut imu = it.iter().zip(g).zip(a);
             for k in 0..=n {
-                while j < m && gb[j] as usize == k {
+                while let Some(((((t, l), v), acc), _)) =
+                    fixes.next_if(|(_, b)| usize::try_from(**b).is_ok_and(|b| b == k))
+                {
                     inner.push_gnss(GnssFix {
-                        t_s: gt[j],
-                        llh: gl[j],
-                        vel_m_s: gv[j],
-                        acc: ga[j],
+                        t_s: *t,
+                        llh: *l,
+                        vel_m_s: *v,
+                        acc: *acc,
                     })?;
-                    j += 1;
                 }
-                if k < n {
-                    if let Some(sol) = inner.push_imu(it[k], g[k], a[k])? {
+                if let Some(((t, gy), ac)) = imu.next() {
+                    if let Some(sol) = inner.push_imu(*t, *gy, *ac)? {
                         out.push(sol);
                     }
                 }

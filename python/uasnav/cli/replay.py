@@ -18,6 +18,9 @@ from uasnav.cli._common import POSITIVE, Real
     help="T:NORTH,EAST — from T s after the first message on, shift every reported position by "
     "NORTH, EAST metres.",
 )
+@click.option(
+    "--offset-until", type=Real(0.0, None), help="End the --offset-after shift T s after the first message."
+)
 @click.option("--drop", type=Real(0.0, 1.0, hi_open=True), default=0.0, help="Fraction of packets to lose.")
 @click.option(
     "--duplicate", type=Real(0.0, 1.0, hi_open=True), default=0.0, help="Fraction of packets to send twice."
@@ -35,14 +38,16 @@ from uasnav.cli._common import POSITIVE, Real
 @click.option(
     "--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of --drop/--duplicate."
 )
-def command(log, target, speed, loop, offset_text, drop, duplicate, start_s, stop_after, seed):  # type: ignore[no-untyped-def]
+def command(log, target, speed, loop, offset_text, offset_until, drop, duplicate, start_s, stop_after, seed):  # type: ignore[no-untyped-def]
     """Send LOG (.tlog as recorded; .bin/.ulg converted to the MAVLink messages a ground station
     receives) to a UDP address in its recorded timing, scaled by --speed."""
     from uasnav.live.replay import parse_offset, parse_udp_target, replay, udp_sender
     from uasnav.live.source import log_packets
 
     host, port = parse_udp_target(target)
-    offset = parse_offset(offset_text) if offset_text else None
+    if offset_until is not None and not offset_text:
+        raise click.UsageError("--offset-until needs --offset-after")
+    offset = parse_offset(offset_text, offset_until) if offset_text else None
     first = iter(log_packets(log))  # open (and check) the log before the first packet leaves
     send, sock = udp_sender(host, port)
     passes = [first]

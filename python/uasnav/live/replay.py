@@ -32,15 +32,16 @@ POSITION_MESSAGES = ("GLOBAL_POSITION_INT", "GPS_RAW_INT", "GPS2_RAW")
 @dataclass(frozen=True)
 class Offset:
     """Shift reported positions by ``north_m``, ``east_m`` (m) from ``after_s`` seconds after the
-    first message on."""
+    first message on (until ``until_s``, when given)."""
 
     after_s: float
     north_m: float
     east_m: float
+    until_s: float = math.inf
 
 
-def parse_offset(text: str) -> Offset:
-    """``T:NORTH,EAST`` (s, m, m) → :class:`Offset`.
+def parse_offset(text: str, until_s: float | None = None) -> Offset:
+    """``T:NORTH,EAST`` (s, m, m) → :class:`Offset` (shifting until ``until_s``, s, if given).
 
     >>> parse_offset("30:100,0")
     Offset(after_s=30.0, north_m=100.0, east_m=0.0)
@@ -48,11 +49,13 @@ def parse_offset(text: str) -> Offset:
     try:
         t, ne = text.split(":")
         n, e = ne.split(",")
-        off = Offset(float(t), float(n), float(e))
+        off = Offset(float(t), float(n), float(e), math.inf if until_s is None else float(until_s))
     except ValueError:
         raise InputError(f"--offset-after: expected T:NORTH,EAST (s:m,m), got {text!r}") from None
     if not all(math.isfinite(x) for x in (off.after_s, off.north_m, off.east_m)) or off.after_s < 0:
         raise InputError(f"--offset-after: expected finite values and T ≥ 0, got {text!r}")
+    if off.until_s <= off.after_s:
+        raise InputError(f"--offset-until: must be after the --offset-after time {off.after_s:g} s")
     return off
 
 
@@ -79,7 +82,11 @@ def shift_position(msg: Any, north_m: float, east_m: float) -> None:
 
 def _encoded(pk: Packet, offset: Offset | None, t0: float, mav: Any) -> bytes:
     msg = pk.msg
-    if offset is not None and pk.t_s - t0 >= offset.after_s and msg.get_type() in POSITION_MESSAGES:
+    if (
+        offset is not None
+        and offset.after_s <= pk.t_s - t0 < offset.until_s
+        and msg.get_type() in POSITION_MESSAGES
+    ):
         shift_position(msg, offset.north_m, offset.east_m)
         mav.srcSystem, mav.srcComponent = msg.get_srcSystem(), msg.get_srcComponent()
         mav.seq = msg.get_seq()

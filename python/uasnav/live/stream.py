@@ -99,9 +99,11 @@ def receive(
     q: queue.Queue[tuple[Any, float]] = queue.Queue(maxsize=QUEUE_MESSAGES)
     dropped = [0]
     halt = threading.Event()
+    polled = [time.monotonic()]  # when the reader last finished a wait on the socket
 
     def reader() -> None:
         while not halt.is_set():
+            polled[0] = time.monotonic()
             try:
                 msg = conn.recv_match(blocking=True, timeout=POLL_S)
             except (OSError, ConnectionError):
@@ -126,7 +128,11 @@ def receive(
             if msg is not None:
                 last_msg = now
                 on_message(msg, wall)
-            on_tick(now)
+            # silence is judged only when nothing waits: no backlog in the queue, and the reader
+            # has had the processor recently (after a stall of the whole process, packets may
+            # still sit in the socket)
+            if q.empty() and now - polled[0] <= 3 * POLL_S:
+                on_tick(now)
             if idle_timeout_s is not None and last_msg is not None and now - last_msg > idle_timeout_s:
                 break
     finally:
