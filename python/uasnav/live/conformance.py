@@ -196,6 +196,18 @@ class ConformanceMonitor:
         self.telemetry_timeout_s = float(telemetry_timeout_s)
         self.stats = MonitorStats()
         self._seq: dict[tuple[int, int], int] = {}
+        self._warm_up(next(iter(geoms.values())))
+
+    @staticmethod
+    def _warm_up(g: IntentGeometry) -> None:
+        """Load the geoid grid and the geodesy and geometry libraries now, so the first position
+        report is judged as fast as the others."""
+        from uasnav.geo import geodetic_to_enu
+        from uasnav.geo.geoid import geoid_height
+
+        geoid_height(g.origin[0], g.origin[1])
+        geodetic_to_enu(g.origin[0], g.origin[1], 0.0, g.origin[0], g.origin[1], 0.0)
+        g.margin(0.0, 0.0, 0.0, float(g.time_s[0, 0]))
 
     # --- events --------------------------------------------------------------------------------
     def _event(
