@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from uasnav.cli._common import POSITIVE, Real
+from uasnav.cli._common import POSITIVE, SEED, Real
 
 
 @click.command("replay")
@@ -35,9 +35,7 @@ from uasnav.cli._common import POSITIVE, Real
 @click.option(
     "--stop-after", type=Real(0.0, None), help="Stop sending T s (log time) after the first message."
 )
-@click.option(
-    "--seed", type=click.IntRange(0), default=0, show_default=True, help="Seed of --drop/--duplicate."
-)
+@click.option("--seed", type=SEED, default=0, show_default=True, help="Seed of --drop/--duplicate.")
 def command(log, target, speed, loop, offset_text, offset_until, drop, duplicate, start_s, stop_after, seed):  # type: ignore[no-untyped-def]
     """Send LOG (.tlog as recorded; .bin/.ulg converted to the MAVLink messages a ground station
     receives) to a UDP address in its recorded timing, scaled by --speed."""

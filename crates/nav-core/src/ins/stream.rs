@@ -25,6 +25,9 @@ use crate::attitude::quat_to_array;
 use crate::scalar::lit;
 use crate::zupt::{HeadingSource, Levelling};
 use crate::{NavError, Real};
+// f64 maths without std: the trait's methods; with std the inherent ones are used.
+#[allow(unused_imports)]
+use num_traits::Float as _;
 
 /// Capacity of the queue of received, not yet applied GNSS fixes; when full the oldest is
 /// dropped (and counted).
