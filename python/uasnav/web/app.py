@@ -122,6 +122,9 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
     templates.env.filters["num"] = _num
     templates.env.filters["auto"] = _auto
     app.mount("/static", StaticFiles(directory=str(HERE / "static")), name="static")
+    from uasnav.web.live import router as live_router  # the /live page (live MAVLink telemetry)
+
+    app.include_router(live_router)
 
     @app.get("/summary.css", include_in_schema=False)
     def summary_css() -> Response:
