@@ -44,7 +44,7 @@ def parse_offset(text: str, until_s: float | None = None) -> Offset:
     """``T:NORTH,EAST`` (s, m, m) → :class:`Offset` (shifting until ``until_s``, s, if given).
 
     >>> parse_offset("30:100,0")
-    Offset(after_s=30.0, north_m=100.0, east_m=0.0)
+    Offset(after_s=30.0, north_m=100.0, east_m=0.0, until_s=inf)
     """
     try:
         t, ne = text.split(":")

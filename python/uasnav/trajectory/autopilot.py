@@ -194,7 +194,7 @@ def px4_max_speed_from_distance(d: float, accel: float, jerk: float, v_final: fl
     v = ½·(−b + √(b² + 8·a·d + 4·v_f²)) with b = 4·a²/j.
 
     >>> round(px4_max_speed_from_distance(4.4, 3.0, 4.0), 3)
-    2.333
+    2.33
     """
     b = 4.0 * accel * accel / jerk
     return 0.5 * (-b + math.sqrt(b * b + 8.0 * accel * max(d, 0.0) + 4.0 * v_final * v_final))
