@@ -111,7 +111,7 @@ def test_xio_errors_name_line_and_column(tmp_path: Path) -> None:
 def test_dataflash_flight_and_other_messages_in_seconds(shared_data: Path) -> None:
     import uasnav.io.ardupilot as ap
     from uasnav.io import read_dataflash_messages, read_flight
-    from uasnav.io.flight import FlightLog
+    from uasnav.io.flight import Flight
 
     path = shared_data / "logs" / "ardupilot_log171.bin"
     assert ap.read_dataflash is read_dataflash and ap.read_tlog is read_tlog  # documented names kept
@@ -123,7 +123,7 @@ def test_dataflash_flight_and_other_messages_in_seconds(shared_data: Path) -> No
     assert 94e3 < np.median(baro["Press"]) < 96e3  # Pa, Canberra
     assert {"Roll", "Pitch", "Yaw"} <= set(tables["ATT"])
     flight = read_flight(path)
-    assert isinstance(flight, FlightLog) and flight.t.size > 1000 and not flight.waypoints
+    assert isinstance(flight, Flight) and flight.t.size > 1000 and not flight.waypoints
     with pytest.raises(AttributeError):
         flight.cruise_ms = 3.0  # type: ignore[misc]  # a read log is immutable
 

@@ -45,7 +45,7 @@ from uasnav.io import (
 from uasnav.io._common import longest_nondecreasing
 from uasnav.io._quiet import library_output_captured
 from uasnav.io.csv_v1 import parse_csv_v1
-from uasnav.io.flight import FlightLog
+from uasnav.io.flight import Flight
 from uasnav.io.xio import read_xio_csv
 
 V1_HEAD = "t,gx,gy,gz,ax,ay,az"
@@ -576,7 +576,7 @@ def test_longest_nondecreasing_keeps_the_longest_run_in_order() -> None:
     assert longest_nondecreasing(np.arange(5.0)).all()
 
 
-# --- ImuLog and FlightLog given something that is not data -----------------------------------
+# --- ImuLog and Flight given something that is not data -----------------------------------
 
 
 @pytest.mark.parametrize(
@@ -636,4 +636,4 @@ def test_flightlog_validates(kw: dict[str, Any], pattern: str) -> None:
         "source": "f.csv",
     }
     with pytest.raises(InputError, match=pattern):
-        FlightLog(**{**base, **kw})
+        Flight.from_track(**{**base, **kw})

@@ -17,9 +17,8 @@ from uasnav.cli import main
 from uasnav.errors import DataFormatError
 from uasnav.geo.datum import HeightDatum, receiver_undulation
 from uasnav.io import open_log
-from uasnav.io.flight import FlightLog
+from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.io.mission_plan import MissionPlan
-from uasnav.io.navdata import BaroData, GnssData, MagData, Trajectory
 from uasnav.io.views import Identity, ModeTimeline
 
 
@@ -132,7 +131,7 @@ def _check_views(log: Any, gnss_datum: HeightDatum) -> None:
     est = log.autopilot_estimate
     # the estimate is given in the fixes' datum: the heights compare directly
     assert isinstance(est, Trajectory) and est.alt_datum is g.alt_datum
-    assert isinstance(log.flight, FlightLog) and log.flight.alt_datum is HeightDatum.AMSL
+    assert isinstance(log.flight, Flight) and log.flight.alt_datum is HeightDatum.AMSL
     assert isinstance(log.params, dict) and len(log.params) > 10
     assert isinstance(log.modes, ModeTimeline) and len(log.modes.names) >= 1
     assert isinstance(log.identity, Identity) and log.identity.autopilot

@@ -25,7 +25,7 @@ adds ``rate_true`` (n, 3) rad/s, ``specific_force_true`` (n, 3) m/s², ``gyro_bi
 and :meth:`ImuLog.resample`.
 
 Files are read and written by :mod:`uasnav.io` (one module per format), which also holds the
-flight telemetry type beside this one, :class:`uasnav.io.flight.FlightLog`.
+flight telemetry type beside this one, :class:`uasnav.io.flight.Flight`.
 """
 
 from __future__ import annotations

@@ -72,7 +72,7 @@ NAV_SCHEMA = pa.schema(
 
 def _truth(flight: Any) -> Any:
     """The simulated truth of a CSV v1 flight (its ``truth_*`` columns) as a Trajectory."""
-    from uasnav.io.navdata import Trajectory
+    from uasnav.io.flight import Trajectory
 
     tr = flight.imu.truth or {}
     if not {"lat", "lon", "alt"} <= set(tr):

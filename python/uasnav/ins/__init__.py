@@ -3,7 +3,7 @@
 ``run(flight, config) -> InsResult`` hands a whole :class:`Flight` (IMU, GNSS, baro,
 magnetometer) to the Rust filter in one call; :mod:`uasnav.ins.evaluate` compares the result
 with the autopilot's estimate or a simulation's truth, runs GNSS-outage experiments and checks
-consistency (NEES). Readers for real logs live in :mod:`uasnav.io.navdata`; simulated flights
+consistency (NEES). Readers for real logs live in :mod:`uasnav.io.flight`; simulated flights
 with truth in :mod:`uasnav.sim.flight`.
 
 Examples
@@ -19,7 +19,7 @@ True
 
 from uasnav.ins import evaluate, magnetic
 from uasnav.ins.core import FIX_STATUS, InsConfig, InsResult, integrity_thresholds, run
-from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
+from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.io.track import TRACK_COLUMNS
 
 __all__ = [

@@ -1,4 +1,4 @@
-"""Run the GNSS/INS filter over a :class:`~uasnav.io.navdata.Flight` (one FFI call, GIL released).
+"""Run the GNSS/INS filter over a :class:`~uasnav.io.flight.Flight` (one FFI call, GIL released).
 
 The filter (``nav_core::ins``) is a loosely coupled 15-state error-state Kalman filter on the
 same strapdown mechanisation and error-state kernel as the ZUPT filter: WGS-84 latitude,
@@ -33,7 +33,7 @@ from uasnav.errors import InputError
 from uasnav.imu import ImuLog
 from uasnav.ins.magnetic import resolve_declination
 from uasnav.io import track
-from uasnav.io.navdata import Flight
+from uasnav.io.flight import Flight
 from uasnav.stationary import MAX_WINDOW_SAMPLES, detect_static
 from uasnav.zupt import MODE_LABELS, Mode
 
@@ -562,6 +562,9 @@ def run(flight: Flight, config: InsConfig | None = None) -> InsResult:
     cfg = InsConfig() if config is None else config
     if not isinstance(flight, Flight):
         raise InputError(f"flight: expected a uasnav.ins.Flight, got {type(flight).__name__}")
+    if flight.imu is None or flight.gnss is None:
+        missing = " and ".join(k for k in ("imu", "gnss") if getattr(flight, k) is None)
+        raise InputError(f"flight: no {missing} to integrate (read the log's nav view)")
     if cfg.mode not in MODE_LABELS:
         raise InputError(f"mode: expected 'classic' (or 'zupt') or 'tczupt', got {cfg.mode!r}")
     if cfg.mode == "zupt":

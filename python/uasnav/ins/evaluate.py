@@ -21,7 +21,7 @@ from scipy import stats
 from uasnav.errors import InputError
 from uasnav.geo.frames import radii_of_curvature
 from uasnav.ins.core import InsConfig, InsResult, run
-from uasnav.io.navdata import Flight, Trajectory
+from uasnav.io.flight import Flight, Trajectory
 from uasnav.limits import check_work
 
 FloatArray = NDArray[np.float64]

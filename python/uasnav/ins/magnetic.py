@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 from uasnav.errors import InputError
 
 if TYPE_CHECKING:
-    from uasnav.io.navdata import Flight
+    from uasnav.io.flight import Flight
 
 __all__ = [
     "resolve_declination",

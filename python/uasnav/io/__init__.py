@@ -17,7 +17,7 @@ extension  reader                           notes
 .tlog      :func:`read_tlog`                MAVLink; ``read_log`` returns the first stream
 ========== ================================ ===========================================
 
-Flight telemetry → :class:`~uasnav.io.flight.FlightLog`; :func:`read_flight` picks the reader
+Flight telemetry → :class:`~uasnav.io.flight.Flight`; :func:`read_flight` picks the reader
 from the extension (``.csv`` flight CSV, ``.tlog``, ``.bin``, ``.ulg``; see
 :mod:`uasnav.io.flight`).
 
@@ -53,7 +53,8 @@ from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
 from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.io.dataflash import read_dataflash, read_dataflash_flight, read_dataflash_messages
-from uasnav.io.flight import FlightLog, read_flight_csv
+from uasnav.io.flight import Flight
+from uasnav.io.formats.csvlog import read_flight_csv
 from uasnav.io.logfile import LogFile, open_log
 from uasnav.io.npz import read_npz, write_npz
 from uasnav.io.px4 import read_ulog, read_ulog_flight
@@ -81,7 +82,7 @@ def read_log(path: str | os.PathLike[str]) -> ImuLog:
     return log.imu  # type: ignore[no-any-return]
 
 
-def read_flight(path: str | os.PathLike[str]) -> FlightLog:
+def read_flight(path: str | os.PathLike[str]) -> Flight:
     """Read the flight telemetry of a log (``open_log(path).flight``: .csv, .tlog, .bin, .ulg).
 
     Raises
@@ -121,7 +122,7 @@ __all__ = [
     "FLIGHT_EXTENSIONS",
     "READ_EXTENSIONS",
     "WRITE_EXTENSIONS",
-    "FlightLog",
+    "Flight",
     "LogFile",
     "open_log",
     "read_csv_table",

@@ -44,7 +44,7 @@ from numpy.typing import NDArray
 from uasnav.errors import DataFormatError
 from uasnav.geo.datum import HeightDatum
 from uasnav.imu import ImuLog
-from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
+from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory
 
 FloatArray = NDArray[np.float64]
 
@@ -123,7 +123,7 @@ def isa_pressure_altitude(p_pa: FloatArray) -> FloatArray:
 
 
 def read_alfa_folder(path: str | os.PathLike[str]) -> Flight:
-    """Read an ALFA ROS-topic CSV folder as a :class:`~uasnav.io.navdata.Flight` (see the
+    """Read an ALFA ROS-topic CSV folder as a :class:`~uasnav.io.flight.Flight` (see the
     module docs).
 
     Raises

@@ -50,7 +50,7 @@ from uasnav.io._common import (
     salvage,
 )
 from uasnav.io._mavlink import messages, reading
-from uasnav.io.flight import FIX_LIMITS, FlightLog, flight_from_fixes
+from uasnav.io.flight import FIX_LIMITS, Flight, flight_from_fixes
 from uasnav.io.views import gps_to_utc
 
 #: Message names of the IMUs in older logs (newer logs use ``IMU`` with an instance field ``I``).
@@ -160,7 +160,7 @@ def _field(d: Mapping[str, Any], kind: str, name: str, p: Path) -> Any:
         ) from None
 
 
-def read_dataflash_flight(path: str | os.PathLike[str]) -> FlightLog:
+def read_dataflash_flight(path: str | os.PathLike[str]) -> Flight:
     """The flight telemetry of a DataFlash log (see the module docs for the messages).
 
     Times are the messages' own ``TimeUS``/``TimeMS`` in seconds (in Copter 3.3 logs the ``GPS``

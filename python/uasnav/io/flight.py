@@ -1,63 +1,231 @@
-"""The in-memory flight telemetry type :class:`FlightLog`, and the flight CSV format.
+"""The flight model: :class:`Flight`, what one log tells about one flight, and the sensor series
+it is made of.
 
-A :class:`FlightLog` is what the flight readers of each log format return (time, WGS-84
-position, NED ground velocity, the mission's navigation waypoints, waypoint-reached events and
-the wind estimate when the log has them); :func:`uasnav.io.read_flight` picks the reader from
-the file extension:
+A :class:`Flight` holds the sensors the GNSS/INS filter integrates (IMU, GNSS, barometer,
+magnetometer), the references to compare with (the autopilot's own estimate, the truth of a
+simulated flight), the position telemetry the autopilot logged (``track``) and the mission's
+events (navigation waypoints, waypoint-reached events, wind, cruise speed). A log's
+:class:`~uasnav.io.logfile.LogFile` gives two of them, each decoding only what it needs:
+``nav`` (the sensors and the estimate, for :func:`uasnav.ins.run`) and ``flight`` (the telemetry
+and the mission, for :mod:`uasnav.trajectory`).
 
-========= =========================================== =============================================
-extension reader                                      messages
-========= =========================================== =============================================
-.csv      :func:`read_flight_csv`                     header ``t,lat,lon,alt,v_N,v_E,v_D``
-.tlog     :func:`uasnav.io.tlog.read_tlog_flight`     GLOBAL_POSITION_INT, MISSION_ITEM(_INT), …
-.bin      :func:`uasnav.io.dataflash.read_dataflash_flight` GPS, CMD, MSG, XKF2/NKF2/EKF2
-.ulg      :func:`uasnav.io.px4.read_ulog_flight`      vehicle_global_position, mission_result, …
-========= =========================================== =============================================
+Every series has its own time stamps (s, one clock per flight). Units are SI; latitude and
+longitude in degrees; heights in metres with their datum (``alt_datum``, :mod:`uasnav.geo.datum`:
+the readers give GNSS fixes and the autopilot's estimate in one datum, ellipsoidal where the
+log allows; the telemetry track in the datum the autopilot logged, AMSL), any datum for the
+barometer (the filter tracks the offset). Frames: body FRD, navigation NED. The constructors
+check shapes, finiteness and strictly increasing time and name what is wrong.
 
-This module imports no format reader (they import it), so it cannot close an import circle.
-The flight readers of binary logs salvage what is valid from a corrupt log (see
-:func:`valid_fixes`).
+This module imports no format reader (the readers of :mod:`uasnav.io.formats` import it), so it
+cannot close an import circle. The readers of binary logs salvage what is valid from a corrupt
+log (see :func:`valid_fixes`).
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from uasnav.errors import DataFormatError, InputError
 from uasnav.geo.datum import HeightDatum
+from uasnav.imu import ImuLog, check_time
 from uasnav.io._common import nothing_valid, report_corruption, salvage
 from uasnav.io._quiet import LibraryOutput
-from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
 
 FloatArray = NDArray[np.float64]
 
-#: Columns of the flight CSV (s, deg, deg, m, then the NED ground velocity in m/s).
-FLIGHT_CSV_COLUMNS = ("t", "lat", "lon", "alt", "v_N", "v_E", "v_D")
+_TRACK_FIELDS = ("t", "lat", "lon", "alt", "vel_ned")
 
-_SAMPLE_FIELDS = ("t", "lat", "lon", "alt", "vel_ned")
+
+def _arr(owner: str, name: str, value: ArrayLike, shape_tail: tuple[int, ...], n: int | None) -> FloatArray:
+    try:
+        a = np.ascontiguousarray(np.asarray(value, dtype=np.float64))
+    except (TypeError, ValueError):
+        raise InputError(f"{owner}.{name}: expected numbers, got {type(value).__name__}") from None
+    want_ndim = 1 + len(shape_tail)
+    if a.ndim != want_ndim or a.shape[1:] != shape_tail or (n is not None and a.shape[0] != n):
+        want = ("n" if n is None else str(n),) + tuple(str(k) for k in shape_tail)
+        raise InputError(f"{owner}.{name}: expected shape ({', '.join(want)}), got {a.shape}")
+    bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(a.shape[0], -1)), axis=1))
+    if bad.size:
+        raise InputError(f"{owner}.{name}: non-finite value at row {int(bad[0])}")
+    return a
+
+
+def _time(owner: str, value: ArrayLike, min_len: int = 1) -> FloatArray:
+    t = _arr(owner, "t", value, (), None)
+    if t.size < min_len:
+        raise InputError(f"{owner}.t: need at least {min_len} samples, got {t.size}")
+    check_time(t, f"{owner}.t")
+    return t
 
 
 @dataclass(frozen=True)
-class FlightLog:
-    """Telemetry of one log.
+class GnssData:
+    """GNSS position/velocity fixes (the GNSS CSV layout ``t,lat,lon,alt,vn,ve,vd,h_acc,v_acc,s_acc``).
 
-    The constructor checks shapes and finiteness (:class:`~uasnav.errors.InputError` naming the
-    field and sample), sorts the samples by time and drops repeated time stamps (the first
-    sample of each time stamp is kept), so ``t`` is strictly increasing.
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Fix time, s.
+    lat, lon : ndarray, shape (m,)
+        Latitude, longitude, degrees (WGS-84).
+    alt : ndarray, shape (m,)
+        Height, m, in the datum ``alt_datum`` (ellipsoidal when the receiver reports it).
+    vel : ndarray, shape (m, 3)
+        Velocity north, east, down, m/s.
+    h_acc, v_acc : ndarray, shape (m,)
+        Reported 1σ horizontal and vertical position accuracy, m (> 0).
+    s_acc : ndarray, shape (m,)
+        Reported 1σ speed accuracy, m/s (> 0).
+    alt_datum : HeightDatum
+        What ``alt`` is measured from (:mod:`uasnav.geo.datum`); ``geoid_undulation_m`` the
+        receiver's own geoid undulation N = ellipsoidal − AMSL height (m) when it reports both.
+    """
+
+    t: FloatArray
+    lat: FloatArray
+    lon: FloatArray
+    alt: FloatArray
+    vel: FloatArray
+    h_acc: FloatArray
+    v_acc: FloatArray
+    s_acc: FloatArray
+    alt_datum: HeightDatum = HeightDatum.ELLIPSOID
+    geoid_undulation_m: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "alt_datum", HeightDatum(self.alt_datum))
+        t = _time("gnss", self.t)
+        n = t.size
+        object.__setattr__(self, "t", t)
+        for k in ("lat", "lon", "alt", "h_acc", "v_acc", "s_acc"):
+            object.__setattr__(self, k, _arr("gnss", k, getattr(self, k), (), n))
+        object.__setattr__(self, "vel", _arr("gnss", "vel", self.vel, (3,), n))
+        if np.any(np.abs(self.lat) > 90.0):
+            raise InputError(f"gnss.lat: outside ±90° at row {int(np.argmax(np.abs(self.lat) > 90))}")
+        for k in ("h_acc", "v_acc", "s_acc"):
+            a = getattr(self, k)
+            if np.any(a <= 0):
+                raise InputError(f"gnss.{k}: accuracy must be > 0 (row {int(np.argmax(a <= 0))})")
+
+    @property
+    def n(self) -> int:
+        """Number of fixes."""
+        return int(self.t.size)
+
+    def select(self, keep: NDArray[np.bool_]) -> GnssData:
+        """The fixes where ``keep`` is true."""
+        return GnssData(
+            *(getattr(self, k)[keep] for k in ("t", "lat", "lon", "alt", "vel", "h_acc", "v_acc", "s_acc")),
+            alt_datum=self.alt_datum,
+            geoid_undulation_m=self.geoid_undulation_m,
+        )
+
+
+@dataclass(frozen=True)
+class BaroData:
+    """Barometric altitude: ``t`` (s), ``alt`` (m, any datum)."""
+
+    t: FloatArray
+    alt: FloatArray
+
+    def __post_init__(self) -> None:
+        t = _time("baro", self.t)
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "alt", _arr("baro", "alt", self.alt, (), t.size))
+
+
+@dataclass(frozen=True)
+class MagData:
+    """Magnetometer: ``t`` (s), ``field`` (k, 3) in the body frame (any unit)."""
+
+    t: FloatArray
+    field: FloatArray
+
+    def __post_init__(self) -> None:
+        t = _time("mag", self.t)
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "field", _arr("mag", "field", self.field, (3,), t.size))
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A navigation solution to compare with: the autopilot's estimate or a simulation's truth.
 
     Attributes
     ----------
     t : ndarray, shape (k,)
-        Time, s (wall clock for .tlog, the log's own clock otherwise).
+        Time, s.
     lat, lon, alt : ndarray, shape (k,)
-        Degrees, degrees, m.
-    vel_ned : ndarray, shape (k, 3)
-        Ground velocity, m/s.
+        Degrees, degrees, m (WGS-84; the height in the datum ``alt_datum``).
+    vel : ndarray, shape (k, 3) or None
+        NED velocity, m/s.
+    euler_deg : ndarray, shape (k, 3) or None
+        Roll, pitch, yaw (3-2-1), degrees.
+    name : str
+        Where it comes from (e.g. ``"ArduPilot EKF (NKF1/AHR2)"``, ``"truth"``).
+    alt_datum : HeightDatum
+        What ``alt`` is measured from (:mod:`uasnav.geo.datum`). A reader gives the autopilot's
+        estimate in the datum of its GNSS fixes, so that the two compare directly.
+    """
+
+    t: FloatArray
+    lat: FloatArray
+    lon: FloatArray
+    alt: FloatArray
+    vel: FloatArray | None = None
+    euler_deg: FloatArray | None = None
+    name: str = "reference"
+    alt_datum: HeightDatum = HeightDatum.ELLIPSOID
+    extra: dict[str, FloatArray] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "alt_datum", HeightDatum(self.alt_datum))
+        t = _time(self.name, self.t, 2)
+        n = t.size
+        object.__setattr__(self, "t", t)
+        for k in ("lat", "lon", "alt"):
+            object.__setattr__(self, k, _arr(self.name, k, getattr(self, k), (), n))
+        if self.vel is not None:
+            object.__setattr__(self, "vel", _arr(self.name, "vel", self.vel, (3,), n))
+        if self.euler_deg is not None:
+            object.__setattr__(self, "euler_deg", _arr(self.name, "euler_deg", self.euler_deg, (3,), n))
+
+
+@dataclass(frozen=True)
+class Flight:
+    """One flight (see the module docs): the parts a log carries, the others None or empty.
+
+    Attributes
+    ----------
+    imu : ImuLog or None
+        The IMU the filter integrates (body FRD; gyro rad/s, accel m/s², temp °C).
+    gnss : GnssData or None
+        GNSS fixes.
+    baro, mag : BaroData, MagData or None
+        Barometer and magnetometer, if logged.
+    reference : Trajectory or None
+        The autopilot's own estimate, in the datum of the GNSS fixes.
+    truth : Trajectory or None
+        Ground truth (simulated flights).
+    imus : dict of str to ImuLog
+        Every IMU of the log (for redundant-IMU fusion), including ``imu``.
+    airborne : (float, float) or None
+        The airborne interval (s) when known.
+    meta : dict
+        Source, format, notes (e.g. the IMU rate's limits).
+    track : Trajectory or None
+        The position telemetry as logged (ULog ``vehicle_global_position``, DataFlash ``GPS``,
+        ``GLOBAL_POSITION_INT``, a flight CSV), time in the log's own clock (wall clock for
+        .tlog), NED ground velocity ``vel``; its datum ``track.alt_datum`` (AMSL for the log
+        readers, ``unknown`` for a flight CSV). :attr:`t`, :attr:`lat`, :attr:`lon`,
+        :attr:`alt`, :attr:`vel_ned` and :attr:`alt_datum` read it.
     waypoints : dict seq → (lat, lon, alt)
         Mission navigation waypoints (deg, deg, m).
     reached : list of (t, seq)
@@ -67,49 +235,35 @@ class FlightLog:
     cruise_ms : float or None
         Mission/waypoint speed (m/s), if logged.
     source : str
-        The file read.
-    alt_datum : HeightDatum
-        What ``alt`` is measured from: AMSL for the log readers (ULog ``vehicle_global_position``
-        / ``vehicle_gps_position.alt``, DataFlash ``GPS.Alt``, ``GLOBAL_POSITION_INT.alt``), not
-        stated by a flight CSV (``unknown``).
+        The file read (``meta["source"]`` when not given).
     """
 
-    t: FloatArray
-    lat: FloatArray
-    lon: FloatArray
-    alt: FloatArray
-    vel_ned: FloatArray
+    imu: ImuLog | None = None
+    gnss: GnssData | None = None
+    baro: BaroData | None = None
+    mag: MagData | None = None
+    reference: Trajectory | None = None
+    truth: Trajectory | None = None
+    imus: dict[str, ImuLog] = field(default_factory=dict)
+    airborne: tuple[float, float] | None = None
+    meta: dict[str, Any] = field(default_factory=dict)
+    track: Trajectory | None = None
     waypoints: dict[int, tuple[float, float, float]] = field(default_factory=dict)
     reached: list[tuple[float, int]] = field(default_factory=list)
     wind_ne: FloatArray | None = None
     cruise_ms: float | None = None
     source: str = ""
-    alt_datum: HeightDatum = HeightDatum.UNKNOWN
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "alt_datum", HeightDatum(self.alt_datum))
+        if self.imu is not None and not isinstance(self.imu, ImuLog):
+            raise InputError(f"flight.imu: expected an ImuLog, got {type(self.imu).__name__}")
+        if self.gnss is not None and not isinstance(self.gnss, GnssData):
+            raise InputError(f"flight.gnss: expected GnssData, got {type(self.gnss).__name__}")
+        if self.track is not None and not isinstance(self.track, Trajectory):
+            raise InputError(f"flight.track: expected a Trajectory, got {type(self.track).__name__}")
+        if not self.source and isinstance(self.meta, Mapping):
+            object.__setattr__(self, "source", str(self.meta.get("source", "")))
         src = self.source or "flight log"
-        arrays: dict[str, FloatArray] = {}
-        for k in _SAMPLE_FIELDS:
-            try:
-                arrays[k] = np.asarray(getattr(self, k), dtype=np.float64)
-            except (TypeError, ValueError):
-                raise InputError(f"{src}: {k} is not numeric ({type(getattr(self, k)).__name__})") from None
-        n = arrays["t"].size
-        if n < 2:
-            raise InputError(f"{src}: fewer than 2 position samples")
-        for k, a in arrays.items():
-            want = (n, 3) if k == "vel_ned" else (n,)
-            if a.shape != want:
-                raise InputError(f"{src}: {k} has shape {a.shape}, expected {want}")
-            bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(n, -1)), axis=1))
-            if bad.size:
-                raise InputError(f"{src}: non-finite {k} at sample {int(bad[0])}")
-        order = np.argsort(arrays["t"], kind="stable")
-        arrays = {k: a[order] for k, a in arrays.items()}
-        keep = np.concatenate([[True], np.diff(arrays["t"]) > 0])
-        for k, a in arrays.items():
-            object.__setattr__(self, k, a[keep])
         if not isinstance(self.waypoints, Mapping):
             raise InputError(
                 f"{src}: waypoints must map seq → (lat, lon, alt), got {type(self.waypoints).__name__}"
@@ -134,6 +288,168 @@ class FlightLog:
             if not (ok and np.isfinite(self.cruise_ms) and self.cruise_ms >= 0):
                 shown = float(self.cruise_ms) if ok else self.cruise_ms
                 raise InputError(f"{src}: cruise speed must be a finite number ≥ 0 m/s, got {shown!r}")
+
+    @classmethod
+    def from_track(
+        cls,
+        t: ArrayLike,
+        lat: ArrayLike,
+        lon: ArrayLike,
+        alt: ArrayLike,
+        vel_ned: ArrayLike,
+        *,
+        alt_datum: HeightDatum = HeightDatum.UNKNOWN,
+        source: str = "",
+        **parts: Any,
+    ) -> Flight:
+        """A flight from its position telemetry: time (s), latitude, longitude (deg), height
+        (m, in ``alt_datum``) and NED ground velocity (k, 3) m/s; ``parts`` are the other fields
+        (``waypoints``, ``reached``, ``wind_ne``, ``cruise_ms`` …).
+
+        The samples are sorted by time and repeated time stamps dropped (the first sample of each
+        time stamp is kept), so the track's ``t`` is strictly increasing.
+
+        Raises
+        ------
+        InputError
+            A field that is not numeric, of the wrong shape or not finite (naming the field and
+            sample); fewer than 2 samples.
+        """
+        src = source or "flight log"
+        arrays: dict[str, FloatArray] = {}
+        for k, v in zip(_TRACK_FIELDS, (t, lat, lon, alt, vel_ned), strict=True):
+            try:
+                arrays[k] = np.asarray(v, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise InputError(f"{src}: {k} is not numeric ({type(v).__name__})") from None
+        n = arrays["t"].size
+        if n < 2:
+            raise InputError(f"{src}: fewer than 2 position samples")
+        for k, a in arrays.items():
+            want = (n, 3) if k == "vel_ned" else (n,)
+            if a.shape != want:
+                raise InputError(f"{src}: {k} has shape {a.shape}, expected {want}")
+            bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(n, -1)), axis=1))
+            if bad.size:
+                raise InputError(f"{src}: non-finite {k} at sample {int(bad[0])}")
+        order = np.argsort(arrays["t"], kind="stable")
+        keep = np.concatenate([[True], np.diff(arrays["t"][order]) > 0])
+        a = {k: v[order][keep] for k, v in arrays.items()}
+        track = Trajectory(
+            a["t"],
+            a["lat"],
+            a["lon"],
+            a["alt"],
+            a["vel_ned"],
+            name="telemetry",
+            alt_datum=HeightDatum(alt_datum),
+        )
+        return cls(track=track, source=source, **parts)
+
+    def _track(self) -> Trajectory:
+        if self.track is None:
+            raise InputError(f"{self.source or 'flight'}: no position telemetry (read the log's flight view)")
+        return self.track
+
+    @property
+    def t(self) -> FloatArray:
+        """Telemetry time, s (strictly increasing)."""
+        return self._track().t
+
+    @property
+    def lat(self) -> FloatArray:
+        """Telemetry latitude, deg."""
+        return self._track().lat
+
+    @property
+    def lon(self) -> FloatArray:
+        """Telemetry longitude, deg."""
+        return self._track().lon
+
+    @property
+    def alt(self) -> FloatArray:
+        """Telemetry height, m, in :attr:`alt_datum`."""
+        return self._track().alt
+
+    @property
+    def vel_ned(self) -> FloatArray:
+        """Telemetry ground velocity (k, 3), NED m/s."""
+        vel = self._track().vel
+        assert vel is not None  # from_track always sets it
+        return vel
+
+    @property
+    def alt_datum(self) -> HeightDatum:
+        """What the telemetry's :attr:`alt` is measured from."""
+        return self._track().alt_datum
+
+    def with_imu(self, imu: ImuLog, name: str | None = None) -> Flight:
+        """The same flight integrating another IMU (e.g. a redundant-IMU fusion)."""
+        meta = dict(self.meta)
+        if name:
+            meta["imu"] = name
+        return replace(self, imu=imu, meta=meta)
+
+    def between(self, t0: float, t1: float) -> Flight:
+        """The flight cut to ``t0 ≤ t ≤ t1`` (every sensor stream and reference; the telemetry
+        track and the mission events are kept whole)."""
+        if self.imu is None or self.gnss is None:
+            raise InputError(f"flight.between({t0}, {t1}): the flight has no IMU and GNSS to cut")
+
+        def cut(t: FloatArray) -> NDArray[np.bool_]:
+            return (t >= t0) & (t <= t1)
+
+        g = self.gnss.select(cut(self.gnss.t))
+        if g.n == 0:
+            raise InputError(f"flight.between({t0}, {t1}): no GNSS fix in that interval")
+        baro = BaroData(self.baro.t[cut(self.baro.t)], self.baro.alt[cut(self.baro.t)]) if self.baro else None
+        mag = MagData(self.mag.t[cut(self.mag.t)], self.mag.field[cut(self.mag.t)]) if self.mag else None
+        if baro is not None and baro.t.size == 0:
+            baro = None
+        if mag is not None and mag.t.size == 0:
+            mag = None
+        return replace(
+            self,
+            imu=self.imu.between(t0, t1),
+            gnss=g,
+            baro=baro,
+            mag=mag,
+            reference=_cut_traj(self.reference, t0, t1),
+            truth=_cut_traj(self.truth, t0, t1),
+            imus={k: v.between(t0, t1) for k, v in self.imus.items()},
+            meta=dict(self.meta),
+        )
+
+
+def _cut_traj(tr: Trajectory | None, t0: float, t1: float) -> Trajectory | None:
+    if tr is None:
+        return None
+    k = (tr.t >= t0) & (tr.t <= t1)
+    if k.sum() < 2:
+        return None
+    return Trajectory(
+        tr.t[k],
+        tr.lat[k],
+        tr.lon[k],
+        tr.alt[k],
+        None if tr.vel is None else tr.vel[k],
+        None if tr.euler_deg is None else tr.euler_deg[k],
+        tr.name,
+        tr.alt_datum,
+        {n: v[k] for n, v in tr.extra.items()},
+    )
+
+
+def strictly_increasing(t: FloatArray) -> NDArray[np.bool_]:
+    """Keep the first of repeated/decreasing time stamps."""
+    keep = np.ones(t.size, dtype=bool)
+    last = -np.inf
+    for i, x in enumerate(t):
+        if x > last:
+            last = x
+        else:
+            keep[i] = False
+    return keep
 
 
 def wind_from(speed_ms: float, from_deg: float) -> FloatArray:
@@ -183,9 +499,9 @@ def flight_from_fixes(
     cruise_ms: float | None = None,
     decoder: LibraryOutput | None = None,
     alt_datum: HeightDatum = HeightDatum.AMSL,
-) -> FlightLog:
-    """A :class:`FlightLog` from position fixes ``(t, lat, lon, alt, v_N, v_E, v_D)`` (rows of a
-    sequence or an array (k, 7)) and events.
+) -> Flight:
+    """A :class:`Flight` (its telemetry track and mission events) from position fixes
+    ``(t, lat, lon, alt, v_N, v_E, v_D)`` (rows of a sequence or an array (k, 7)) and events.
 
     ``alt_datum`` is the heights' datum (the log readers': AMSL). ``wind`` holds the log's wind
     estimates (north, east; m/s): their mean becomes ``wind_ne``.
@@ -207,12 +523,12 @@ def flight_from_fixes(
     report_corruption(src, decoder, int((~keep).sum()), a.shape[0], "position fix")
     a = a[keep]
     try:
-        return FlightLog(
-            t=a[:, 0],
-            lat=a[:, 1],
-            lon=a[:, 2],
-            alt=a[:, 3],
-            vel_ned=a[:, 4:7],
+        return Flight.from_track(
+            a[:, 0],
+            a[:, 1],
+            a[:, 2],
+            a[:, 3],
+            a[:, 4:7],
             waypoints=waypoints,
             reached=sorted(reached),
             wind_ne=np.mean(np.asarray(wind, dtype=np.float64), axis=0) if wind else None,
@@ -224,52 +540,15 @@ def flight_from_fixes(
         raise DataFormatError(str(e).removeprefix(f"{src}: "), path=src) from None
 
 
-def read_flight_csv(path: str | os.PathLike[str]) -> FlightLog:
-    """Read a flight CSV: header ``t,lat,lon,alt,v_N,v_E,v_D`` (s, deg, deg, m, m/s NED), no mission.
-
-    Other columns are ignored.
-
-    Raises
-    ------
-    DataFormatError
-        Empty file, missing column, fewer than 2 rows, a non-numeric, missing or non-finite
-        cell, a latitude/longitude/altitude outside :data:`FIX_LIMITS`, malformed CSV or text
-        that is not UTF-8 (names line and column).
-    """
-    source = str(path)
-    lines = split_lines(read_text(path))
-    first = next(csv_rows(lines, 0, source), None)
-    if first is None:
-        raise DataFormatError("empty file", path=source)
-    header_line, cells = first
-    head = [h.strip() for h in cells]
-    missing = [c for c in FLIGHT_CSV_COLUMNS if c not in head]
-    if missing:
-        raise DataFormatError(
-            f"missing column(s) {missing}; need {FLIGHT_CSV_COLUMNS}", path=source, line=header_line
-        )
-    data, row_lines = numeric_rows(lines, header_line, source, head, FLIGHT_CSV_COLUMNS)
-    for j, name in enumerate(FLIGHT_CSV_COLUMNS[1:4], start=1):
-        lo, hi = FIX_LIMITS[name]
-        out = np.flatnonzero((data[:, j] < lo) | (data[:, j] > hi))
-        if out.size:
-            raise DataFormatError(
-                f"{float(data[out[0], j])!r} is outside [{lo:g}, {hi:g}]",
-                path=source,
-                line=row_lines[out[0]],
-                column=name,
-            )
-    return FlightLog(
-        t=data[:, 0], lat=data[:, 1], lon=data[:, 2], alt=data[:, 3], vel_ned=data[:, 4:7], source=str(path)
-    )
-
-
 __all__ = [
     "FIX_LIMITS",
-    "FLIGHT_CSV_COLUMNS",
-    "FlightLog",
+    "BaroData",
+    "Flight",
+    "GnssData",
+    "MagData",
+    "Trajectory",
     "flight_from_fixes",
-    "read_flight_csv",
+    "strictly_increasing",
     "valid_fixes",
     "wind_from",
 ]

@@ -24,7 +24,7 @@ import numpy as np
 
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
-from uasnav.io.navdata import GnssData
+from uasnav.io.flight import GnssData
 from uasnav.io.table import read_csv_table
 
 #: The columns, in order.
@@ -38,7 +38,7 @@ def read_gnss_csv(path: str | os.PathLike[str]) -> GnssData:
     ------
     DataFormatError
         Unreadable or malformed file, a missing column (named), fewer than 1 fix, or values
-        :class:`~uasnav.io.navdata.GnssData` refuses (time not increasing, |lat| > 90°,
+        :class:`~uasnav.io.flight.GnssData` refuses (time not increasing, |lat| > 90°,
         accuracies ≤ 0), with the file named.
     """
     cols, _ = read_csv_table(path)

@@ -9,13 +9,13 @@ decoded on first access and cached:
 view                  type                                           units, frames, datums
 ===================== ============================================== =========================
 ``imus`` / ``imu``    dict of :class:`~uasnav.imu.ImuLog` / primary  body FRD; rad/s, m/s², °C
-``gnss``              :class:`~uasnav.io.navdata.GnssData`           deg, NED m/s; ``alt_datum``
-``baro``              :class:`~uasnav.io.navdata.BaroData`           m, datum unknown
-``mag``               :class:`~uasnav.io.navdata.MagData`            body FRD, unit as logged
-``autopilot_estimate`` :class:`~uasnav.io.navdata.Trajectory`        deg; NED m/s; deg 3-2-1;
+``gnss``              :class:`~uasnav.io.flight.GnssData`           deg, NED m/s; ``alt_datum``
+``baro``              :class:`~uasnav.io.flight.BaroData`           m, datum unknown
+``mag``               :class:`~uasnav.io.flight.MagData`            body FRD, unit as logged
+``autopilot_estimate`` :class:`~uasnav.io.flight.Trajectory`        deg; NED m/s; deg 3-2-1;
                                                                      in the GNSS fixes' datum
-``nav``               :class:`~uasnav.io.navdata.Flight`             all of the above together
-``flight``            :class:`~uasnav.io.flight.FlightLog`           telemetry for trajectory
+``nav``               :class:`~uasnav.io.flight.Flight`             all of the above together
+``flight``            :class:`~uasnav.io.flight.Flight`           telemetry for trajectory
 ``plan``              :class:`~uasnav.io.mission_plan.MissionPlan`   items with altitude frames
 ``params``            dict name → float                              as the autopilot stores
 ``limits``            :class:`~uasnav.io.autopilot_limits.AutopilotLimits` SI
@@ -142,7 +142,7 @@ class LogFile:
 
     @property
     def nav(self) -> Any:
-        """The navigation data (:class:`~uasnav.io.navdata.Flight`)."""
+        """The navigation data (:class:`~uasnav.io.flight.Flight`)."""
         return self.view("nav")
 
     @property
@@ -167,7 +167,7 @@ class LogFile:
 
     @property
     def flight(self) -> Any:
-        """Flight telemetry (:class:`~uasnav.io.flight.FlightLog`)."""
+        """Flight telemetry (:class:`~uasnav.io.flight.Flight`)."""
         return self.view("flight")
 
     @property
@@ -205,7 +205,7 @@ def open_log(path: str | os.PathLike[str], *, need: Iterable[str] = (), **option
     """Open the log ``path`` — a file, an ALFA folder or an ``http(s)://`` URL, fetched first
     into a temporary folder that lives as long as the :class:`LogFile` — (see the module docs);
     ``need`` declares the views to decode in the first pass. ``gnss=`` (a GNSS CSV path or
-    :class:`~uasnav.io.navdata.GnssData`) gives a CSV v1 log its fixes, or replaces a log's own.
+    :class:`~uasnav.io.flight.GnssData`) gives a CSV v1 log its fixes, or replaces a log's own.
 
     Raises
     ------

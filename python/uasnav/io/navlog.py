@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from uasnav.io.flight import Flight
 from uasnav.io.logfile import open_log
-from uasnav.io.navdata import Flight
 
 
 def read_nav(path: str | Any, *, gnss_csv: str | None = None) -> Flight:

@@ -40,7 +40,7 @@ from uasnav.io._common import (
     salvage,
 )
 from uasnav.io._quiet import LibraryOutput, library_output_captured
-from uasnav.io.flight import FlightLog, flight_from_fixes
+from uasnav.io.flight import Flight, flight_from_fixes
 
 #: |magnetic field| above which a record is corrupt, µT (sensors saturate near ±5000 µT).
 MAX_MAG_UT = 10_000.0
@@ -262,7 +262,7 @@ def read_ulog_imus(path: str | os.PathLike[str]) -> dict[str, ImuLog]:
     return out
 
 
-def read_ulog_flight(path: str | os.PathLike[str]) -> FlightLog:
+def read_ulog_flight(path: str | os.PathLike[str]) -> Flight:
     """The flight telemetry of a PX4 ULog (see the module docs for the topics).
 
     Corrupt position records are dropped (:func:`uasnav.io.flight.valid_fixes`; one

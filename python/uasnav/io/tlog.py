@@ -29,7 +29,7 @@ from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
 from uasnav.io._common import because, build_log, corruption_meta, report_corruption
 from uasnav.io._mavlink import messages, reading
-from uasnav.io.flight import FlightLog, flight_from_fixes, wind_from
+from uasnav.io.flight import Flight, flight_from_fixes, wind_from
 from uasnav.units import STANDARD_GRAVITY
 
 #: IMU message streams read by :func:`read_tlog`.
@@ -111,7 +111,7 @@ def read_tlog(path: str | os.PathLike[str]) -> dict[str, ImuLog]:
     return out
 
 
-def read_tlog_flight(path: str | os.PathLike[str]) -> FlightLog:
+def read_tlog_flight(path: str | os.PathLike[str]) -> Flight:
     """The flight telemetry of a MAVLink log (see the module docs for the messages).
 
     Navigation waypoints are the ``NAV_WAYPOINT`` items with a position (seq 0, ArduPilot's

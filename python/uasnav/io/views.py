@@ -1,5 +1,5 @@
 """The typed views of a log that :class:`~uasnav.io.logfile.LogFile` offers besides the sensor
-and estimate data types of :mod:`uasnav.io.navdata` (IMU, GNSS, barometer, magnetometer,
+and estimate data types of :mod:`uasnav.io.flight` (IMU, GNSS, barometer, magnetometer,
 autopilot estimate) and the plan (:class:`~uasnav.io.mission_plan.MissionPlan`).
 
 Time base: every time in every view is the log's own clock in seconds — time since boot for

@@ -42,7 +42,7 @@ from uasnav import earth
 from uasnav.errors import InputError
 from uasnav.geo.frames import radii_of_curvature
 from uasnav.imu import ImuLog
-from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
+from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.limits import check_memory
 from uasnav.sim.core import thermal_model
 from uasnav.sim.model import SensorModel

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from uasnav.errors import InputError
 from uasnav.io import read_flight
 from uasnav.io.autopilot_limits import DEFAULT_LIMITS
-from uasnav.io.flight import FlightLog
+from uasnav.io.flight import Flight
 from uasnav.io.logfile import LogFile, open_log
 from uasnav.io.plans import read_plan_route
 from uasnav.trajectory.baselines import evaluate_methods, kinematic_times
@@ -127,7 +127,7 @@ def flight_samples(
     return FlightSamples(tuple(runs_all), tuple(samples_all), opened)
 
 
-def _read(path: str | Path | LogFile) -> tuple[FlightLog, LogFile | None]:
+def _read(path: str | Path | LogFile) -> tuple[Flight, LogFile | None]:
     """The telemetry of ``path`` and, for a binary log, the opened log (one decoding pass for
     the telemetry and the autopilot limits; an already opened log is used as it is)."""
     if isinstance(path, LogFile):

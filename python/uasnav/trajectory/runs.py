@@ -1,4 +1,4 @@
-"""Flown mission runs of flight telemetry (:class:`uasnav.io.flight.FlightLog`, read with
+"""Flown mission runs of flight telemetry (:class:`uasnav.io.flight.Flight`, read with
 :func:`uasnav.io.open_log`), and the elements measured on them.
 
 :func:`flown_runs` cuts a log into mission runs (consecutive reached events of increasing
@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import InputError
-from uasnav.io.flight import FlightLog
+from uasnav.io.flight import Flight
 from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, arc_length_along, geodetic_to_local, plan_length
 from uasnav.trajectory.samples import ElementSamples, measure_elements
 
@@ -49,7 +49,7 @@ class FlownRun:
     alt_m: FloatArray | None = None
 
 
-def flown_runs(log: FlightLog, origin: tuple[float, float, float] | None = None) -> list[FlownRun]:
+def flown_runs(log: Flight, origin: tuple[float, float, float] | None = None) -> list[FlownRun]:
     """Cut a log into mission runs between reached navigation waypoints (local NED plan).
 
     Raises :class:`InputError` if the log has no mission waypoints or no run reaching two of
@@ -95,7 +95,7 @@ def flown_runs(log: FlightLog, origin: tuple[float, float, float] | None = None)
 
 
 def run_samples(
-    log: FlightLog,
+    log: Flight,
     segment_m: float = DEFAULT_SEGMENT_M,
     cruise_ms: float | None = None,
     wind_ne: np.ndarray | None = None,

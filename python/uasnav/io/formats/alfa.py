@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
+from uasnav.io.flight import Flight
 from uasnav.io.formats.base import LogFormat
-from uasnav.io.navdata import Flight
 from uasnav.io.views import Identity
 
 

@@ -26,7 +26,7 @@ VIEWS = (
     "modes",
     "identity",
 )
-#: Views taken from the navigation data (:class:`~uasnav.io.navdata.Flight`).
+#: Views taken from the navigation data (:class:`~uasnav.io.flight.Flight`).
 NAV_PARTS = {"gnss": "gnss", "baro": "baro", "mag": "mag", "autopilot_estimate": "reference"}
 
 
@@ -113,15 +113,16 @@ class LogFormat:
 
     def _with_gnss(self, nav: Any) -> Any:
         """``nav`` with the GNSS fixes of the option ``gnss`` (a GNSS CSV path or GnssData)."""
-        from uasnav.io.navdata import Flight, GnssData
+        from dataclasses import replace
+
+        from uasnav.io.flight import GnssData
 
         gnss = self.options["gnss"]
         if not isinstance(gnss, GnssData):
             from uasnav.io.gnss_csv import read_gnss_csv
 
             gnss = read_gnss_csv(gnss)
-        n = nav
-        return Flight(n.imu, gnss, n.baro, n.mag, n.reference, n.truth, n.imus, n.airborne, n.meta)
+        return replace(nav, gnss=gnss)
 
 
 __all__ = ["NAV_PARTS", "VIEWS", "LogFormat"]

@@ -7,14 +7,20 @@ Heights: the GNSS CSV's ``alt`` is ellipsoidal (:mod:`uasnav.io.gnss_csv`); the 
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any, ClassVar
 
+import numpy as np
+
 from uasnav.errors import DataFormatError, InputError
-from uasnav.io.flight import FLIGHT_CSV_COLUMNS
+from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
+from uasnav.io.flight import FIX_LIMITS, Flight, GnssData, MagData
 from uasnav.io.formats.base import LogFormat
-from uasnav.io.navdata import Flight, GnssData, MagData
 from uasnav.io.views import Identity
+
+#: Columns of the flight CSV (s, deg, deg, m, then the NED ground velocity in m/s).
+FLIGHT_CSV_COLUMNS = ("t", "lat", "lon", "alt", "v_N", "v_E", "v_D")
 
 
 def csv_kind(path: str | Path) -> str:
@@ -124,16 +130,60 @@ class NpzFormat(_WholeFile):
         return read_npz(self.path)
 
 
+def read_flight_csv(path: str | os.PathLike[str]) -> Flight:
+    """Read a flight CSV: header ``t,lat,lon,alt,v_N,v_E,v_D`` (s, deg, deg, m, m/s NED), no mission.
+
+    Other columns are ignored.
+
+    Raises
+    ------
+    DataFormatError
+        Empty file, missing column, fewer than 2 rows, a non-numeric, missing or non-finite
+        cell, a latitude/longitude/altitude outside :data:`FIX_LIMITS`, malformed CSV or text
+        that is not UTF-8 (names line and column).
+    """
+    source = str(path)
+    lines = split_lines(read_text(path))
+    first = next(csv_rows(lines, 0, source), None)
+    if first is None:
+        raise DataFormatError("empty file", path=source)
+    header_line, cells = first
+    head = [h.strip() for h in cells]
+    missing = [c for c in FLIGHT_CSV_COLUMNS if c not in head]
+    if missing:
+        raise DataFormatError(
+            f"missing column(s) {missing}; need {FLIGHT_CSV_COLUMNS}", path=source, line=header_line
+        )
+    data, row_lines = numeric_rows(lines, header_line, source, head, FLIGHT_CSV_COLUMNS)
+    for j, name in enumerate(FLIGHT_CSV_COLUMNS[1:4], start=1):
+        lo, hi = FIX_LIMITS[name]
+        out = np.flatnonzero((data[:, j] < lo) | (data[:, j] > hi))
+        if out.size:
+            raise DataFormatError(
+                f"{float(data[out[0], j])!r} is outside [{lo:g}, {hi:g}]",
+                path=source,
+                line=row_lines[out[0]],
+                column=name,
+            )
+    return Flight.from_track(data[:, 0], data[:, 1], data[:, 2], data[:, 3], data[:, 4:7], source=source)
+
+
 class FlightCsvFormat(LogFormat):
-    """Flight CSV ``t,lat,lon,alt,v_N,v_E,v_D`` (:func:`uasnav.io.flight.read_flight_csv`)."""
+    """Flight CSV ``t,lat,lon,alt,v_N,v_E,v_D`` (:func:`read_flight_csv`)."""
 
     name = "flight-csv"
     SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"flight": ()}
 
-    def build_flight(self) -> Any:
-        from uasnav.io.flight import read_flight_csv
-
+    def build_flight(self) -> Flight:
         return read_flight_csv(self.path)
 
 
-__all__ = ["CsvV1Format", "FlightCsvFormat", "NpzFormat", "XioFormat", "csv_kind"]
+__all__ = [
+    "FLIGHT_CSV_COLUMNS",
+    "CsvV1Format",
+    "FlightCsvFormat",
+    "NpzFormat",
+    "XioFormat",
+    "csv_kind",
+    "read_flight_csv",
+]

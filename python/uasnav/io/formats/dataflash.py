@@ -33,9 +33,9 @@ from uasnav.io.dataflash import (
     read_dataflash_identity,
     read_dataflash_messages,
 )
+from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory, strictly_increasing
 from uasnav.io.formats._scan import MavlinkScan
 from uasnav.io.formats.base import LogFormat
-from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory, strictly_increasing
 from uasnav.io.plan_formats.logs import read_dataflash_plan
 from uasnav.io.views import Identity, ModeTimeline, changes
 

@@ -23,10 +23,10 @@ from uasnav.io._common import because
 from uasnav.io._mavlink import messages, reading
 from uasnav.io.alfa import isa_pressure_altitude
 from uasnav.io.autopilot_params import ARDUPILOT_PARAMS, PX4_PARAMS
+from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.io.formats._scan import MavlinkScan
 from uasnav.io.formats.base import LogFormat
 from uasnav.io.formats.dataflash import COPTER_MODES
-from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.io.plan_formats.logs import read_tlog_plan
 from uasnav.io.tlog import IMU_TYPES, read_tlog, read_tlog_flight
 from uasnav.io.views import Identity, ModeTimeline, changes
@@ -41,7 +41,7 @@ _GCS = 6  # MAV_TYPE_GCS: the ground station's own heartbeat
 
 
 def read_tlog_nav(path: str | os.PathLike[str]) -> Flight:
-    """Navigation data of a MAVLink log as a :class:`~uasnav.io.navdata.Flight`: the IMU from
+    """Navigation data of a MAVLink log as a :class:`~uasnav.io.flight.Flight`: the IMU from
     ``SCALED_IMU`` (else ``RAW_IMU``, ArduPilot scaling: mg, mrad/s), ``GPS_RAW_INT`` (fixes
     with ``fix_type`` ≥ 3; ``h_acc``/``v_acc``/``vel_acc`` when sent, else σ from ``eph``),
     ``SCALED_PRESSURE`` (ISA pressure altitude), the IMU's magnetometer, and the reference from

@@ -33,9 +33,9 @@ from uasnav.errors import DataFormatError
 from uasnav.geo.datum import HeightDatum, receiver_undulation
 from uasnav.geo.frames import ned_to_geodetic
 from uasnav.io.autopilot_params import PX4_PARAMS
+from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory, strictly_increasing
 from uasnav.io.formats._scan import ULogScan
 from uasnav.io.formats.base import LogFormat
-from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory, strictly_increasing
 from uasnav.io.plan_formats.ulog import read_ulog_plan
 from uasnav.io.px4 import _open, _start_utc, read_ulog, read_ulog_flight, read_ulog_imus
 from uasnav.io.views import Identity, ModeTimeline, changes
