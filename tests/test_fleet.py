@@ -215,7 +215,7 @@ def test_ulog_instances_and_start_against_pyulog(shared_data):
 
     from pyulog import ULog
 
-    from uasnav.io.px4 import read_ulog_imus
+    from uasnav.io.formats.ulog import read_ulog_imus
 
     path = shared_data / "logs" / "px4_sample_log_small.ulg"
     imus = read_ulog_imus(path)

@@ -362,7 +362,7 @@ def test_ulog_without_gnss_or_imu_is_a_named_error(tmp_path) -> None:  # type: i
     """A PX4 ULog with an IMU but no GNSS topic, and one with GNSS but no IMU topic (written by the
     tests' minimal ULog writer: no shared ULog lacks either): `uasnav nav` fails with one error
     line naming the missing topics; the IMU-only log itself is readable (the error is the GNSS)."""
-    from uasnav.io.px4 import read_ulog
+    from uasnav.io.formats.ulog import read_ulog
     from ulog_writer import write_ulog
 
     imu_fields = (("uint64_t", "timestamp"),) + tuple(

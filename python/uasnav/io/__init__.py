@@ -55,9 +55,9 @@ from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.io.dataflash import read_dataflash, read_dataflash_flight, read_dataflash_messages
 from uasnav.io.flight import Flight
 from uasnav.io.formats.csvlog import read_flight_csv
+from uasnav.io.formats.ulog import read_ulog, read_ulog_flight
 from uasnav.io.logfile import LogFile, open_log
 from uasnav.io.npz import read_npz, write_npz
-from uasnav.io.px4 import read_ulog, read_ulog_flight
 from uasnav.io.table import read_csv_table, write_csv_table
 from uasnav.io.tlog import read_tlog, read_tlog_flight
 from uasnav.io.xio import read_xio_csv

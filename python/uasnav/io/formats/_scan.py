@@ -2,9 +2,10 @@
 
 A :class:`~uasnav.io.logfile.LogFile` decodes its file once, for the union of the message types
 its views need (:class:`MavlinkScan`: one pymavlink pass with a ``type`` filter;
-:class:`ULogScan`: one pyulog parse with ``message_name_filter_list``), and builds the views
-while the scan is *active* (:func:`active`). Inside that block the format readers' low-level
-access (:func:`uasnav.io._mavlink.reading`, :func:`uasnav.io.px4._open`) replays the scan
+:class:`ULogScan`: one pyulog parse with
+``message_name_filter_list``), and builds the views while the scan is *active*
+(:func:`active`). Inside that block the format readers' low-level access
+(:func:`uasnav.io._mavlink.reading`, :func:`_open`) replays the scan
 instead of opening the file again. A reader that asks for a type the scan does not hold
 falls back to a real decoding pass (the parse-count test catches that as a defect).
 
@@ -18,10 +19,10 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from uasnav.errors import DataFormatError
 from uasnav.io._active import active, lookup
 from uasnav.io._mavlink import scan_file
-from uasnav.io._quiet import LibraryOutput
-from uasnav.io.px4 import parse_ulog
+from uasnav.io._quiet import LibraryOutput, library_output_captured
 
 
 class MavlinkScan:
@@ -62,8 +63,50 @@ class ReplayConnection:
         """Nothing to close: the file was closed after the decoding pass."""
 
 
+def parse_ulog(p: Path, topics: list[str] | None = None) -> tuple[Any, LibraryOutput]:
+    """The ULog ``p`` parsed by pyulog (only ``topics`` when given: its
+    ``message_name_filter_list``) and what pyulog printed meanwhile (its corruption notices go
+    to stdout, which must stay clean for ``--json``).
+
+    Raises
+    ------
+    DataFormatError
+        Missing file, not a regular file (a device or FIFO), or not a ULog pyulog can parse.
+    """
+    from pyulog import ULog
+
+    if not p.exists():
+        raise DataFormatError("no such file", path=str(p))
+    if not p.is_file():
+        raise DataFormatError("not a regular file", path=str(p))  # a device or FIFO
+    ulog = None
+    failure: Exception | None = None
+    with library_output_captured() as decoder:
+        try:
+            ulog = ULog(str(p), message_name_filter_list=topics)
+        except Exception as e:  # pyulog raises bare exceptions on corrupt headers
+            failure = e
+    if ulog is None:
+        raise DataFormatError(
+            f"not a readable ULog ({type(failure).__name__}: {failure})", path=str(p)
+        ) from None
+    if getattr(ulog, "file_corruption", False) and not decoder.lines:
+        decoder.note("pyulog detected file corruption")
+    return ulog, decoder
+
+
+def _open(p: Path, topics: list[str] | None = None) -> tuple[Any, LibraryOutput]:
+    """The parsed ULog ``p``: the active scan's (the :class:`ULogScan`) when there is
+    one, else a fresh parse of ``topics`` (None: every topic)."""
+    scan = lookup(p)
+    if scan is not None and hasattr(scan, "ulog"):
+        return scan.ulog, scan.decoder
+    return parse_ulog(p, topics)
+
+
 class ULogScan:
-    """A PX4 ULog parsed once by pyulog for the topics ``types`` only."""
+    """A PX4 ULog parsed once by pyulog for the topics ``types`` only (the decoding pass of a
+    :class:`~uasnav.io.logfile.LogFile`; :func:`_open` replays it while it is active)."""
 
     def __init__(self, path: Path, types: Iterable[str]) -> None:
         self.path = Path(path)
@@ -74,10 +117,24 @@ class ULogScan:
         return set(types) <= self.types
 
 
+_GNSS = ("vehicle_gps_position", "sensor_gps")
+_IMU = ("sensor_combined", "vehicle_imu", "sensor_gyro", "sensor_accel", *_GNSS)
+#: PX4 ``vehicle_status.nav_state`` numbers → names (``vehicle_status.msg``).
+NAV_STATES = {
+    0: "MANUAL", 1: "ALTCTL", 2: "POSCTL", 3: "AUTO_MISSION", 4: "AUTO_LOITER", 5: "AUTO_RTL",
+    6: "AUTO_RCRECOVER", 7: "AUTO_RTGS", 8: "AUTO_LANDENGFAIL", 9: "AUTO_LANDGPSFAIL", 10: "ACRO",
+    12: "DESCEND", 13: "TERMINATION", 14: "OFFBOARD", 15: "STAB", 17: "AUTO_TAKEOFF",
+    18: "AUTO_LAND", 19: "AUTO_FOLLOW_TARGET", 20: "AUTO_PRECLAND", 21: "ORBIT", 22: "AUTO_VTOL_TAKEOFF",
+}  # fmt: skip
+#: PX4 ``vehicle_status.vehicle_type``.
+VEHICLE_TYPES = {0: "unknown", 1: "multirotor", 2: "fixed-wing", 3: "rover", 4: "airship"}
+_RELEASE_TYPES = {0: "dev", 64: "alpha", 128: "beta", 192: "rc", 255: ""}
+
+
 def decoder_of(scan: Any) -> LibraryOutput:
     """The decoder output of a scan (a fresh, empty one for a scan without notes)."""
     out = getattr(scan, "decoder", None)
     return out if isinstance(out, LibraryOutput) else LibraryOutput()
 
 
-__all__ = ["ReplayConnection", "ULogScan", "active", "decoder_of", "lookup"]
+__all__ = ["MavlinkScan", "ReplayConnection", "ULogScan", "active", "decoder_of", "lookup", "parse_ulog"]

@@ -26,8 +26,6 @@ mission, or a mission of N items the log does not carry).
 from __future__ import annotations
 
 import math
-import os
-from pathlib import Path
 
 import numpy as np
 
@@ -83,24 +81,16 @@ def _altitude_frame(nav: dict[str, np.ndarray], r: int, seq: int, source: str) -
     return f
 
 
-def read_ulog_plan(path: str | os.PathLike[str]) -> MissionPlan:
-    """The mission of a PX4 ULog (see module).
+def ulog_plan(ulog: object, source: str) -> MissionPlan:
+    """The mission of a PX4 ULog parsed by pyulog (at least the :data:`TOPICS`; see module);
+    ``source`` names the file in errors.
 
     Raises
     ------
-    InputError
-        No such file.
     DataFormatError
-        Not a ULog, no mission items in the log (naming what the log says of its mission), an
-        item with an invalid command, position or altitude.
+        No mission items in the log (naming what the log says of its mission), an item with an
+        invalid command, position or altitude.
     """
-    from uasnav.io.px4 import _open
-
-    p = Path(path)
-    source = str(p)
-    if not p.is_file():
-        raise InputError(f"{p}: no such file")
-    ulog, _ = _open(p, list(TOPICS))  # pyulog's notices are kept off stdout (--json stays clean)
     nav = _topic(ulog, "navigator_mission_item")
     if nav is None or nav["timestamp"].size == 0:
         mission = _topic(ulog, "mission")
@@ -169,4 +159,4 @@ def read_ulog_plan(path: str | os.PathLike[str]) -> MissionPlan:
     return MissionPlan(items=tuple(items), home=home, source=source)
 
 
-__all__ = ["TOPICS", "read_ulog_plan"]
+__all__ = ["TOPICS", "ulog_plan"]
