@@ -31,7 +31,7 @@ def _row(c: Any, r: Any) -> dict[str, Any]:
 def main() -> None:
     from uasnav import ins, redundancy
     from uasnav.ins import evaluate as ev
-    from uasnav.io.navlog import read_nav
+    from uasnav.io import read_nav
 
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--declination", type=float, default=None, help="degrees, east positive")

@@ -240,7 +240,7 @@ def test_ulog_instances_and_start_against_pyulog(shared_data):
 def test_dataflash_identity_closed_form(shared_data):
     import datetime as dt
 
-    from uasnav.io.dataflash import read_dataflash_identity
+    from uasnav.io.formats.dataflash import read_dataflash_identity
 
     ident = read_dataflash_identity(shared_data / "logs" / "ardupilot_log171.bin")
     assert ident["vehicle"] == "PX4v2 004A002F 33345119 32383433"

@@ -109,12 +109,10 @@ def test_xio_errors_name_line_and_column(tmp_path: Path) -> None:
 
 
 def test_dataflash_flight_and_other_messages_in_seconds(shared_data: Path) -> None:
-    import uasnav.io.ardupilot as ap
     from uasnav.io import read_dataflash_messages, read_flight
     from uasnav.io.flight import Flight
 
     path = shared_data / "logs" / "ardupilot_log171.bin"
-    assert ap.read_dataflash is read_dataflash and ap.read_tlog is read_tlog  # documented names kept
     tables = read_dataflash_messages(path, ["BARO", "MAG", "ATT", "MSG"])
     assert sorted(tables) == ["ATT", "BARO", "MAG"]  # MSG: text only, no time in this (3.3) log
     baro = tables["BARO"]

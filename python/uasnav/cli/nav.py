@@ -163,7 +163,7 @@ def command(
     from uasnav.atomicfile import output_set
     from uasnav.errors import InputError
     from uasnav.ins import evaluate as ev
-    from uasnav.io.navlog import read_nav
+    from uasnav.io import read_nav
 
     outage_list = _outages(outages)
     durations = _durations(sweep)

@@ -17,20 +17,25 @@ extension  reader                           notes
 .tlog      :func:`read_tlog`                MAVLink; ``read_log`` returns the first stream
 ========== ================================ ===========================================
 
-Flight telemetry → :class:`~uasnav.io.flight.Flight`; :func:`read_flight` picks the reader
-from the extension (``.csv`` flight CSV, ``.tlog``, ``.bin``, ``.ulg``; see
-:mod:`uasnav.io.flight`).
+One flight → :class:`~uasnav.io.flight.Flight`: :func:`read_nav` (``open_log(path).nav``: the
+sensors and the autopilot's estimate, for :func:`uasnav.ins.run`) and :func:`read_flight`
+(``open_log(path).flight``: the telemetry track and the mission's events, ``.csv`` flight CSV,
+``.tlog``, ``.bin``, ``.ulg``).
 
 Writers are atomic: :func:`write_log` by extension (``.csv`` → CSV v1, ``.npz``) for IMU logs,
 :func:`write_csv_table` for any other numeric table (:mod:`uasnav.io.table`).
 
-One class per log format in :mod:`uasnav.io.formats` (which message types each view needs and
-the format's rules: GNSS delay, EKF origin, height datums, declination parameter, field layouts
-across firmware versions) over the record decoders of :mod:`~uasnav.io.csv_v1`,
-:mod:`~uasnav.io.npz`, :mod:`~uasnav.io.px4` (ULog), :mod:`~uasnav.io.dataflash`,
-:mod:`~uasnav.io.tlog`, :mod:`~uasnav.io.xio`, :mod:`~uasnav.io.alfa`, :mod:`~uasnav.io.flight`
-(flight CSV), :mod:`~uasnav.io.table`. Nothing here imports from the rest of uasnav except
-:mod:`uasnav.imu`, :mod:`uasnav.errors`, :mod:`uasnav.units`, :mod:`uasnav.limits`,
+One class per log format in :mod:`uasnav.io.formats` reads that format, and only there: which
+message types each view needs, the record decoders, and the format's rules (GNSS delay, EKF
+origin, height datums, declination parameter, field layouts across firmware versions):
+:mod:`~uasnav.io.formats.ulog` (PX4 ULog), :mod:`~uasnav.io.formats.dataflash`,
+:mod:`~uasnav.io.formats.tlog`, :mod:`~uasnav.io.formats.alfa`,
+:mod:`~uasnav.io.formats.csvlog` (CSV v1 over :mod:`~uasnav.io.csv_v1`, x-io over
+:mod:`~uasnav.io.xio`, flight CSV, ``.npz`` over :mod:`~uasnav.io.npz`). The functions
+``read_ulog``, ``read_dataflash``, ``read_tlog``, ``read_*_flight`` and
+``read_dataflash_messages`` exported here are those decoders (each reads its file in one pass,
+or replays the active pass of a :class:`LogFile`). Nothing here imports from the rest of uasnav
+except :mod:`uasnav.imu`, :mod:`uasnav.errors`, :mod:`uasnav.units`, :mod:`uasnav.limits`,
 :mod:`uasnav.geo`, :mod:`uasnav.httpfetch` and :mod:`uasnav.atomicfile`.
 
 Hostile files: every reader gives one :class:`~uasnav.errors.DataFormatError` naming the file
@@ -52,14 +57,14 @@ from pathlib import Path
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
 from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
-from uasnav.io.dataflash import read_dataflash, read_dataflash_flight, read_dataflash_messages
 from uasnav.io.flight import Flight
 from uasnav.io.formats.csvlog import read_flight_csv
+from uasnav.io.formats.dataflash import read_dataflash, read_dataflash_flight, read_dataflash_messages
+from uasnav.io.formats.tlog import read_tlog, read_tlog_flight
 from uasnav.io.formats.ulog import read_ulog, read_ulog_flight
 from uasnav.io.logfile import LogFile, open_log
 from uasnav.io.npz import read_npz, write_npz
 from uasnav.io.table import read_csv_table, write_csv_table
-from uasnav.io.tlog import read_tlog, read_tlog_flight
 from uasnav.io.xio import read_xio_csv
 
 READ_EXTENSIONS = (".csv", ".txt", ".npz", ".ulg", ".bin", ".tlog")
@@ -105,6 +110,21 @@ def read_flight(path: str | os.PathLike[str]) -> Flight:
     return open_log(p, need=("flight",)).flight  # type: ignore[no-any-return]
 
 
+def read_nav(path: str | os.PathLike[str], *, gnss_csv: str | os.PathLike[str] | None = None) -> Flight:
+    """The navigation data of a log (``open_log(path, gnss=gnss_csv).nav``): ``.bin``, ``.ulg``,
+    ``.tlog``, ``.csv`` (CSV v1, with ``gnss_csv`` required) or an ALFA ROS-topic CSV folder;
+    ``gnss_csv`` replaces the log's own GNSS when given.
+
+    Raises
+    ------
+    InputError
+        Unknown extension, or a CSV log without ``gnss_csv``.
+    DataFormatError
+        The format reader's errors.
+    """
+    return open_log(path, need=("nav",), gnss=gnss_csv).nav  # type: ignore[no-any-return]
+
+
 def write_log(log: ImuLog, path: str | os.PathLike[str]) -> None:
     """Write ``log`` atomically; ``.csv`` → CSV v1 (with truth columns), ``.npz``."""
     require_log(log)
@@ -133,6 +153,7 @@ __all__ = [
     "read_flight",
     "read_flight_csv",
     "read_log",
+    "read_nav",
     "read_npz",
     "read_tlog",
     "read_tlog_flight",

@@ -2,7 +2,7 @@
 
 A ``.tlog`` is a sequence of records, each an 8-byte big-endian UNIX time stamp in µs (the
 ground station's wall clock) followed by one MAVLink packet. :func:`write_tlog_flight` writes
-what :func:`uasnav.io.tlog.read_tlog_flight` reads back: ``GLOBAL_POSITION_INT`` fixes, the
+what :func:`uasnav.io.formats.tlog.read_tlog_flight` reads back: ``GLOBAL_POSITION_INT`` fixes, the
 mission (``MISSION_ITEM_INT``: home at seq 0, ``DO_CHANGE_SPEED`` with the cruise speed, then the
 navigation waypoints) and ``MISSION_ITEM_REACHED`` events. Packets are MAVLink 2, encoded by
 pymavlink (its ``ardupilotmega`` dialect, the one the readers use). Used by the synthetic fleet
