@@ -279,3 +279,51 @@ def test_a_gnss_csv_replaces_the_logs_fixes(shared_data: Path, tmp_path: Path) -
     assert nav.gnss.n == fixes.n and nav.imu.n > 1000
     with pytest.raises(DataFormatError, match="carries no plan"):
         open_log(shared_data / "imu" / "xio_fusion_sensor_data.csv").view("plan")
+
+
+def test_format_classes_state_their_interface() -> None:
+    from uasnav.io.formats.alfa import AlfaFormat
+    from uasnav.io.formats.base import LogFormat, WholeFileFormat
+    from uasnav.io.formats.csvlog import ImuFileFormat
+    from uasnav.io.logfile import _CSV, BY_EXTENSION
+
+    with pytest.raises(TypeError, match="abstract"):
+        LogFormat(Path("x"))  # type: ignore[abstract]
+
+    class NoReader(ImuFileFormat):
+        name = "no-reader"
+
+    with pytest.raises(TypeError, match="read_imu"):
+        NoReader(Path("x"))  # type: ignore[abstract]
+
+    class NoIdentity(WholeFileFormat):
+        name = "no-identity"
+
+    with pytest.raises(TypeError, match="build_identity"):
+        NoIdentity(Path("x"))  # type: ignore[abstract]
+    for cls in (*BY_EXTENSION.values(), *_CSV.values(), AlfaFormat):
+        fmt = cls(Path("x"))
+        assert fmt.name and cls.carries("identity"), cls
+
+
+def test_one_flight_model_for_the_filter_and_the_trajectory(shared_data: Path) -> None:
+    """``nav`` and ``flight`` are the same type: the sensors and estimate of one, the logged
+    track and mission events of the other; a flight without sensors is refused by the filter."""
+    from uasnav import ins
+    from uasnav.errors import InputError
+
+    log = open_log(shared_data / "flights" / "px4_s500_mission_land.ulg", need={"nav", "flight"})
+    nav, fl = log.nav, log.flight
+    assert type(nav) is type(fl) is Flight
+    assert nav.imu is not None and nav.gnss is not None and nav.track is None
+    assert fl.imu is None and fl.track is not None and fl.reached
+    assert fl.t is fl.track.t and fl.vel_ned.shape == (fl.t.size, 3)
+    assert fl.alt_datum is fl.track.alt_datum is HeightDatum.AMSL
+    assert nav.source == fl.source == str(log.path)
+    with pytest.raises(InputError, match="no position telemetry"):
+        _ = nav.t
+    with pytest.raises(InputError, match="no imu and gnss"):
+        ins.run(fl)
+    # unsorted telemetry with a repeated stamp: sorted, the first sample of a stamp kept
+    f = Flight.from_track([1.0, 0.0, 1.0], [45.0, 45.1, 45.2], [7.0] * 3, [1.0] * 3, np.zeros((3, 3)))
+    assert f.t.tolist() == [0.0, 1.0] and f.lat.tolist() == [45.1, 45.0]

@@ -117,20 +117,6 @@ class ULogScan:
         return set(types) <= self.types
 
 
-_GNSS = ("vehicle_gps_position", "sensor_gps")
-_IMU = ("sensor_combined", "vehicle_imu", "sensor_gyro", "sensor_accel", *_GNSS)
-#: PX4 ``vehicle_status.nav_state`` numbers → names (``vehicle_status.msg``).
-NAV_STATES = {
-    0: "MANUAL", 1: "ALTCTL", 2: "POSCTL", 3: "AUTO_MISSION", 4: "AUTO_LOITER", 5: "AUTO_RTL",
-    6: "AUTO_RCRECOVER", 7: "AUTO_RTGS", 8: "AUTO_LANDENGFAIL", 9: "AUTO_LANDGPSFAIL", 10: "ACRO",
-    12: "DESCEND", 13: "TERMINATION", 14: "OFFBOARD", 15: "STAB", 17: "AUTO_TAKEOFF",
-    18: "AUTO_LAND", 19: "AUTO_FOLLOW_TARGET", 20: "AUTO_PRECLAND", 21: "ORBIT", 22: "AUTO_VTOL_TAKEOFF",
-}  # fmt: skip
-#: PX4 ``vehicle_status.vehicle_type``.
-VEHICLE_TYPES = {0: "unknown", 1: "multirotor", 2: "fixed-wing", 3: "rover", 4: "airship"}
-_RELEASE_TYPES = {0: "dev", 64: "alpha", 128: "beta", 192: "rc", 255: ""}
-
-
 def decoder_of(scan: Any) -> LibraryOutput:
     """The decoder output of a scan (a fresh, empty one for a scan without notes)."""
     out = getattr(scan, "decoder", None)

@@ -47,7 +47,7 @@ from uasnav.errors import DataFormatError
 from uasnav.geo.datum import HeightDatum
 from uasnav.imu import ImuLog
 from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory
-from uasnav.io.formats.base import LogFormat
+from uasnav.io.formats.base import WholeFileFormat
 from uasnav.io.views import Identity
 
 FloatArray = NDArray[np.float64]
@@ -276,7 +276,7 @@ def _ned_euler_deg(att: dict[str, FloatArray], t: FloatArray) -> FloatArray:
     )
 
 
-class AlfaFormat(LogFormat):
+class AlfaFormat(WholeFileFormat):
     """A CMU ALFA ROS-topic CSV folder."""
 
     name = "alfa-ros-csv"

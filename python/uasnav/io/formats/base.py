@@ -4,6 +4,7 @@ EKF origin, height datums, field layouts across firmware versions) live in its o
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, ClassVar
@@ -30,9 +31,11 @@ VIEWS = (
 NAV_PARTS = {"gnss": "gnss", "baro": "baro", "mag": "mag", "autopilot_estimate": "reference"}
 
 
-class LogFormat:
-    """One log format. Subclasses set :attr:`name` and :attr:`SOURCES` (view → message types or
-    topics it decodes) and implement :meth:`scan` (binary formats) and ``build_<view>``."""
+class LogFormat(ABC):
+    """One log format. A subclass sets :attr:`name` and :attr:`SOURCES` (view → message types or
+    topics it decodes), implements :meth:`scan` (through :class:`ScannedFormat` for binary logs,
+    :class:`WholeFileFormat` for files read whole) and :meth:`build_identity`, and builds every
+    other view of :attr:`SOURCES` with a ``build_<view>`` method or a :attr:`READERS` entry."""
 
     name: ClassVar[str] = ""
     #: The message types / topics each view needs.
@@ -56,22 +59,17 @@ class LogFormat:
             out.update(self.SOURCES.get("nav" if v in NAV_PARTS else v, ()))
         return out
 
-    #: The decoding pass of a binary format (:mod:`uasnav.io.formats._scan`), and its options;
-    #: None for formats read whole.
-    SCANNER: ClassVar[Callable[..., Any] | None] = None
-    SCAN_OPTIONS: ClassVar[dict[str, Any]] = {}
     #: Views read by one reader function of the path (called with the scan active).
     READERS: ClassVar[dict[str, Callable[[Path], Any]]] = {}
 
+    @abstractmethod
     def scan(self, types: set[str], previous: Any | None) -> Any | None:
-        """The scan that covers ``types``: ``previous`` when it does, else one new decoding pass
-        for ``types`` and what ``previous`` held; None for formats read whole."""
-        if self.SCANNER is None:
-            return None
-        if previous is not None and previous.covers(types):
-            return previous
-        union = set(types) | (set(previous.types) if previous is not None else set())
-        return self.SCANNER(self.path, union, **self.SCAN_OPTIONS)
+        """The decoding pass that covers the message types ``types`` (``previous``, the pass
+        made so far, when it does), or None for a format read whole."""
+
+    @abstractmethod
+    def build_identity(self) -> Any:
+        """Who wrote the log (:class:`~uasnav.io.views.Identity`)."""
 
     def build(self, view: str, cache: dict[str, Any]) -> Any:
         """The view ``view`` (called with the scan active; ``cache`` holds views already built)."""
@@ -125,4 +123,28 @@ class LogFormat:
         return replace(nav, gnss=gnss)
 
 
-__all__ = ["NAV_PARTS", "VIEWS", "LogFormat"]
+class ScannedFormat(LogFormat):
+    """A binary log decoded in passes of :attr:`SCANNER` (:mod:`uasnav.io.formats._scan`) for
+    the union of the message types the views need."""
+
+    #: The decoding pass and its options.
+    SCANNER: ClassVar[Callable[..., Any]]
+    SCAN_OPTIONS: ClassVar[dict[str, Any]] = {}
+
+    def scan(self, types: set[str], previous: Any | None) -> Any:
+        """``previous`` when it covers ``types``, else one new pass for ``types`` and what
+        ``previous`` held."""
+        if previous is not None and previous.covers(types):
+            return previous
+        union = set(types) | (set(previous.types) if previous is not None else set())
+        return self.SCANNER(self.path, union, **self.SCAN_OPTIONS)
+
+
+class WholeFileFormat(LogFormat):
+    """A file (or folder) read whole by its views' builders: no decoding pass to share."""
+
+    def scan(self, types: set[str], previous: Any | None) -> None:
+        return None
+
+
+__all__ = ["NAV_PARTS", "VIEWS", "LogFormat", "ScannedFormat", "WholeFileFormat"]

@@ -8,15 +8,17 @@ Heights: the GNSS CSV's ``alt`` is ellipsoidal (:mod:`uasnav.io.gnss_csv`); the 
 from __future__ import annotations
 
 import os
+from abc import abstractmethod
 from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
 from uasnav.errors import DataFormatError, InputError
+from uasnav.imu import ImuLog
 from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
 from uasnav.io.flight import FIX_LIMITS, Flight, GnssData, MagData
-from uasnav.io.formats.base import LogFormat
+from uasnav.io.formats.base import WholeFileFormat
 from uasnav.io.views import Identity
 
 #: Columns of the flight CSV (s, deg, deg, m, then the NED ground velocity in m/s).
@@ -58,17 +60,18 @@ def csv_kind(path: str | Path) -> str:
     return "csv-v1"
 
 
-class _WholeFile(LogFormat):
-    """A format read whole by one reader: the IMU log is read once and cached."""
+class ImuFileFormat(WholeFileFormat):
+    """An IMU log read whole by one reader (:meth:`read_imu`), once, then cached."""
 
-    def _imu(self) -> Any:
-        raise NotImplementedError
+    @abstractmethod
+    def read_imu(self) -> ImuLog:
+        """The file's IMU log."""
 
-    def build_imu(self) -> Any:
+    def build_imu(self) -> ImuLog:
         cached = self.options.get("_imu")
         if cached is None:
-            cached = self.options["_imu"] = self._imu()
-        return cached
+            cached = self.options["_imu"] = self.read_imu()
+        return cached  # type: ignore[no-any-return]
 
     def build_imus(self) -> dict[str, Any]:
         return {"imu0": self.build_imu()}
@@ -78,14 +81,14 @@ class _WholeFile(LogFormat):
         return Identity(vehicle_id=meta.get("vehicle"), board=meta.get("hardware"), clock="file")
 
 
-class CsvV1Format(_WholeFile):
+class CsvV1Format(ImuFileFormat):
     """CSV v1 IMU log (:func:`uasnav.io.csv_v1.read_csv_v1`); ``nav`` with the GNSS CSV given
     as the option ``gnss`` (``mx my mz`` become the magnetometer when present)."""
 
     name = "csv-v1"
     SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "nav": (), "identity": ()}
 
-    def _imu(self) -> Any:
+    def read_imu(self) -> ImuLog:
         from uasnav.io.csv_v1 import read_csv_v1
 
         return read_csv_v1(self.path)
@@ -106,25 +109,25 @@ class CsvV1Format(_WholeFile):
         return Flight(imu, gnss, None, mag, imus={"IMU": imu}, meta=meta)
 
 
-class XioFormat(_WholeFile):
+class XioFormat(ImuFileFormat):
     """x-io Technologies CSV (:func:`uasnav.io.xio.read_xio_csv`)."""
 
     name = "xio-csv"
     SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "identity": ()}
 
-    def _imu(self) -> Any:
+    def read_imu(self) -> ImuLog:
         from uasnav.io.xio import read_xio_csv
 
         return read_xio_csv(self.path)
 
 
-class NpzFormat(_WholeFile):
+class NpzFormat(ImuFileFormat):
     """uasnav / ADIS ``.npz`` IMU arrays (:func:`uasnav.io.npz.read_npz`)."""
 
     name = "npz"
     SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "identity": ()}
 
-    def _imu(self) -> Any:
+    def read_imu(self) -> ImuLog:
         from uasnav.io.npz import read_npz
 
         return read_npz(self.path)
@@ -168,20 +171,24 @@ def read_flight_csv(path: str | os.PathLike[str]) -> Flight:
     return Flight.from_track(data[:, 0], data[:, 1], data[:, 2], data[:, 3], data[:, 4:7], source=source)
 
 
-class FlightCsvFormat(LogFormat):
+class FlightCsvFormat(WholeFileFormat):
     """Flight CSV ``t,lat,lon,alt,v_N,v_E,v_D`` (:func:`read_flight_csv`)."""
 
     name = "flight-csv"
-    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"flight": ()}
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"flight": (), "identity": ()}
 
     def build_flight(self) -> Flight:
         return read_flight_csv(self.path)
+
+    def build_identity(self) -> Identity:
+        return Identity(clock="file")
 
 
 __all__ = [
     "FLIGHT_CSV_COLUMNS",
     "CsvV1Format",
     "FlightCsvFormat",
+    "ImuFileFormat",
     "NpzFormat",
     "XioFormat",
     "csv_kind",

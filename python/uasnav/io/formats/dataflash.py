@@ -69,7 +69,7 @@ from uasnav.io.flight import (
     strictly_increasing,
 )
 from uasnav.io.formats._scan import MavlinkScan
-from uasnav.io.formats.base import LogFormat
+from uasnav.io.formats.base import ScannedFormat
 from uasnav.io.plan_formats.logs import read_dataflash_plan
 from uasnav.io.views import Identity, ModeTimeline, changes, gps_to_utc
 
@@ -506,7 +506,7 @@ def read_dataflash_nav(path: str | Any, imu: str | None = None) -> Flight:
     )
 
 
-class DataflashFormat(LogFormat):
+class DataflashFormat(ScannedFormat):
     """ArduPilot DataFlash (see the module docs)."""
 
     name = "ardupilot-dataflash"

@@ -43,7 +43,7 @@ from uasnav.io.autopilot_params import ARDUPILOT_PARAMS, PX4_PARAMS
 from uasnav.io.flight import BaroData, Flight, GnssData, MagData, Trajectory, flight_from_fixes, wind_from
 from uasnav.io.formats._scan import MavlinkScan
 from uasnav.io.formats.alfa import isa_pressure_altitude
-from uasnav.io.formats.base import LogFormat
+from uasnav.io.formats.base import ScannedFormat
 from uasnav.io.formats.dataflash import COPTER_MODES
 from uasnav.io.plan_formats.logs import read_tlog_plan
 from uasnav.io.views import Identity, ModeTimeline, changes
@@ -364,7 +364,7 @@ def read_tlog_nav(path: str | os.PathLike[str]) -> Flight:
     )
 
 
-class TlogFormat(LogFormat):
+class TlogFormat(ScannedFormat):
     """MAVLink telemetry log (see the module docs)."""
 
     name = "mavlink-tlog"

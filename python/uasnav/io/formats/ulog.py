@@ -66,7 +66,7 @@ from uasnav.io.flight import (
     strictly_increasing,
 )
 from uasnav.io.formats._scan import ULogScan, _open
-from uasnav.io.formats.base import LogFormat
+from uasnav.io.formats.base import ScannedFormat
 from uasnav.io.mission_plan import MissionPlan
 from uasnav.io.plan_formats.ulog import TOPICS as PLAN_TOPICS
 from uasnav.io.plan_formats.ulog import ulog_plan
@@ -461,7 +461,7 @@ def _declination_meta(ulog: Any, g: dict[str, FloatArray], sel: NDArray[np.intp]
     return meta
 
 
-class UlogFormat(LogFormat):
+class UlogFormat(ScannedFormat):
     """PX4 ULog (see the module docs)."""
 
     name = "px4-ulog"
