@@ -56,7 +56,7 @@ def test_covariance_matches_filterpy_with_the_same_dense_model():
     gyro = np.tile(W_IE, (n, 1))  # noiseless static unit, level, heading north
     accel = np.tile([0.0, 0.0, -G45], (n, 1))
     cfg = zupt.ZuptConfig()
-    core = cfg.core_dict("zupt")
+    core = cfg.filter_config("classic")
     out = _core.zupt_run(gyro, accel, dt, config=core, levelling_samples=100, heading_rad=0.0)
     # The same model in dense form (Groves ch. 14 as documented in nav_core::zupt).
     F = np.zeros((15, 15))
@@ -174,14 +174,16 @@ def test_errors_name_what_is_wrong(ramp):
     g[57, 1] = np.nan
     with pytest.raises(InputError, match=r"gyro_rad_s.*57"):
         _core.zupt_run(g, a, 0.01, levelling_samples=10)
-    with pytest.raises(InputError, match='unknown key "sigma_arw"'):
-        _core.zupt_run(np.zeros((100, 3)), a, 0.01, config={"sigma_arw": 1.0})
+    with pytest.raises(InputError, match=r"config: .*FilterConfig\.mode"):
+        _core.zupt_run(np.zeros((100, 3)), a, 0.01, config={"sigma_arw": 1.0})  # not a config object
+    with pytest.raises(InputError, match=r"config: .*sigma_arw_rad_sqrt_s"):
+        _core.zupt_run(np.zeros((100, 3)), a, 0.01, config=zupt.FilterConfig(sigma_arw_rad_sqrt_s="x"))
     with pytest.raises(InputError, match="meas_std_velocity_m_s"):
-        _core.zupt_run(np.zeros((100, 3)), a, 0.01, config={"meas_std_velocity_m_s": -1.0})
+        _core.zupt_run(np.zeros((100, 3)), a, 0.01, config=zupt.FilterConfig(meas_std_velocity_m_s=-1.0))
     with pytest.raises(InputError, match="accel"):
         _core.zupt_run(np.zeros((100, 3)), a[:50], 0.01)
     with pytest.raises(InputError, match="temp"):
-        _core.zupt_run(np.zeros((100, 3)), a, 0.01, mode="tczupt")
+        _core.zupt_run(np.zeros((100, 3)), a, 0.01, config=zupt.FilterConfig(mode="tczupt"))
 
 
 def test_cli_writes_the_est_csv_contract(tmp_path):

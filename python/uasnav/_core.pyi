@@ -124,9 +124,7 @@ def zupt_run(
     accel: NDArray[np.float64],
     dt_s: float,
     *,
-    mode: str = "zupt",
-    discretisation: str = "first_order",
-    config: dict[str, float] | None = None,
+    config: Any | None = None,
     temp: NDArray[np.float64] | None = None,
     dbias_dtemp: NDArray[np.float64] | None = None,
     mag: NDArray[np.float64] | None = None,
@@ -142,8 +140,10 @@ def zupt_run(
     """Run the ZUPT filter, classic ('classic', also spelled 'zupt') or thermally compensated
     ('tczupt'), over a whole log (GIL released).
 
-    gyro, accel (n, 3) rad/s and m/s² (body); dt_s sample period (s); config: SI floats named
-    as nav_core::zupt::ZuptConfig (unknown keys raise); temp (n,) °C; dbias_dtemp (n, 3)
+    gyro, accel (n, 3) rad/s and m/s² (body); dt_s sample period (s); config: one object with
+    the attributes of uasnav.zupt.FilterConfig (mode, discretisation and the SI floats of
+    nav_core::zupt::ZuptConfig by name, None keeps nav-core's default; None: the classic
+    filter with nav-core's defaults); temp (n,) °C; dbias_dtemp (n, 3)
     rad/s/°C (TCZUPT); mag (n, 3) for a magnetic heading with declination_rad; stationary
     (n,) bool (updates only where true); zero_gyro_bias starts the bias from the mean
     gyro over the levelling window minus the Earth rate (plus gyro_bias0). Returns a dict:

@@ -162,27 +162,77 @@ class ZuptConfig:
         """A copy with some fields changed."""
         return dataclasses.replace(self, **changes)
 
-    def core_dict(self, mode: Mode) -> dict[str, float]:
-        """The SI floats the Rust filter takes (names as in ``nav_core::zupt::ZuptConfig``)."""
+    def filter_config(self, mode: Mode) -> FilterConfig:
+        """The configuration of the Rust filter for ``mode`` (the thesis' noise of that mode
+        unless :attr:`noise` is set)."""
         noise = self.noise or (THESIS_TCZUPT_NOISE if mode == "tczupt" else THESIS_ZUPT_NOISE)
-        return {
-            "sigma_vrw_m_s_sqrt_s": noise.sigma_vrw_m_s_sqrt_s,
-            "sigma_arw_rad_sqrt_s": noise.sigma_arw_rad_sqrt_s,
-            "sigma_abi_m_s2": noise.sigma_abi_m_s2,
-            "sigma_gbi_rad_s": noise.sigma_gbi_rad_s,
-            "meas_std_position_m": self.meas_std_position_m,
-            "meas_std_velocity_m_s": self.meas_std_velocity_m_s,
-            "meas_std_attitude_rad": self.meas_std_attitude_rad,
-            "update_interval_s": self.update_interval_s,
-            "init_std_position_m": self.init_std_position_m,
-            "init_std_velocity_m_s": self.init_std_velocity_m_s,
-            "init_std_attitude_rad": self.init_std_attitude_rad,
-            "init_std_accel_bias_m_s2": self.init_std_accel_bias_m_s2,
-            "init_std_gyro_bias_rad_s": self.init_std_gyro_bias_rad_s,
-            "latitude_rad": float(np.deg2rad(self.latitude_deg)),
-            "height_m": self.height_m,
-            "temp_slope_window_s": self.temp_slope_window_s,
-        }
+        return FilterConfig(
+            mode=mode,
+            discretisation=self.discretisation,
+            sigma_vrw_m_s_sqrt_s=noise.sigma_vrw_m_s_sqrt_s,
+            sigma_arw_rad_sqrt_s=noise.sigma_arw_rad_sqrt_s,
+            sigma_abi_m_s2=noise.sigma_abi_m_s2,
+            sigma_gbi_rad_s=noise.sigma_gbi_rad_s,
+            meas_std_position_m=self.meas_std_position_m,
+            meas_std_velocity_m_s=self.meas_std_velocity_m_s,
+            meas_std_attitude_rad=self.meas_std_attitude_rad,
+            update_interval_s=self.update_interval_s,
+            init_std_position_m=self.init_std_position_m,
+            init_std_velocity_m_s=self.init_std_velocity_m_s,
+            init_std_attitude_rad=self.init_std_attitude_rad,
+            init_std_accel_bias_m_s2=self.init_std_accel_bias_m_s2,
+            init_std_gyro_bias_rad_s=self.init_std_gyro_bias_rad_s,
+            latitude_rad=float(np.deg2rad(self.latitude_deg)),
+            height_m=self.height_m,
+            temp_slope_window_s=self.temp_slope_window_s,
+        )
+
+
+@dataclass(frozen=True)
+class FilterConfig:
+    """The configuration of the Rust ZUPT filter (``nav_core::zupt::ZuptConfig``) as it crosses
+    into Rust: one typed object, each field named and in the units of its nav-core namesake (SI,
+    units in the names). ``None`` keeps nav-core's default. :meth:`ZuptConfig.filter_config`
+    builds it.
+
+    Attributes
+    ----------
+    mode : {"classic", "zupt", "tczupt"}
+        The filter (``"zupt"`` is another name of ``"classic"``).
+    discretisation : {"first_order", "second_order"}
+        Transition-matrix discretisation.
+    sigma_vrw_m_s_sqrt_s, sigma_arw_rad_sqrt_s, sigma_abi_m_s2, sigma_gbi_rad_s : float or None
+        Process noise: velocity and angle random walk, accelerometer and gyro bias instability.
+    meas_std_position_m, meas_std_velocity_m_s, meas_std_attitude_rad : float or None
+        R of the frozen-position, zero-velocity and frozen-attitude measurements.
+    update_interval_s : float or None
+        ZUPT cadence, s.
+    init_std_position_m, …, init_std_gyro_bias_rad_s : float or None
+        Initial σ of each state group (m, m/s, rad, m/s², rad/s).
+    latitude_rad, height_m : float or None
+        Frozen position: geodetic latitude (rad), ellipsoidal height (m).
+    temp_slope_window_s : float or None
+        Window of the least-squares dT/dt slope (TCZUPT), s.
+    """
+
+    mode: str = "classic"
+    discretisation: str = "first_order"
+    sigma_vrw_m_s_sqrt_s: float | None = None
+    sigma_arw_rad_sqrt_s: float | None = None
+    sigma_abi_m_s2: float | None = None
+    sigma_gbi_rad_s: float | None = None
+    meas_std_position_m: float | None = None
+    meas_std_velocity_m_s: float | None = None
+    meas_std_attitude_rad: float | None = None
+    update_interval_s: float | None = None
+    init_std_position_m: float | None = None
+    init_std_velocity_m_s: float | None = None
+    init_std_attitude_rad: float | None = None
+    init_std_accel_bias_m_s2: float | None = None
+    init_std_gyro_bias_rad_s: float | None = None
+    latitude_rad: float | None = None
+    height_m: float | None = None
+    temp_slope_window_s: float | None = None
 
 
 @dataclass(frozen=True)
@@ -394,9 +444,7 @@ def run(
         np.ascontiguousarray(gyro),
         np.ascontiguousarray(log.accel),
         dt,
-        mode=mode,
-        discretisation=cfg.discretisation,
-        config=cfg.core_dict(mode),
+        config=cfg.filter_config(mode),
         temp=None if log.temp is None else np.ascontiguousarray(log.temp),
         dbias_dtemp=dbdt,
         mag=mag,
@@ -602,6 +650,7 @@ __all__ = [
     "STATE_NAMES",
     "THESIS_TCZUPT_NOISE",
     "THESIS_ZUPT_NOISE",
+    "FilterConfig",
     "StationarityResult",
     "ZuptConfig",
     "ZuptResult",

@@ -4,7 +4,7 @@ use nav_core::zupt::{Discretisation, Mode};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyOverflowError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::PyString;
 
 use crate::errors::input_error;
 
@@ -120,24 +120,14 @@ pub fn floats<const N: usize>(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<[f
         .map_err(|_| input_error(py, format!("{name}: expected {N} values, got {}", v.len())))
 }
 
-/// The entries of a filter's config dict of floats (`{"sigma_gbi_rad_s": 1e-5, …}`) as
-/// `(key, value)`: a key that is not a str or a value that is not a float is an `InputError`
-/// naming it. The caller maps each key to its field (and refuses unknown keys).
-pub fn float_items(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<Vec<(String, f64)>> {
-    d.iter()
-        .map(|(k, v)| {
-            let key: String = k.extract().map_err(|_| {
-                input_error(py, format!("config: keys must be str, got {}", repr(&k)))
-            })?;
-            let x: f64 = v.extract().map_err(|_| {
-                input_error(
-                    py,
-                    format!("config[{key:?}]: expected a float, got {}", repr(&v)),
-                )
-            })?;
-            Ok((key, x))
-        })
-        .collect()
+/// The one mapping of a typed config object's extraction error (a missing attribute, a wrong
+/// type) to an `InputError` naming the field: `config: failed to extract field … : <cause>`.
+pub fn config_error(py: Python<'_>, e: PyErr) -> PyErr {
+    let why = match e.cause(py) {
+        Some(c) => format!(": {}", c.value(py)),
+        None => String::new(),
+    };
+    input_error(py, format!("config: {}{why}", e.value(py)))
 }
 
 /// A filter mode by its Python name: `"classic"` (also `"zupt"`, the thesis' name of the

@@ -8,7 +8,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{self, float_items, rows, slice1};
+use crate::convert::{self, rows, slice1};
 use crate::errors::{input_error, IntoPy};
 use crate::{floats_arg, uint_arg};
 
@@ -18,43 +18,68 @@ uint_arg!(window_arg, "window_samples", usize, usize_arg);
 floats_arg!(accel_bias0_arg, "accel_bias0", 3);
 floats_arg!(gyro_bias0_arg, "gyro_bias0", 3);
 
-/// Builds a `ZuptConfig` from `mode`, `discretisation` and a dict of SI floats named exactly
-/// as the nav-core fields; an unknown key is an error (a typo must not pass silently).
-fn config(
-    py: Python<'_>,
-    mode: &str,
-    discretisation: &str,
-    values: Option<&Bound<'_, PyDict>>,
-) -> PyResult<ZuptConfig<f64>> {
+/// `uasnav.zupt.FilterConfig` as it crosses: nav-core's `ZuptConfig` fields read as attributes
+/// of one object, by the same names and units (SI, units in the names), types checked by PyO3;
+/// `None` keeps nav-core's default.
+#[derive(FromPyObject)]
+struct FilterConfig {
+    mode: String,
+    discretisation: String,
+    sigma_vrw_m_s_sqrt_s: Option<f64>,
+    sigma_arw_rad_sqrt_s: Option<f64>,
+    sigma_abi_m_s2: Option<f64>,
+    sigma_gbi_rad_s: Option<f64>,
+    meas_std_position_m: Option<f64>,
+    meas_std_velocity_m_s: Option<f64>,
+    meas_std_attitude_rad: Option<f64>,
+    update_interval_s: Option<f64>,
+    init_std_position_m: Option<f64>,
+    init_std_velocity_m_s: Option<f64>,
+    init_std_attitude_rad: Option<f64>,
+    init_std_accel_bias_m_s2: Option<f64>,
+    init_std_gyro_bias_rad_s: Option<f64>,
+    latitude_rad: Option<f64>,
+    height_m: Option<f64>,
+    temp_slope_window_s: Option<f64>,
+}
+
+/// `slot ← value` unless the value is `None` (nav-core's default stays).
+fn set<T>(slot: &mut T, value: Option<T>) {
+    if let Some(v) = value {
+        *slot = v;
+    }
+}
+
+/// The `config` argument as nav-core's `ZuptConfig` (None: the classic filter with nav-core's
+/// defaults), validated.
+fn config_arg(py: Python<'_>, obj: Option<&Bound<'_, PyAny>>) -> PyResult<ZuptConfig<f64>> {
+    let Some(obj) = obj else {
+        let c = ZuptConfig::<f64>::default();
+        c.validate().py_err(py)?;
+        return Ok(c);
+    };
+    let a: FilterConfig = obj.extract().map_err(|e| convert::config_error(py, e))?;
     let mut c = ZuptConfig::<f64> {
-        mode: convert::mode(py, mode)?,
-        discretisation: convert::discretisation(py, discretisation)?,
+        mode: convert::mode(py, &a.mode)?,
+        discretisation: convert::discretisation(py, &a.discretisation)?,
         ..ZuptConfig::default()
     };
-    if let Some(d) = values {
-        for (key, x) in float_items(py, d)? {
-            let slot = match key.as_str() {
-                "sigma_vrw_m_s_sqrt_s" => &mut c.noise.sigma_vrw_m_s_sqrt_s,
-                "sigma_arw_rad_sqrt_s" => &mut c.noise.sigma_arw_rad_sqrt_s,
-                "sigma_abi_m_s2" => &mut c.noise.sigma_abi_m_s2,
-                "sigma_gbi_rad_s" => &mut c.noise.sigma_gbi_rad_s,
-                "meas_std_position_m" => &mut c.meas_std_position_m,
-                "meas_std_velocity_m_s" => &mut c.meas_std_velocity_m_s,
-                "meas_std_attitude_rad" => &mut c.meas_std_attitude_rad,
-                "update_interval_s" => &mut c.update_interval_s,
-                "init_std_position_m" => &mut c.init_std_position_m,
-                "init_std_velocity_m_s" => &mut c.init_std_velocity_m_s,
-                "init_std_attitude_rad" => &mut c.init_std_attitude_rad,
-                "init_std_accel_bias_m_s2" => &mut c.init_std_accel_bias_m_s2,
-                "init_std_gyro_bias_rad_s" => &mut c.init_std_gyro_bias_rad_s,
-                "latitude_rad" => &mut c.latitude_rad,
-                "height_m" => &mut c.height_m,
-                "temp_slope_window_s" => &mut c.temp_slope_window_s,
-                _ => return Err(input_error(py, format!("config: unknown key {key:?}"))),
-            };
-            *slot = x;
-        }
-    }
+    set(&mut c.noise.sigma_vrw_m_s_sqrt_s, a.sigma_vrw_m_s_sqrt_s);
+    set(&mut c.noise.sigma_arw_rad_sqrt_s, a.sigma_arw_rad_sqrt_s);
+    set(&mut c.noise.sigma_abi_m_s2, a.sigma_abi_m_s2);
+    set(&mut c.noise.sigma_gbi_rad_s, a.sigma_gbi_rad_s);
+    set(&mut c.meas_std_position_m, a.meas_std_position_m);
+    set(&mut c.meas_std_velocity_m_s, a.meas_std_velocity_m_s);
+    set(&mut c.meas_std_attitude_rad, a.meas_std_attitude_rad);
+    set(&mut c.update_interval_s, a.update_interval_s);
+    set(&mut c.init_std_position_m, a.init_std_position_m);
+    set(&mut c.init_std_velocity_m_s, a.init_std_velocity_m_s);
+    set(&mut c.init_std_attitude_rad, a.init_std_attitude_rad);
+    set(&mut c.init_std_accel_bias_m_s2, a.init_std_accel_bias_m_s2);
+    set(&mut c.init_std_gyro_bias_rad_s, a.init_std_gyro_bias_rad_s);
+    set(&mut c.latitude_rad, a.latitude_rad);
+    set(&mut c.height_m, a.height_m);
+    set(&mut c.temp_slope_window_s, a.temp_slope_window_s);
     c.validate().py_err(py)?;
     Ok(c)
 }
@@ -62,8 +87,7 @@ fn config(
 /// Runs the ZUPT/TCZUPT filter over a whole log; returns a dict of decimated histories and
 /// a summary (see `_core.pyi`).
 #[pyfunction]
-#[pyo3(signature = (gyro, accel, dt_s, *, mode="zupt", discretisation="first_order",
-    config=None, temp=None, dbias_dtemp=None, mag=None, stationary=None,
+#[pyo3(signature = (gyro, accel, dt_s, *, config=None, temp=None, dbias_dtemp=None, mag=None, stationary=None,
     levelling_samples=6000, heading_rad=None, declination_rad=None,
     accel_bias0=[0.0; 3], gyro_bias0=[0.0; 3], zero_gyro_bias=true, decimation=1))]
 #[allow(clippy::too_many_arguments)]
@@ -72,9 +96,7 @@ fn zupt_run<'py>(
     gyro: PyReadonlyArray2<'py, f64>,
     accel: PyReadonlyArray2<'py, f64>,
     dt_s: f64,
-    mode: &str,
-    discretisation: &str,
-    config: Option<Bound<'py, PyDict>>,
+    config: Option<Bound<'py, PyAny>>,
     temp: Option<PyReadonlyArray1<'py, f64>>,
     dbias_dtemp: Option<PyReadonlyArray2<'py, f64>>,
     mag: Option<PyReadonlyArray2<'py, f64>>,
@@ -87,7 +109,7 @@ fn zupt_run<'py>(
     zero_gyro_bias: bool,
     #[pyo3(from_py_with = decimation_arg)] decimation: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let cfg = config_or_default(py, mode, discretisation, config.as_ref())?;
+    let cfg = config_arg(py, config.as_ref())?;
     let g = rows::<3>(py, "gyro", &gyro)?;
     let a = rows::<3>(py, "accel", &accel)?;
     let t = temp.as_ref().map(|x| slice1(py, "temp", x)).transpose()?;
@@ -194,15 +216,6 @@ pub(crate) fn to2<const K: usize>(v: &[[f64; K]]) -> Array2<f64> {
         row.iter_mut().zip(r).for_each(|(s, x)| *s = *x);
     }
     out
-}
-
-fn config_or_default(
-    py: Python<'_>,
-    mode: &str,
-    discretisation: &str,
-    values: Option<&Bound<'_, PyDict>>,
-) -> PyResult<ZuptConfig<f64>> {
-    config(py, mode, discretisation, values)
 }
 
 type StaticArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<bool>>);

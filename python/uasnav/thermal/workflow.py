@@ -13,16 +13,14 @@ from __future__ import annotations
 import os
 import warnings
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from uasnav.errors import InputError
+from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
-from uasnav.io import read_log
-from uasnav.io.csv_v1 import open_csv_v1
-from uasnav.io.xio import is_xio_csv
+from uasnav.io import open_log, read_log
+from uasnav.io.formats.csvlog import CsvV1Format
 from uasnav.thermal._common import (
     TEMP_MAX_C,
     TEMP_MIN_C,
@@ -48,7 +46,7 @@ TRUTH_KEYS = ("gyro_bias_thermal", "gyro_bias")
 def load_training_data(path: str | os.PathLike[str], average_s: float = 1.0) -> tuple[FloatArray, FloatArray]:
     """Calibration data of a static log: block means of temperature and gyro output.
 
-    A CSV v1 log is averaged while it is read, chunk by chunk (:func:`uasnav.io.csv_v1.open_csv_v1`,
+    A CSV v1 log is averaged while it is read, chunk by chunk (:meth:`CsvV1Format.stream`,
     :class:`~uasnav.thermal.binning.TimeBlockMeans`): memory grows with the number of blocks,
     not with the log (a day-long 100 Hz soak log of 1 GB is averaged in about 100 MB). Other
     formats are read whole.
@@ -73,8 +71,9 @@ def load_training_data(path: str | os.PathLike[str], average_s: float = 1.0) -> 
     InputError
         The log has no temperature, or fewer than 20 blocks.
     """
-    if average_s > 0 and np.isfinite(average_s) and _is_csv_v1(path):
-        temp, bias = _csv_block_means(path, average_s)
+    fmt = _format(path) if average_s > 0 and np.isfinite(average_s) else None
+    if isinstance(fmt, CsvV1Format):
+        temp, bias = _csv_block_means(fmt, path, average_s)
     else:
         log = read_log(path)
         if log.temp is None:
@@ -90,23 +89,21 @@ def load_training_data(path: str | os.PathLike[str], average_s: float = 1.0) -> 
     return temp, bias
 
 
-def _is_csv_v1(path: str | os.PathLike[str]) -> bool:
-    """Whether :func:`uasnav.io.read_log` reads ``path`` as CSV v1 (and not as x-io CSV)."""
-    p = Path(path)
-    if p.suffix.lower() not in (".csv", ".txt"):
-        return False
+def _format(path: str | os.PathLike[str]) -> object | None:
+    """The format :func:`uasnav.io.open_log` recognises (extension, CSV header), or None when it
+    cannot tell: :func:`uasnav.io.read_log` then names the problem."""
     try:
-        with open(p, "rb") as fh:
-            first = fh.readline(4096).decode("utf-8", errors="replace")
-    except OSError:
-        return False  # read_log names the problem
-    return not is_xio_csv(first)
+        return open_log(path).format
+    except (InputError, DataFormatError):
+        return None
 
 
-def _csv_block_means(path: str | os.PathLike[str], average_s: float) -> tuple[FloatArray, FloatArray]:
+def _csv_block_means(
+    fmt: CsvV1Format, path: str | os.PathLike[str], average_s: float
+) -> tuple[FloatArray, FloatArray]:
     """:func:`load_training_data` of a CSV v1 log, averaged chunk by chunk while it is read,
     with the checks and errors of the whole-log path in the same order."""
-    with open_csv_v1(path) as stream:
+    with fmt.stream() as stream:
         if "temp" not in stream.columns:
             for _ in stream.blocks():  # an error in the data rows is reported first, as read_log does
                 pass

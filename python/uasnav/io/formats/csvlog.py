@@ -93,6 +93,13 @@ class CsvV1Format(ImuFileFormat):
 
         return read_csv_v1(self.path)
 
+    def stream(self) -> Any:
+        """The data rows in chunks, for consumers that stream
+        (:func:`uasnav.io.csv_v1.open_csv_v1`: block means while reading)."""
+        from uasnav.io.csv_v1 import open_csv_v1
+
+        return open_csv_v1(self.path)
+
     def build_nav(self) -> Flight:
         gnss = self.options.get("gnss")
         if gnss is None:
