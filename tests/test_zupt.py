@@ -68,10 +68,10 @@ def test_covariance_matches_filterpy_with_the_same_dense_model():
     F[6:9, 6:9] = -_skew(W_IE)
     F[6:9, 12:15] = -np.eye(3)
     sig = [
-        core["sigma_vrw_m_s_sqrt_s"],
-        core["sigma_arw_rad_sqrt_s"],
-        core["sigma_abi_m_s2"],
-        core["sigma_gbi_rad_s"],
+        core.sigma_vrw_m_s_sqrt_s,
+        core.sigma_arw_rad_sqrt_s,
+        core.sigma_abi_m_s2,
+        core.sigma_gbi_rad_s,
     ]
     kf = KalmanFilter(dim_x=15, dim_z=9)
     kf.F = np.eye(15) + F * dt
@@ -174,7 +174,7 @@ def test_errors_name_what_is_wrong(ramp):
     g[57, 1] = np.nan
     with pytest.raises(InputError, match=r"gyro_rad_s.*57"):
         _core.zupt_run(g, a, 0.01, levelling_samples=10)
-    with pytest.raises(InputError, match=r"config: .*FilterConfig\.mode"):
+    with pytest.raises(InputError, match=r"config: .*no attribute 'mode'"):
         _core.zupt_run(np.zeros((100, 3)), a, 0.01, config={"sigma_arw": 1.0})  # not a config object
     with pytest.raises(InputError, match=r"config: .*sigma_arw_rad_sqrt_s"):
         _core.zupt_run(np.zeros((100, 3)), a, 0.01, config=zupt.FilterConfig(sigma_arw_rad_sqrt_s="x"))
