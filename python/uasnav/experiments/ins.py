@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav import ins
+from uasnav.geo.frames import ned_to_geodetic
 from uasnav.ins import evaluate as ev
 from uasnav.sim.core import thermal_bias
 from uasnav.sim.flight import FlightErrors, matched_config_values, simulate_flight
@@ -101,9 +102,9 @@ def ramp_sweep(f: ins.Flight, start_s: float, rates: tuple[float, ...] = RAMP_RA
     for rate in rates:
         for name, u in RAMP_DIRECTIONS.items():
             a = np.clip(g.t - start_s, 0.0, None) * rate
-            lat = g.lat + np.degrees(a * u[0] / 6_367_000.0)
-            lon = g.lon + np.degrees(a * u[1] / (6_378_000.0 * np.cos(np.radians(g.lat))))
-            gg = dataclasses.replace(g, lat=lat, lon=lon, alt=g.alt - a * u[2])
+            # each fix moved by the ramp's NED vector on the WGS-84 ellipsoid
+            lat, lon, alt = ned_to_geodetic(a * u[0], a * u[1], a * u[2], g.lat, g.lon, g.alt)
+            gg = dataclasses.replace(g, lat=lat, lon=lon, alt=alt)
             r = ins.run(dataclasses.replace(f, gnss=gg), matched_config(hal_m=40.0, val_m=50.0, decimation=5))
             flagged = r.fix_t[np.isin(r.fix_status, (1, 2, 5, 6))]
             bad, worst = unannounced_rows(r, f.truth)  # type: ignore[arg-type]
@@ -175,7 +176,8 @@ def run(seed: int = 0, quick: bool = False, progress: Callable[[str], None] | No
     # innovation tests never flag: the solution separation does.
     f = simulate_flight(duration_s=400.0, seed=seed + 7, errors=NO_THERMAL)
     fault = np.clip(f.gnss.t - 100.0, 0.0, None) * 0.1
-    g = dataclasses.replace(f.gnss, lat=f.gnss.lat + np.degrees(fault / 6_367_000.0))
+    lat, lon, alt = ned_to_geodetic(fault, 0.0 * fault, 0.0 * fault, f.gnss.lat, f.gnss.lon, f.gnss.alt)
+    g = dataclasses.replace(f.gnss, lat=lat, lon=lon, alt=alt)
     r = ins.run(dataclasses.replace(f, gnss=g), matched_config(hal_m=40.0, val_m=50.0, decimation=5))
     d = ev.ned_difference(r.lat, r.lon, r.alt, f.truth, r.t)  # type: ignore[arg-type]
     err = np.hypot(d[:, 0], d[:, 1])
