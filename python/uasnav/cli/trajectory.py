@@ -336,8 +336,9 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
     autopilot's mission execution model with the log's own parameters (one flight is enough;
     no training), beside QGroundControl's mission-time estimate and plan length ÷ speed; the
     element methods (LVQ, kinematic point mass …, e% of eq. 59) by leave-one-run-out where the
-    logs hold two runs or more. --simulated: the thesis' experiment, 7 flights per trajectory
-    train, 3 test.
+    logs hold two runs or more; the model's own choices (its options, a learned scale, or a
+    baseline) re-made on the other runs and scored on each held-out run and each held-out log.
+    --simulated: the thesis' experiment, 7 flights per trajectory train, 3 test.
     """
     if simulated:
         from uasnav.experiments.trajectory import run_phantom4
@@ -390,6 +391,18 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             f"{tb['coverage']:.0%} time bounds ({tb['source']}): {tb['covered']}/{tb['n_runs']} real runs "
             f"within (Clopper–Pearson 95 %: {lo:.3f}–{hi:.3f})"
         )
+    ho = out.get("held_out")
+    if ho:
+        for key, label in (
+            ("leave_one_run_out", "leave-one-run-out"),
+            ("leave_one_log_out", "leave-one-log-out"),
+        ):
+            h = ho[key]
+            click.echo(
+                f"held out ({label}, chosen among {len(ho['candidates'])} candidates on the other runs): "
+                f"run |e%| median {h['run_abs_e_pct_median']:.2f}, worst {h['run_abs_e_pct_worst']:.2f}; "
+                f"the prior kept for {h['prior_chosen']}/{len(h['runs'])} runs"
+            )
     for row in out.get("table17", []):
         click.echo(
             f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
@@ -430,6 +443,10 @@ def _evaluate_flights(
         try:
             mission = evaluate_logs(logs_with_plan)
             table.update(mission["methods"])
+            from uasnav.trajectory.holdout import held_out_report, run_table
+
+            # the model's choices re-made on some runs and scored on the held-out rest
+            mission["held_out"] = held_out_report(run_table(logs_with_plan))
         except (InputError, DataFormatError) as e:
             mission_error = str(e)
     element_error: str | None = None
@@ -496,6 +513,7 @@ def _evaluate_flights(
         out["per_stack"] = mission["per_stack"]
         out["parameters"] = mission["parameters"]
         out["time_bounds"] = mission["time_bounds"]
+        out["held_out"] = mission["held_out"]
     if element_error is not None:
         out["element_methods"] = f"not evaluated: {element_error}"
     if mission_error is not None:

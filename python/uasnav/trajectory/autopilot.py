@@ -387,6 +387,40 @@ _PLANE_ALIASES = {"TRIM_ARSPD_CM": ("AIRSPEED_CRUISE", 0.01), "LIM_ROLL_CD": ("R
 
 
 @dataclass(frozen=True)
+class ModelOptions:
+    """The modelling choices of the mission execution models that are not a firmware
+    parameter: how the vehicle follows what the firmware commands. The defaults are what the
+    firmware source implies; :mod:`uasnav.trajectory.holdout` re-chooses them on held-out
+    flights.
+
+    Attributes
+    ----------
+    ac3_slowdown_factor : float
+        ArduCopter 3.x: the waypoint target slows down at this multiple of ``WPNAV_ACCEL``
+        (``AC_WPNav::get_slow_down_speed`` v = √(4·a·d) is a deceleration of 2·a).
+    px4_tracking_lag : bool
+        PX4: the vehicle trails its smoothed trajectory by 1/``MPC_XY_P`` seconds of speed when
+        the navigator checks the acceptance radius.
+    px4_takeoff_lead : bool
+        PX4: a take-off from the ground first spools the motors up
+        (``MPC_SPOOLUP_TIME``/``COM_SPOOLUP_TIME``) and ramps the climb setpoint
+        (``MPC_TKO_RAMP_T``).
+    px4_yaw_acceptance : bool
+        PX4: a waypoint with a heading is accepted only once the heading is within
+        ``MIS_YAW_ERR`` (``Mission::is_mission_item_reached``).
+    yaw_before_move : bool
+        Turn to face the next leg before flying it where the firmware waits for the heading:
+        PX4 with ``MPC_YAW_MODE`` 4 ("towards waypoint, yaw first"); ArduCopter never waits.
+    """
+
+    ac3_slowdown_factor: float = 2.0
+    px4_tracking_lag: bool = True
+    px4_takeoff_lead: bool = True
+    px4_yaw_acceptance: bool = True
+    yaw_before_move: bool = True
+
+
+@dataclass(frozen=True)
 class MissionParams:
     """The parameters a mission execution model flies with (SI units).
 
@@ -400,12 +434,15 @@ class MissionParams:
         Parameter name → value in SI units (m, m/s, m/s², m/s³, s, deg).
     sources : dict of str → str
         Parameter name → ``"log"`` or the firmware default's citation.
+    options : ModelOptions
+        The modelling choices that are not firmware parameters.
     """
 
     family: str
     version: str | None
     values: dict[str, float]
     sources: dict[str, str] = field(default_factory=dict)
+    options: ModelOptions = field(default_factory=ModelOptions)
 
     def __getitem__(self, name: str) -> float:
         return self.values[name]
@@ -716,7 +753,7 @@ def predict_mission(
                     theta = _turn_angle(s.ne, target, pos[nxt])
                     v_out = corner_speed(p, theta, cruise)
             _leg(p, s, target, h1, cruise, v_out)
-            if p.family == "px4-mc":
+            if p.family == "px4-mc" and p.options.px4_yaw_acceptance:
                 _px4_yaw(p, s, it.params[3])
             if cmd == MAV_CMD_NAV_LOITER_TURNS:
                 turns = it.params[0] if math.isfinite(it.params[0]) else 1.0
@@ -829,7 +866,8 @@ def _leg(
     elif p.family == "arducopter":
         a = p["WPNAV_ACCEL"]
         if (p.major or 4) <= 3:
-            a = 2.0 * a  # the 3.x target slows down at twice WPNAV_ACCEL (get_slow_down_speed)
+            # the 3.x target slows down at twice WPNAV_ACCEL (get_slow_down_speed)
+            a = p.options.ac3_slowdown_factor * a
             t_h, v_end = leg_time(d, cruise, p["WPNAV_ACCEL"], None, v0, v_out, decel=a)
         else:
             t_h, v_end = leg_time(d, cruise, a, p["WPNAV_JERK"], v0, v_out)
@@ -838,7 +876,8 @@ def _leg(
         if accept:
             r_h = min(p["NAV_ACC_RAD"], d)
             r_v = min(p["NAV_MC_ALT_RAD"], abs(dz))
-            t_h, v_end = px4_leg_time(d, cruise, a, j, v0, v_out, p["NAV_ACC_RAD"], 1.0 / p["MPC_XY_P"])
+            lag = 1.0 / p["MPC_XY_P"] if p.options.px4_tracking_lag else 0.0
+            t_h, v_end = px4_leg_time(d, cruise, a, j, v0, v_out, p["NAV_ACC_RAD"], lag)
             t_v -= _tail_time(r_v, 0.0, vz, az)
         else:
             # to the point itself: the braking limit approaches it exponentially, so the leg
@@ -876,7 +915,7 @@ def _climb_time(p: MissionParams, dz: float, *, vtol: bool, ground: bool) -> flo
         # on the ground: the motors spool up, then the take-off ramp raises the climb-speed
         # setpoint over MPC_TKO_RAMP_T from the one that holds the vehicle down; the
         # take-off is accepted within NAV_MC_ALT_RAD
-        lead = p["MPC_SPOOLUP_TIME"] + p["MPC_TKO_RAMP_T"] if ground else 0.0
+        lead = p["MPC_SPOOLUP_TIME"] + p["MPC_TKO_RAMP_T"] if ground and p.options.px4_takeoff_lead else 0.0
         return lead + max(dz - p["NAV_MC_ALT_RAD"], 0.0) / p["MPC_TKO_SPEED"]
     if p.family == "plane":
         if vtol:
@@ -1016,6 +1055,7 @@ __all__ = [
     "Default",
     "MissionParams",
     "MissionPrediction",
+    "ModelOptions",
     "banded_descent_time",
     "corner_speed",
     "distance_over_speed_time",
