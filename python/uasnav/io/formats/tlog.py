@@ -28,7 +28,7 @@ from uasnav.io.formats.base import LogFormat
 from uasnav.io.formats.dataflash import COPTER_MODES
 from uasnav.io.navdata import BaroData, Flight, GnssData, MagData, Trajectory
 from uasnav.io.plan_formats.logs import read_tlog_plan
-from uasnav.io.tlog import IMU_TYPES, read_tlog, read_tlog_flight
+from uasnav.io.tlog import IMU_TYPES, read_tlog, read_tlog_flight, vz_down_sign
 from uasnav.io.views import Identity, ModeTimeline, changes
 from uasnav.units import STANDARD_GRAVITY
 
@@ -162,6 +162,7 @@ def read_tlog_nav(path: str | os.PathLike[str]) -> Flight:
     reference = None
     if len(ref) >= 2:
         r = increasing(np.asarray(ref, dtype=np.float64))
+        r[:, 6] *= vz_down_sign(r[:, 0], r[:, 3], r[:, 6])
         eul = None
         if len(att) >= 2:
             at = increasing(np.asarray(att, dtype=np.float64))
