@@ -714,6 +714,43 @@ def _calibrate_from_flights(
     )
 
 
+def _own_run_bounds(
+    model: Any,
+    flight_logs: Sequence[str],
+    limits_log: str | None,
+    coverage: float,
+    wind: np.ndarray,
+    climb: float | None,
+    descent: float | None,
+    accel_z: float | None,
+    speed: float | None,
+) -> str:
+    """``intent``: the time bounds from the vehicle's own AUTO runs (``--flights``, else the
+    ``--limits-from`` log's when it has enough runs for the coverage) set on ``model``; returns
+    why they were not used (to append to the simulated bounds' source), or "". Explicit
+    ``--flights`` that cannot give the coverage are an error."""
+    from uasnav.trajectory.timebounds import DEFAULT_TAU_S
+    from uasnav.utm.intent import vehicle_run_bounds
+
+    logs = list(flight_logs) or ([limits_log] if limits_log else [])
+    if not logs:
+        return ""
+    prior = model.time_bounds_
+    tau = prior.tau_s if prior is not None else DEFAULT_TAU_S
+    try:
+        bounds = vehicle_run_bounds(
+            logs, model, wind, climb_ms=climb, descent_ms=descent, accel_z_ms2=accel_z, cruise_ms=speed,
+            tau_s=tau,
+        )  # fmt: skip
+        bounds.quantile(coverage)
+    except (InputError, DataFormatError) as why:
+        if flight_logs:
+            raise InputError(f"--flights: {why}") from why
+        return f" (the vehicle's own runs in {Path(logs[0]).name} not used: {why})"
+    model.time_bounds_ = bounds
+    return ""
+
+
 @command.command("intent")
 @click.option(
     "--model",
@@ -787,13 +824,23 @@ def _calibrate_from_flights(
     help="Runs to calibrate a model without time bounds.",
 )
 @click.option(
+    "--flights",
+    "flight_logs",
+    multiple=True,
+    type=click.Path(dir_okay=False),
+    help="The vehicle's own earlier flights (.tlog .bin .ulg with their mission; repeat the option): "
+    "the time bounds come from how this prediction missed their AUTO runs. Default: the "
+    "--limits-from log's runs when there are enough for --coverage, else the model's bounds.",
+)
+@click.option(
     "--out", "out", required=True, type=OutputPath(), help="F3548 OperationalIntentDetails JSON to write."
 )
 @click.option("--geojson", "geojson", type=OutputPath(), help="Also write the volumes and route as GeoJSON.")
 @click.option("--json", "as_json", is_flag=True, help="Print a machine-readable summary.")
 def intent(  # type: ignore[no-untyped-def]
     model_path, plan_path, wind_text, start_text, coverage, lateral_buffer, vertical_buffer, geoid_height,
-    home_alt, speed, climb_rate, descent_rate, limits_log, priority, calibration_runs, out, geojson, as_json,
+    home_alt, speed, climb_rate, descent_rate, limits_log, priority, calibration_runs, flight_logs, out,
+    geojson, as_json,
 ):  # fmt: skip
     """An ASTM F3548 operational intent (W84 volumes) whose volumes contain the predicted 4D
     trajectory with its calibrated time bounds and the buffers."""
@@ -810,7 +857,7 @@ def intent(  # type: ignore[no-untyped-def]
 
     wind = parse_wind(wind_text)
     start = parse_time(start_text, "--start")
-    check_outputs([model_path, plan_path], {"--out": out, "--geojson": geojson})
+    check_outputs([model_path, plan_path, *flight_logs], {"--out": out, "--geojson": geojson})
     model = load_model(model_path)
     plan = read_plan(plan_path)
     # vertical limits: the explicit options, else the log's (--limits-from), else the model's
@@ -829,6 +876,9 @@ def intent(  # type: ignore[no-untyped-def]
             accel_z, from_log = lim.accel_z_ms2, [*from_log, "accel_z_ms2"]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
+    own_note = _own_run_bounds(
+        model, flight_logs, limits_log, coverage, wind, climb_rate, descent_rate, accel_z, speed
+    )
     if model.time_bounds_ is None:
         from uasnav.trajectory.calibration import check_runs
 
@@ -840,7 +890,7 @@ def intent(  # type: ignore[no-untyped-def]
             v = speed or plan_cruise_speed(plan) or model.cruise_ms_
             runs = simulated_runs(model, calibration_runs, progress=lambda i, n: bar.update(1), cruise_ms=v)
         model.time_bounds_ = fit_bounds(
-            runs, source=f"{calibration_runs} simulated runs at {v:g} m/s, seed 0"
+            runs, source=f"{calibration_runs} simulated runs at {v:g} m/s, seed 0{own_note}"
         )
     b = build_intent(
         plan, model, wind, start, coverage=coverage, lateral_buffer_m=lateral_buffer,
