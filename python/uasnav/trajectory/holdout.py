@@ -189,8 +189,8 @@ def held_out(
         test = g == label
         c, k = choose(table, ~test, candidates)
         e[test] = _e_pct(table.pred_s[c.name][test] * k, table.real_s[test])
-        for i in np.flatnonzero(test):
-            chosen_by_run[i] = (c.name, k, int((~test).sum()))
+        for j in np.flatnonzero(test).tolist():
+            chosen_by_run[j] = (c.name, k, int((~test).sum()))
     for i in range(n):
         name, k, n_train = chosen_by_run[i]
         rows.append(
