@@ -35,8 +35,8 @@ PX4 multicopter (``FlightTaskAuto`` + ``PositionSmoothing``): ``MPC_XY_CRUISE``,
 corner speed √(a·R·tan(α/2)) with R = ``NAV_ACC_RAD`` and α the angle between the legs
 (``computeMaxSpeedInWaypoint``); with ``MPC_YAW_MODE`` 4 ("yaw first") the vehicle stops at
 each corner and turns at ``MPC_YAWRAUTO_MAX`` before the next leg; take-off at
-``MPC_TKO_SPEED`` after a ``MPC_TKO_RAMP_T`` ramp; landing at ``MPC_Z_V_AUTO_DN`` above ``MPC_LAND_ALT1``, blending linearly to ``MPC_LAND_SPEED``
-at ``MPC_LAND_ALT2`` and below.
+``MPC_TKO_SPEED`` after a ``MPC_TKO_RAMP_T`` ramp; landing at ``MPC_Z_V_AUTO_DN`` above
+``MPC_LAND_ALT1``, blending linearly to ``MPC_LAND_SPEED`` at ``MPC_LAND_ALT2`` and below.
 
 Fixed wing and QuadPlane (ArduPlane): legs at the cruise airspeed (``AIRSPEED_CRUISE``, before
 4.5 ``TRIM_ARSPD_CM``), corners as circular arcs of radius v²/(g·tan φ) with φ = ``ROLL_LIMIT_DEG``
