@@ -596,6 +596,18 @@ def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # t
     click.echo(f"parameters from the log: {', '.join(from_log) or 'none'}; others the firmware defaults")
 
 
+def _flights_option(what: str):  # type: ignore[no-untyped-def]
+    """``--flights LOG`` (repeatable): the vehicle's own earlier flights, for ``what``."""
+    return click.option(
+        "--flights",
+        "flight_logs",
+        multiple=True,
+        type=click.Path(dir_okay=False),
+        help="The vehicle's own earlier flights (.tlog .bin .ulg with their mission; repeat the option): "
+        + what,
+    )
+
+
 @command.command("calibrate")
 @click.option(
     "--model", "model_path", required=True, type=click.Path(dir_okay=False), help="Model JSON (from train)."
@@ -624,14 +636,7 @@ def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # t
     show_default=True,
     help="Coverage reported for the held-out runs.",
 )
-@click.option(
-    "--flights",
-    "flight_logs",
-    multiple=True,
-    type=click.Path(dir_okay=False),
-    help="The vehicle's own earlier flights (.tlog .bin .ulg with their mission; repeat the option): "
-    "the bounds come from their AUTO runs instead of simulation.",
-)
+@_flights_option("the bounds come from their AUTO runs instead of simulation.")
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def calibrate(model_path, out, runs, test_runs, coverage, flight_logs, seed, as_json):  # type: ignore[no-untyped-def]
@@ -823,14 +828,9 @@ def _own_run_bounds(
     show_default=True,
     help="Runs to calibrate a model without time bounds.",
 )
-@click.option(
-    "--flights",
-    "flight_logs",
-    multiple=True,
-    type=click.Path(dir_okay=False),
-    help="The vehicle's own earlier flights (.tlog .bin .ulg with their mission; repeat the option): "
+@_flights_option(
     "the time bounds come from how this prediction missed their AUTO runs. Default: the "
-    "--limits-from log's runs when there are enough for --coverage, else the model's bounds.",
+    "--limits-from log's runs when there are enough for --coverage, else the model's bounds."
 )
 @click.option(
     "--out", "out", required=True, type=OutputPath(), help="F3548 OperationalIntentDetails JSON to write."
