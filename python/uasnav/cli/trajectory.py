@@ -722,7 +722,7 @@ def _calibrate_from_flights(
 def _own_run_bounds(
     model: Any,
     flight_logs: Sequence[str],
-    limits_log: str | None,
+    limits_log: Any,
     coverage: float,
     wind: np.ndarray,
     climb: float | None,
@@ -751,7 +751,8 @@ def _own_run_bounds(
     except (InputError, DataFormatError) as why:
         if flight_logs:
             raise InputError(f"--flights: {why}") from why
-        return f" (the vehicle's own runs in {Path(logs[0]).name} not used: {why})"
+        name = Path(str(getattr(logs[0], "path", logs[0]))).name
+        return f" (the vehicle's own runs in {name} not used: {why})"
     model.time_bounds_ = bounds
     return ""
 
@@ -864,10 +865,19 @@ def intent(  # type: ignore[no-untyped-def]
     # own (build_intent → route3d.vertical_limits)
     accel_z: float | None = None
     from_log: list[str] = []
+    limits_source: Any = limits_log
     if limits_log:
         from uasnav.io.autopilot_limits import read_autopilot_limits
 
-        lim = read_autopilot_limits(limits_log)
+        if Path(limits_log).suffix.lower() in (".tlog", ".bin", ".ulg"):
+            from uasnav.io.logfile import open_log
+            from uasnav.trajectory.mission_runs import MISSION_VIEWS
+
+            # one decoding pass serves the limits and the vehicle's own runs
+            limits_source = open_log(limits_log, need=("limits", *MISSION_VIEWS))
+            lim = limits_source.limits
+        else:
+            lim = read_autopilot_limits(limits_log)
         if lim.climb_ms is not None and climb_rate is None:
             climb_rate, from_log = lim.climb_ms, [*from_log, "climb_ms"]
         if lim.descent_ms is not None and descent_rate is None:
@@ -877,7 +887,7 @@ def intent(  # type: ignore[no-untyped-def]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
     own_note = _own_run_bounds(
-        model, flight_logs, limits_log, coverage, wind, climb_rate, descent_rate, accel_z, speed
+        model, flight_logs, limits_source, coverage, wind, climb_rate, descent_rate, accel_z, speed
     )
     if model.time_bounds_ is None:
         from uasnav.trajectory.calibration import check_runs
