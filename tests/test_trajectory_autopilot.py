@@ -3,6 +3,7 @@ the parameter defaults against their cited firmware sources, and the real flight
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -116,12 +117,54 @@ def test_defaults_match_their_cited_source(table: dict[str, ap.Default]) -> None
         number = float(m.group(1).replace("−", "-"))
         assert d.value == pytest.approx(number * _UNIT_SCALE.get(m.group(2) or "", 1.0)), (name, d.source)
         assert re.search(r"\.(cpp|c|h)\b", d.source) and re.search(r"\d\.\d", d.source), d.source
+        # read in the public source: the stored file and the layout or commit that dates it
+        assert re.search(r"\.(cpp|c|h|yaml)\b", d.verified), (name, d.verified)
+
+
+def test_corrected_citations() -> None:
+    # 3.x keeps the WPNAV defaults in the header; LAND_ALT_LOW is a parameter from 3.6 on
+    assert ap.ARDUCOPTER_DEFAULTS["3"]["WPNAV_ACCEL"].source.startswith("AC_WPNav.h Copter-3.6")
+    assert "LAND_ALT_LOW 1000 cm" in ap.ARDUCOPTER_DEFAULTS["3"]["LAND_ALT_LOW"].source
+    assert ap.ARDUCOPTER_DEFAULTS["4"]["LAND_ALT_LOW"].source.startswith("ArduCopter/Parameters.cpp")
+    # PX4 1.11 descends at MPC_Z_VEL_MAX_DN 1 m/s; 1.12+ in AUTO at MPC_Z_V_AUTO_DN 1.5 m/s
+    assert ap.PX4_MC_DEFAULTS["MPC_Z_VEL_MAX_DN"].value == 1.0
+    assert ap.PX4_MC_DEFAULTS["MPC_Z_V_AUTO_DN"].value == 1.5
+
+
+_NO_YAW = (0.0, 0.0, 0.0, math.nan)
+
+
+def test_px4_yaw_first_waits_for_the_heading() -> None:
+    # MPC_YAW_MODE 4: stop at the corner, turn at MPC_YAWRAUTO_MAX, then fly the next leg (the
+    # items leave the heading to the yaw mode: param 4 NaN)
+    items = [
+        MissionItem(22, 3, alt_m=10.0),
+        MissionItem(16, 3, _NO_YAW, lat_deg=_north(50.0), lon_deg=8.0, alt_m=10.0),
+        MissionItem(16, 3, _NO_YAW, lat_deg=_north(50.0), lon_deg=8.0 + 50.0 / 75_800.0, alt_m=10.0),
+        MissionItem(16, 3, _NO_YAW, lat_deg=_north(100.0), lon_deg=8.0 + 50.0 / 75_800.0, alt_m=10.0),
+    ]
+    base = ap.mission_params("px4-mc", "1.14.0", {"MPC_YAW_MODE": 4.0, "NAV_ACC_RAD": 1.0})
+    no_wait = ap.mission_params("px4-mc", "1.14.0", {"MPC_YAW_MODE": 0.0, "NAV_ACC_RAD": 1.0})
+    r4, r0 = ap.predict_mission(_plan(items), base), ap.predict_mission(_plan(items), no_wait)
+    # two turns of atan(50/1) ≈ 88.9° at 45°/s on top of the legs (and the stops at the corners)
+    turn_s = math.degrees(math.atan2(50.0, 1.0)) / 45.0
+    assert r4.eta_s - r0.eta_s >= 2 * turn_s
+    no_option = dataclasses.replace(base, options=ap.ModelOptions(yaw_before_move=False))
+    assert ap.predict_mission(_plan(items), no_option).eta_s == pytest.approx(r0.eta_s)
+    # ArduCopter turns while it flies: WP_YAW_BEHAVIOR changes nothing in the time
+    ac = ap.mission_params("arducopter", "4.5.7")
+    assert ap.predict_mission(_plan(items), ac).eta_s == pytest.approx(
+        ap.predict_mission(
+            _plan(items), dataclasses.replace(ac, options=ap.ModelOptions(yaw_before_move=False))
+        ).eta_s
+    )
 
 
 def test_log_parameters_win_and_are_converted() -> None:
     p = ap.mission_params("arducopter", "3.5.7", {"WPNAV_SPEED": 500.0, "WPNAV_ACCEL": 100.0})
     assert p["WPNAV_SPEED"] == 5.0 and p.sources["WPNAV_SPEED"] == "log"
-    assert p.sources["LAND_SPEED"].startswith("ArduCopter/Parameters.cpp Copter-3.6")
+    # LAND_SPEED's default is the config.h macro Parameters.cpp refers to
+    assert p.sources["LAND_SPEED"].startswith("ArduCopter/config.h Copter-3.6")
     # PX4 before 1.12 climbs at MPC_Z_VEL_MAX_UP in AUTO, from 1.12 at MPC_Z_V_AUTO_UP
     old = ap.mission_params("px4-mc", "1.11.0", {"MPC_Z_VEL_MAX_DN": 1.0})
     new = ap.mission_params("px4-mc", "1.14.0", {"MPC_Z_V_AUTO_DN": 2.0})
@@ -185,7 +228,8 @@ def test_quadplane_dalby_plan_predicts(shared_data: Path) -> None:
     assert out["autopilot"] == "plane" and out["landed"]
     # km-long legs at 12–24 m/s with a DO_JUMP loop repeated four times: most of an hour
     assert 1800 < out["eta_s"] < 7200
-    assert out["parameters"]["AIRSPEED_CRUISE"]["source"].startswith("ArduPlane/Parameters.cpp")
+    # the default is the config.h macro ArduPlane/Parameters.cpp refers to
+    assert out["parameters"]["AIRSPEED_CRUISE"]["source"].startswith("ArduPlane/config.h")
     # VTOL take-off (84) and landing (85) are items with times
     assert {84, 85} <= {i["command"] for i in out["items"]}
 

@@ -336,8 +336,9 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
     autopilot's mission execution model with the log's own parameters (one flight is enough;
     no training), beside QGroundControl's mission-time estimate and plan length ÷ speed; the
     element methods (LVQ, kinematic point mass …, e% of eq. 59) by leave-one-run-out where the
-    logs hold two runs or more. --simulated: the thesis' experiment, 7 flights per trajectory
-    train, 3 test.
+    logs hold two runs or more; the model's own choices (its options, a learned scale, or a
+    baseline) re-made on the other runs and scored on each held-out run and each held-out log.
+    --simulated: the thesis' experiment, 7 flights per trajectory train, 3 test.
     """
     if simulated:
         from uasnav.experiments.trajectory import run_phantom4
@@ -390,6 +391,18 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             f"{tb['coverage']:.0%} time bounds ({tb['source']}): {tb['covered']}/{tb['n_runs']} real runs "
             f"within (Clopper–Pearson 95 %: {lo:.3f}–{hi:.3f})"
         )
+    ho = out.get("held_out")
+    if ho:
+        for key, label in (
+            ("leave_one_run_out", "leave-one-run-out"),
+            ("leave_one_log_out", "leave-one-log-out"),
+        ):
+            h = ho[key]
+            click.echo(
+                f"held out ({label}, chosen among {len(ho['candidates'])} candidates on the other runs): "
+                f"run |e%| median {h['run_abs_e_pct_median']:.2f}, worst {h['run_abs_e_pct_worst']:.2f}; "
+                f"the prior kept for {h['prior_chosen']}/{len(h['runs'])} runs"
+            )
     for row in out.get("table17", []):
         click.echo(
             f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
@@ -430,6 +443,10 @@ def _evaluate_flights(
         try:
             mission = evaluate_logs(logs_with_plan)
             table.update(mission["methods"])
+            from uasnav.trajectory.holdout import held_out_report, run_table
+
+            # the model's choices re-made on some runs and scored on the held-out rest
+            mission["held_out"] = held_out_report(run_table(logs_with_plan))
         except (InputError, DataFormatError) as e:
             mission_error = str(e)
     element_error: str | None = None
@@ -496,6 +513,7 @@ def _evaluate_flights(
         out["per_stack"] = mission["per_stack"]
         out["parameters"] = mission["parameters"]
         out["time_bounds"] = mission["time_bounds"]
+        out["held_out"] = mission["held_out"]
     if element_error is not None:
         out["element_methods"] = f"not evaluated: {element_error}"
     if mission_error is not None:
@@ -578,6 +596,18 @@ def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # t
     click.echo(f"parameters from the log: {', '.join(from_log) or 'none'}; others the firmware defaults")
 
 
+def _flights_option(what: str):  # type: ignore[no-untyped-def]
+    """``--flights LOG`` (repeatable): the vehicle's own earlier flights, for ``what``."""
+    return click.option(
+        "--flights",
+        "flight_logs",
+        multiple=True,
+        type=click.Path(dir_okay=False),
+        help="The vehicle's own earlier flights (.tlog .bin .ulg with their mission; repeat the option): "
+        + what,
+    )
+
+
 @command.command("calibrate")
 @click.option(
     "--model", "model_path", required=True, type=click.Path(dir_okay=False), help="Model JSON (from train)."
@@ -606,14 +636,7 @@ def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # t
     show_default=True,
     help="Coverage reported for the held-out runs.",
 )
-@click.option(
-    "--flights",
-    "flight_logs",
-    multiple=True,
-    type=click.Path(dir_okay=False),
-    help="The vehicle's own earlier flights (.tlog .bin .ulg with their mission; repeat the option): "
-    "the bounds come from their AUTO runs instead of simulation.",
-)
+@_flights_option("the bounds come from their AUTO runs instead of simulation.")
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def calibrate(model_path, out, runs, test_runs, coverage, flight_logs, seed, as_json):  # type: ignore[no-untyped-def]
@@ -696,6 +719,44 @@ def _calibrate_from_flights(
     )
 
 
+def _own_run_bounds(
+    model: Any,
+    flight_logs: Sequence[str],
+    limits_log: Any,
+    coverage: float,
+    wind: np.ndarray,
+    climb: float | None,
+    descent: float | None,
+    accel_z: float | None,
+    speed: float | None,
+) -> str:
+    """``intent``: the time bounds from the vehicle's own AUTO runs (``--flights``, else the
+    ``--limits-from`` log's when it has enough runs for the coverage) set on ``model``; returns
+    why they were not used (to append to the simulated bounds' source), or "". Explicit
+    ``--flights`` that cannot give the coverage are an error."""
+    from uasnav.trajectory.timebounds import DEFAULT_TAU_S
+    from uasnav.utm.intent import vehicle_run_bounds
+
+    logs = list(flight_logs) or ([limits_log] if limits_log else [])
+    if not logs:
+        return ""
+    prior = model.time_bounds_
+    tau = prior.tau_s if prior is not None else DEFAULT_TAU_S
+    try:
+        bounds = vehicle_run_bounds(
+            logs, model, wind, climb_ms=climb, descent_ms=descent, accel_z_ms2=accel_z, cruise_ms=speed,
+            tau_s=tau,
+        )  # fmt: skip
+        bounds.quantile(coverage)
+    except (InputError, DataFormatError) as why:
+        if flight_logs:
+            raise InputError(f"--flights: {why}") from why
+        name = Path(str(getattr(logs[0], "path", logs[0]))).name
+        return f" (the vehicle's own runs in {name} not used: {why})"
+    model.time_bounds_ = bounds
+    return ""
+
+
 @command.command("intent")
 @click.option(
     "--model",
@@ -768,6 +829,10 @@ def _calibrate_from_flights(
     show_default=True,
     help="Runs to calibrate a model without time bounds.",
 )
+@_flights_option(
+    "the time bounds come from how this prediction missed their AUTO runs. Default: the "
+    "--limits-from log's runs when there are enough for --coverage, else the model's bounds."
+)
 @click.option(
     "--out", "out", required=True, type=OutputPath(), help="F3548 OperationalIntentDetails JSON to write."
 )
@@ -775,7 +840,8 @@ def _calibrate_from_flights(
 @click.option("--json", "as_json", is_flag=True, help="Print a machine-readable summary.")
 def intent(  # type: ignore[no-untyped-def]
     model_path, plan_path, wind_text, start_text, coverage, lateral_buffer, vertical_buffer, geoid_height,
-    home_alt, speed, climb_rate, descent_rate, limits_log, priority, calibration_runs, out, geojson, as_json,
+    home_alt, speed, climb_rate, descent_rate, limits_log, priority, calibration_runs, flight_logs, out,
+    geojson, as_json,
 ):  # fmt: skip
     """An ASTM F3548 operational intent (W84 volumes) whose volumes contain the predicted 4D
     trajectory with its calibrated time bounds and the buffers."""
@@ -792,17 +858,26 @@ def intent(  # type: ignore[no-untyped-def]
 
     wind = parse_wind(wind_text)
     start = parse_time(start_text, "--start")
-    check_outputs([model_path, plan_path], {"--out": out, "--geojson": geojson})
+    check_outputs([model_path, plan_path, *flight_logs], {"--out": out, "--geojson": geojson})
     model = load_model(model_path)
     plan = read_plan(plan_path)
     # vertical limits: the explicit options, else the log's (--limits-from), else the model's
     # own (build_intent → route3d.vertical_limits)
     accel_z: float | None = None
     from_log: list[str] = []
+    limits_source: Any = limits_log
     if limits_log:
         from uasnav.io.autopilot_limits import read_autopilot_limits
 
-        lim = read_autopilot_limits(limits_log)
+        if Path(limits_log).suffix.lower() in (".tlog", ".bin", ".ulg"):
+            from uasnav.io.logfile import open_log
+            from uasnav.trajectory.mission_runs import MISSION_VIEWS
+
+            # one decoding pass serves the limits and the vehicle's own runs
+            limits_source = open_log(limits_log, need=("limits", *MISSION_VIEWS))
+            lim = limits_source.limits
+        else:
+            lim = read_autopilot_limits(limits_log)
         if lim.climb_ms is not None and climb_rate is None:
             climb_rate, from_log = lim.climb_ms, [*from_log, "climb_ms"]
         if lim.descent_ms is not None and descent_rate is None:
@@ -811,6 +886,9 @@ def intent(  # type: ignore[no-untyped-def]
             accel_z, from_log = lim.accel_z_ms2, [*from_log, "accel_z_ms2"]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
+    own_note = _own_run_bounds(
+        model, flight_logs, limits_source, coverage, wind, climb_rate, descent_rate, accel_z, speed
+    )
     if model.time_bounds_ is None:
         from uasnav.trajectory.calibration import check_runs
 
@@ -822,7 +900,7 @@ def intent(  # type: ignore[no-untyped-def]
             v = speed or plan_cruise_speed(plan) or model.cruise_ms_
             runs = simulated_runs(model, calibration_runs, progress=lambda i, n: bar.update(1), cruise_ms=v)
         model.time_bounds_ = fit_bounds(
-            runs, source=f"{calibration_runs} simulated runs at {v:g} m/s, seed 0"
+            runs, source=f"{calibration_runs} simulated runs at {v:g} m/s, seed 0{own_note}"
         )
     b = build_intent(
         plan, model, wind, start, coverage=coverage, lateral_buffer_m=lateral_buffer,

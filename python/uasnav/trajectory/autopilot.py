@@ -33,9 +33,10 @@ to ``LAND_ALT_LOW`` and at ``LAND_SPEED`` below; RTL climbs to ``RTL_ALT``, retu
 PX4 multicopter (``FlightTaskAuto`` + ``PositionSmoothing``): ``MPC_XY_CRUISE``,
 ``MPC_ACC_HOR``, ``MPC_JERK_AUTO``, ``MPC_Z_V_AUTO_UP/DN`` (before 1.12: ``MPC_Z_VEL_MAX_UP/DN``),
 corner speed √(a·R·tan(α/2)) with R = ``NAV_ACC_RAD`` and α the angle between the legs
-(``computeMaxSpeedInWaypoint``); take-off at ``MPC_TKO_SPEED`` after a ``MPC_TKO_RAMP_T`` ramp;
-landing at ``MPC_Z_V_AUTO_DN`` above ``MPC_LAND_ALT1``, blending linearly to ``MPC_LAND_SPEED``
-at ``MPC_LAND_ALT2`` and below.
+(``computeMaxSpeedInWaypoint``); with ``MPC_YAW_MODE`` 4 ("yaw first") the vehicle stops at
+each corner and turns at ``MPC_YAWRAUTO_MAX`` before the next leg; take-off at
+``MPC_TKO_SPEED`` after a ``MPC_TKO_RAMP_T`` ramp; landing at ``MPC_Z_V_AUTO_DN`` above
+``MPC_LAND_ALT1``, blending linearly to ``MPC_LAND_SPEED`` at ``MPC_LAND_ALT2`` and below.
 
 Fixed wing and QuadPlane (ArduPlane): legs at the cruise airspeed (``AIRSPEED_CRUISE``, before
 4.5 ``TRIM_ARSPD_CM``), corners as circular arcs of radius v²/(g·tan φ) with φ = ``ROLL_LIMIT_DEG``
@@ -278,48 +279,96 @@ def _braking_with_cruise(
 # --------------------------------------------------------------------------- parameters
 @dataclass(frozen=True)
 class Default:
-    """A firmware default and where it is defined."""
+    """A firmware default and where it is defined.
+
+    Attributes
+    ----------
+    value : float
+        The default in SI units (m, m/s, m/s², m/s³, s, deg).
+    source : str
+        ``"<file> <version>: <NAME> <number> <unit>"``, the number in the firmware's own unit.
+    verified : str
+        Where the number was read in the public source: the file as stored at a commit, or the
+        layout of the file that identifies the release (names the commit when known).
+    """
 
     value: float
     source: str
+    verified: str = ""
 
 
-#: ArduCopter defaults, SI units, by major version. Sources: ArduPilot
-#: ``libraries/AC_WPNav/AC_WPNav.cpp`` (``WPNAV_*``), ``ArduCopter/Parameters.cpp``
-#: (``RTL_*``, ``LAND_*``), ``ArduCopter/mode_land.cpp`` (``LAND_ALT_LOW``; 3.x hard-codes
-#: ``LAND_START_ALT`` 1000 cm in ``ArduCopter/defines.h``).
+# Stored versions of the firmware sources the defaults below were read in (public GitHub):
+_AC3_WPNAV = "AC_WPNav.h of Copter 3.x (WPNAV_ACCELERATION 100, WPNAV_WP_SPEED 500 in the header)"
+_AC4_WPNAV = "AC_WPNav.cpp with ACCEL_C and the SCurve legs (Copter 4.x var_info)"
+_AC_CONFIG = "ArduCopter/config.h (LAND_SPEED 50, RTL_ALT 1500, RTL_LOITER_TIME 5000, RTL_ALT_FINAL 0)"
+_AC36_PARAMS = "ArduCopter/Parameters.cpp with Copter::ModeFlowHold (3.6): ParametersG2 LAND_ALT_LOW 1000"
+_AC45_PARAMS = "ArduCopter/Parameters.cpp with rtl_speed_cms/land_speed_high_cms (4.5+)"
+_PX4_111 = "mc_pos_control_params.c of the v1.11 layout (defines MPC_SPOOLUP_TIME; no MPC_Z_V_AUTO_*)"
+_PX4_112 = "mc_pos_control_params.c of the v1.12–1.13 layout (defines MPC_Z_V_AUTO_*, SYS_VEHICLE_RESP)"
+_PX4_114 = "multicopter_autonomous_params.c at 456c5516 (v1.14 split layout)"
+_PX4_MAIN = "multicopter_*_params.yaml at 6ffdc936 (main; MPC_YAWRAUTO_MAX is 60 there)"
+_PX4_NAV = "navigator_params.c (NAV_ACC_RAD 10, NAV_MC_ALT_RAD 0.8)"
+_PX4_MIS = "mission_params.c and mission_params.yaml at 4631d99a (MIS_YAW_ERR 12, MIS_YAW_TMT −1)"
+_PX4_RTL = (
+    "rtl_params.c: RTL_RETURN_ALT 60, RTL_DESCEND_ALT 30 in every layout; RTL_LAND_DELAY −1 (old) / 0 (new)"
+)
+_PLANE_CONFIG = "ArduPlane/config.h (AIRSPEED_CRUISE 12, ROLL_LIMIT_DEG 45, WP_RADIUS_DEFAULT 90)"
+_QPLANE = "ArduPlane/quadplane.cpp var_info (TRANSITION_MS 5000, LAND_SPEED 50, LAND_FINAL_ALT 6)"
+_TECS = "libraries/AP_TECS/AP_TECS.cpp var_info (CLMB_MAX 5.0, SINK_MAX 5.0)"
+
+#: ArduCopter defaults, SI units, by major version. 3.x keeps the ``WPNAV_*`` defaults in
+#: ``libraries/AC_WPNav/AC_WPNav.h``, 4.x in ``AC_WPNav.cpp`` (``WPNAV_ACCELERATION`` in the
+#: header); ``LAND_SPEED``, ``RTL_ALT``, ``RTL_LOIT_TIME``, ``RTL_ALT_FINAL`` are ``config.h``
+#: macros used by ``ArduCopter/Parameters.cpp``, which defines ``LAND_SPEED_HIGH``, ``RTL_SPEED``
+#: and ``LAND_ALT_LOW`` (``ParametersG2``) itself.
 ARDUCOPTER_DEFAULTS: dict[str, dict[str, Default]] = {
     "3": {
-        "WPNAV_SPEED": Default(5.0, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_SPEED 500 cm/s"),
-        "WPNAV_ACCEL": Default(1.0, "AC_WPNav.cpp Copter-3.6: WPNAV_ACCELERATION 100 cm/s²"),
-        "WPNAV_SPEED_UP": Default(2.5, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_SPEED_UP 250 cm/s"),
-        "WPNAV_SPEED_DN": Default(1.5, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_SPEED_DOWN 150 cm/s"),
-        "WPNAV_ACCEL_Z": Default(1.0, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²"),
-        "WPNAV_RADIUS": Default(2.0, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_RADIUS 200 cm"),
-        "LAND_SPEED": Default(0.5, "ArduCopter/Parameters.cpp Copter-3.6: LAND_SPEED 50 cm/s"),
-        "LAND_SPEED_HIGH": Default(0.0, "ArduCopter/Parameters.cpp Copter-3.6: LAND_SPEED_HIGH 0"),
-        "LAND_ALT_LOW": Default(10.0, "ArduCopter/defines.h Copter-3.6: LAND_START_ALT 1000 cm"),
-        "RTL_ALT": Default(15.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_ALT 1500 cm"),
-        "RTL_SPEED": Default(0.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_SPEED 0 (WPNAV_SPEED)"),
-        "RTL_LOIT_TIME": Default(5.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_LOIT_TIME 5000 ms"),
-        "RTL_ALT_FINAL": Default(0.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_ALT_FINAL 0"),
+        "WPNAV_SPEED": Default(5.0, "AC_WPNav.h Copter-3.6: WPNAV_WP_SPEED 500 cm/s", _AC3_WPNAV),
+        "WPNAV_ACCEL": Default(1.0, "AC_WPNav.h Copter-3.6: WPNAV_ACCELERATION 100 cm/s²", _AC3_WPNAV),
+        "WPNAV_SPEED_UP": Default(2.5, "AC_WPNav.h Copter-3.6: WPNAV_WP_SPEED_UP 250 cm/s", _AC3_WPNAV),
+        "WPNAV_SPEED_DN": Default(1.5, "AC_WPNav.h Copter-3.6: WPNAV_WP_SPEED_DOWN 150 cm/s", _AC3_WPNAV),
+        "WPNAV_ACCEL_Z": Default(
+            1.0, "AC_WPNav.h Copter-3.6: WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²", _AC3_WPNAV
+        ),
+        "WPNAV_RADIUS": Default(2.0, "AC_WPNav.h Copter-3.6: WPNAV_WP_RADIUS 200 cm", _AC3_WPNAV),
+        "LAND_SPEED": Default(0.5, "ArduCopter/config.h Copter-3.6: LAND_SPEED 50 cm/s", _AC_CONFIG),
+        "LAND_SPEED_HIGH": Default(
+            0.0, "ArduCopter/Parameters.cpp Copter-3.6: LAND_SPEED_HIGH 0", _AC36_PARAMS
+        ),
+        "LAND_ALT_LOW": Default(
+            10.0, "ArduCopter/Parameters.cpp Copter-3.6: LAND_ALT_LOW 1000 cm", _AC36_PARAMS
+        ),
+        "RTL_ALT": Default(15.0, "ArduCopter/config.h Copter-3.6: RTL_ALT 1500 cm", _AC_CONFIG),
+        "RTL_SPEED": Default(
+            0.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_SPEED 0 (WPNAV_SPEED)", _AC36_PARAMS
+        ),
+        "RTL_LOIT_TIME": Default(5.0, "ArduCopter/config.h Copter-3.6: RTL_LOITER_TIME 5000 ms", _AC_CONFIG),
+        "RTL_ALT_FINAL": Default(0.0, "ArduCopter/config.h Copter-3.6: RTL_ALT_FINAL 0", _AC_CONFIG),
     },
     "4": {
-        "WPNAV_SPEED": Default(10.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED 1000 cm/s"),
-        "WPNAV_ACCEL": Default(2.5, "AC_WPNav.cpp Copter-4.5: WPNAV_ACCELERATION 250 cm/s²"),
-        "WPNAV_SPEED_UP": Default(2.5, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED_UP 250 cm/s"),
-        "WPNAV_SPEED_DN": Default(1.5, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED_DOWN 150 cm/s"),
-        "WPNAV_ACCEL_Z": Default(1.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²"),
-        "WPNAV_RADIUS": Default(2.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_RADIUS 200 cm"),
-        "WPNAV_JERK": Default(1.0, "AC_WPNav.cpp Copter-4.5: WPNAV_JERK 1 m/s³"),
-        "WPNAV_ACCEL_C": Default(0.0, "AC_WPNav.cpp Copter-4.5: WPNAV_ACCEL_C 0 (2×WPNAV_ACCEL)"),
-        "LAND_SPEED": Default(0.5, "ArduCopter/Parameters.cpp Copter-4.5: LAND_SPEED 50 cm/s"),
-        "LAND_SPEED_HIGH": Default(0.0, "ArduCopter/Parameters.cpp Copter-4.5: LAND_SPEED_HIGH 0"),
-        "LAND_ALT_LOW": Default(10.0, "ArduCopter/mode_land.cpp Copter-4.5: LAND_ALT_LOW 1000 cm"),
-        "RTL_ALT": Default(15.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_ALT 1500 cm"),
-        "RTL_SPEED": Default(0.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_SPEED 0 (WPNAV_SPEED)"),
-        "RTL_LOIT_TIME": Default(5.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_LOIT_TIME 5000 ms"),
-        "RTL_ALT_FINAL": Default(0.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_ALT_FINAL 0"),
+        "WPNAV_SPEED": Default(10.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED 1000 cm/s", _AC4_WPNAV),
+        "WPNAV_ACCEL": Default(2.5, "AC_WPNav.h Copter-4.5: WPNAV_ACCELERATION 250 cm/s²", _AC4_WPNAV),
+        "WPNAV_SPEED_UP": Default(2.5, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED_UP 250 cm/s", _AC4_WPNAV),
+        "WPNAV_SPEED_DN": Default(1.5, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED_DOWN 150 cm/s", _AC4_WPNAV),
+        "WPNAV_ACCEL_Z": Default(
+            1.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²", _AC4_WPNAV
+        ),
+        "WPNAV_RADIUS": Default(2.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_RADIUS 200 cm", _AC4_WPNAV),
+        "WPNAV_JERK": Default(1.0, "AC_WPNav.cpp Copter-4.5: JERK 1 m/s³", _AC4_WPNAV),
+        "WPNAV_ACCEL_C": Default(0.0, "AC_WPNav.cpp Copter-4.5: ACCEL_C 0 (2×WPNAV_ACCEL)", _AC4_WPNAV),
+        "LAND_SPEED": Default(0.5, "ArduCopter/config.h Copter-4.5: LAND_SPEED 50 cm/s", _AC_CONFIG),
+        "LAND_SPEED_HIGH": Default(
+            0.0, "ArduCopter/Parameters.cpp Copter-4.5: LAND_SPEED_HIGH 0", _AC45_PARAMS
+        ),
+        "LAND_ALT_LOW": Default(
+            10.0, "ArduCopter/Parameters.cpp Copter-4.5: LAND_ALT_LOW 1000 cm", _AC45_PARAMS
+        ),
+        "RTL_ALT": Default(15.0, "ArduCopter/config.h Copter-4.5: RTL_ALT 1500 cm", _AC_CONFIG),
+        "RTL_SPEED": Default(
+            0.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_SPEED 0 (WPNAV_SPEED)", _AC45_PARAMS
+        ),
+        "RTL_LOIT_TIME": Default(5.0, "ArduCopter/config.h Copter-4.5: RTL_LOITER_TIME 5000 ms", _AC_CONFIG),
+        "RTL_ALT_FINAL": Default(0.0, "ArduCopter/config.h Copter-4.5: RTL_ALT_FINAL 0", _AC_CONFIG),
     },
 }
 #: ArduCopter parameters logged in cm, cm/s, cm/s² or ms (→ SI by these factors).
@@ -331,59 +380,132 @@ _AC_SCALE = {
 }  # fmt: skip
 
 #: PX4 multicopter defaults (SI). Sources: PX4-Autopilot
-#: ``src/modules/mc_pos_control/mc_pos_control_params.c`` and
-#: ``src/modules/navigator/navigator_params.c``, release 1.11 / 1.14 as named.
+#: ``src/modules/mc_pos_control/mc_pos_control_params.c`` (one file up to 1.13; split into
+#: ``multicopter_*_params.c`` in 1.14 and into ``.yaml`` later), ``navigator_params.c``,
+#: ``mission_params.c``, ``rtl_params.c``. Every value is the same from 1.11 to 1.14 unless
+#: its citation names a range; ``MPC_YAWRAUTO_MAX`` is 60 °/s on PX4 main after 1.14.
 PX4_MC_DEFAULTS: dict[str, Default] = {
-    "MPC_XY_CRUISE": Default(5.0, "mc_pos_control_params.c v1.11–1.14: MPC_XY_CRUISE 5 m/s"),
-    "MPC_ACC_HOR": Default(3.0, "mc_pos_control_params.c v1.11–1.14: MPC_ACC_HOR 3 m/s²"),
-    "MPC_JERK_AUTO": Default(4.0, "mc_pos_control_params.c v1.11–1.14: MPC_JERK_AUTO 4 m/s³"),
-    "MPC_Z_V_AUTO_UP": Default(3.0, "mc_pos_control_params.c v1.14: MPC_Z_V_AUTO_UP 3 m/s"),
-    "MPC_Z_V_AUTO_DN": Default(1.5, "mc_pos_control_params.c v1.14: MPC_Z_V_AUTO_DN 1.5 m/s"),
-    "MPC_Z_VEL_MAX_UP": Default(3.0, "mc_pos_control_params.c v1.11: MPC_Z_VEL_MAX_UP 3 m/s"),
-    "MPC_Z_VEL_MAX_DN": Default(1.0, "mc_pos_control_params.c v1.11: MPC_Z_VEL_MAX_DN 1 m/s"),
-    "MPC_ACC_UP_MAX": Default(4.0, "mc_pos_control_params.c v1.11–1.14: MPC_ACC_UP_MAX 4 m/s²"),
-    "MPC_TKO_SPEED": Default(1.5, "mc_pos_control_params.c v1.11–1.14: MPC_TKO_SPEED 1.5 m/s"),
-    "MPC_TKO_RAMP_T": Default(3.0, "mc_pos_control_params.c v1.11–1.14: MPC_TKO_RAMP_T 3 s"),
-    "MPC_LAND_SPEED": Default(0.7, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_SPEED 0.7 m/s"),
-    "MPC_LAND_ALT1": Default(10.0, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_ALT1 10 m"),
-    "MPC_LAND_ALT2": Default(5.0, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_ALT2 5 m"),
-    "NAV_ACC_RAD": Default(10.0, "navigator_params.c v1.11–1.14: NAV_ACC_RAD 10 m"),
-    "NAV_MC_ALT_RAD": Default(0.8, "navigator_params.c v1.11–1.14: NAV_MC_ALT_RAD 0.8 m"),
-    "MIS_YAW_ERR": Default(12.0, "mission_params.c v1.11–1.14: MIS_YAW_ERR 12°"),
-    "MIS_YAW_TMT": Default(-1.0, "mission_params.c v1.11–1.14: MIS_YAW_TMT −1 (no timeout)"),
-    "MPC_YAWRAUTO_MAX": Default(45.0, "mc_pos_control_params.c v1.11–1.14: MPC_YAWRAUTO_MAX 45°/s"),
-    "MPC_XY_TRAJ_P": Default(0.5, "mc_pos_control_params.c v1.11–1.14: MPC_XY_TRAJ_P 0.5"),
-    "MPC_XY_P": Default(0.95, "mc_pos_control_params.c v1.11–1.14: MPC_XY_P 0.95"),
-    "MPC_SPOOLUP_TIME": Default(
-        1.0, "mc_pos_control_params.c v1.11: MPC_SPOOLUP_TIME 1 s (COM_SPOOLUP_TIME from 1.12)"
+    "MPC_XY_CRUISE": Default(
+        5.0, "mc_pos_control_params.c v1.11–1.14: MPC_XY_CRUISE 5 m/s", f"{_PX4_111}; {_PX4_114}"
     ),
-    "RTL_RETURN_ALT": Default(60.0, "rtl_params.c v1.11–1.14: RTL_RETURN_ALT 60 m"),
-    "RTL_DESCEND_ALT": Default(30.0, "rtl_params.c v1.11–1.14: RTL_DESCEND_ALT 30 m"),
-    "RTL_LAND_DELAY": Default(0.0, "rtl_params.c v1.13–1.14: RTL_LAND_DELAY 0 s (−1 before: hover)"),
+    "MPC_ACC_HOR": Default(
+        3.0, "mc_pos_control_params.c v1.11–1.14: MPC_ACC_HOR 3 m/s²", f"{_PX4_111}; {_PX4_114}"
+    ),
+    "MPC_JERK_AUTO": Default(
+        4.0, "mc_pos_control_params.c v1.11–1.14: MPC_JERK_AUTO 4 m/s³", f"{_PX4_111}; {_PX4_114}"
+    ),
+    "MPC_Z_V_AUTO_UP": Default(
+        3.0, "mc_pos_control_params.c v1.12–1.14: MPC_Z_V_AUTO_UP 3 m/s", f"{_PX4_112}; {_PX4_114}"
+    ),
+    "MPC_Z_V_AUTO_DN": Default(
+        1.5, "mc_pos_control_params.c v1.12–1.14: MPC_Z_V_AUTO_DN 1.5 m/s", f"{_PX4_112}; {_PX4_114}"
+    ),
+    "MPC_Z_VEL_MAX_UP": Default(3.0, "mc_pos_control_params.c v1.11: MPC_Z_VEL_MAX_UP 3 m/s", _PX4_111),
+    "MPC_Z_VEL_MAX_DN": Default(1.0, "mc_pos_control_params.c v1.11: MPC_Z_VEL_MAX_DN 1 m/s", _PX4_111),
+    "MPC_ACC_UP_MAX": Default(
+        4.0, "mc_pos_control_params.c v1.11–1.14: MPC_ACC_UP_MAX 4 m/s²", f"{_PX4_111}; {_PX4_112}"
+    ),
+    "MPC_TKO_SPEED": Default(
+        1.5, "mc_pos_control_params.c v1.11–1.14: MPC_TKO_SPEED 1.5 m/s", f"{_PX4_111}; {_PX4_MAIN}"
+    ),
+    "MPC_TKO_RAMP_T": Default(
+        3.0, "mc_pos_control_params.c v1.11–1.14: MPC_TKO_RAMP_T 3 s", f"{_PX4_111}; {_PX4_MAIN}"
+    ),
+    "MPC_LAND_SPEED": Default(
+        0.7, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_SPEED 0.7 m/s", f"{_PX4_111}; {_PX4_MAIN}"
+    ),
+    "MPC_LAND_ALT1": Default(
+        10.0, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_ALT1 10 m", f"{_PX4_111}; {_PX4_MAIN}"
+    ),
+    "MPC_LAND_ALT2": Default(
+        5.0, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_ALT2 5 m", f"{_PX4_111}; {_PX4_MAIN}"
+    ),
+    "NAV_ACC_RAD": Default(10.0, "navigator_params.c v1.11–1.14: NAV_ACC_RAD 10 m", _PX4_NAV),
+    "NAV_MC_ALT_RAD": Default(0.8, "navigator_params.c v1.11–1.14: NAV_MC_ALT_RAD 0.8 m", _PX4_NAV),
+    "MIS_YAW_ERR": Default(12.0, "mission_params.c v1.11–1.14: MIS_YAW_ERR 12°", _PX4_MIS),
+    "MIS_YAW_TMT": Default(-1.0, "mission_params.c v1.11–1.14: MIS_YAW_TMT −1 (no timeout)", _PX4_MIS),
+    "MPC_YAWRAUTO_MAX": Default(
+        45.0,
+        "mc_pos_control_params.c v1.11–1.14: MPC_YAWRAUTO_MAX 45°/s",
+        f"{_PX4_111}; {_PX4_112}; {_PX4_114}",
+    ),
+    "MPC_YAW_MODE": Default(
+        0.0,
+        "mc_pos_control_params.c v1.11–1.14: MPC_YAW_MODE 0 (towards waypoint)",
+        f"{_PX4_111}; {_PX4_114}",
+    ),
+    "MPC_XY_TRAJ_P": Default(
+        0.5, "mc_pos_control_params.c v1.11–1.14: MPC_XY_TRAJ_P 0.5", f"{_PX4_111}; {_PX4_114}"
+    ),
+    "MPC_XY_P": Default(0.95, "mc_pos_control_params.c v1.11–1.13: MPC_XY_P 0.95", f"{_PX4_111}; {_PX4_112}"),
+    "MPC_SPOOLUP_TIME": Default(
+        1.0, "mc_pos_control_params.c v1.11: MPC_SPOOLUP_TIME 1 s (COM_SPOOLUP_TIME from 1.12)", _PX4_111
+    ),
+    "RTL_RETURN_ALT": Default(60.0, "rtl_params.c v1.11–1.14: RTL_RETURN_ALT 60 m", _PX4_RTL),
+    "RTL_DESCEND_ALT": Default(30.0, "rtl_params.c v1.11–1.14: RTL_DESCEND_ALT 30 m", _PX4_RTL),
+    "RTL_LAND_DELAY": Default(
+        0.0, "rtl_params.c v1.13–1.14: RTL_LAND_DELAY 0 s (−1 before: hover)", _PX4_RTL
+    ),
 }
 
-#: ArduPlane / QuadPlane defaults (SI). Sources: ArduPilot ``ArduPlane/Parameters.cpp``
-#: (``TRIM_ARSPD_CM``/``AIRSPEED_CRUISE``, ``LIM_ROLL_CD``/``ROLL_LIMIT_DEG``, ``WP_RADIUS``),
-#: ``ArduPlane/quadplane.cpp`` (``Q_TRANSITION_MS``, ``Q_LAND_SPEED``, ``Q_LAND_FINAL_ALT``;
-#: ``Q_WP_SPEED_UP/DN`` are the ``AC_WPNav`` defaults), Plane-4.5.
+#: ArduPlane / QuadPlane defaults (SI). Sources: ArduPilot ``ArduPlane/config.h`` (used by
+#: ``Parameters.cpp``: ``TRIM_ARSPD_CM``/``AIRSPEED_CRUISE``, ``LIM_ROLL_CD``/``ROLL_LIMIT_DEG``,
+#: ``WP_RADIUS``), ``ArduPlane/quadplane.cpp`` (``Q_TRANSITION_MS``, ``Q_LAND_SPEED``,
+#: ``Q_LAND_FINAL_ALT``; ``Q_WP_SPEED_UP/DN`` are the ``AC_WPNav`` defaults), ``AP_TECS.cpp``.
 PLANE_DEFAULTS: dict[str, Default] = {
-    "AIRSPEED_CRUISE": Default(12.0, "ArduPlane/Parameters.cpp Plane-4.5: AIRSPEED_CRUISE 12 m/s"),
-    "ROLL_LIMIT_DEG": Default(45.0, "ArduPlane/Parameters.cpp Plane-4.5: ROLL_LIMIT_DEG 45°"),
-    "WP_RADIUS": Default(90.0, "ArduPlane/Parameters.cpp Plane-4.5: WP_RADIUS 90 m"),
-    "Q_WP_SPEED_UP": Default(2.5, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_SPEED_UP 250 cm/s"),
-    "Q_WP_SPEED_DN": Default(1.5, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_SPEED_DOWN 150 cm/s"),
-    "Q_WP_ACCEL_Z": Default(1.0, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²"),
-    "Q_LAND_SPEED": Default(0.5, "ArduPlane/quadplane.cpp Plane-4.5: Q_LAND_SPEED 50 cm/s"),
-    "Q_LAND_FINAL_ALT": Default(6.0, "ArduPlane/quadplane.cpp Plane-4.5: Q_LAND_FINAL_ALT 6 m"),
-    "Q_TRANSITION_MS": Default(5.0, "ArduPlane/quadplane.cpp Plane-4.5: Q_TRANSITION_MS 5000 ms"),
-    "TECS_CLMB_MAX": Default(5.0, "libraries/AP_TECS/AP_TECS.cpp Plane-4.5: TECS_CLMB_MAX 5 m/s"),
-    "TECS_SINK_MAX": Default(5.0, "libraries/AP_TECS/AP_TECS.cpp Plane-4.5: TECS_SINK_MAX 5 m/s"),
+    "AIRSPEED_CRUISE": Default(12.0, "ArduPlane/config.h Plane-4.5: AIRSPEED_CRUISE 12 m/s", _PLANE_CONFIG),
+    "ROLL_LIMIT_DEG": Default(45.0, "ArduPlane/config.h Plane-4.5: ROLL_LIMIT_DEG 45°", _PLANE_CONFIG),
+    "WP_RADIUS": Default(90.0, "ArduPlane/config.h Plane-4.5: WP_RADIUS_DEFAULT 90 m", _PLANE_CONFIG),
+    "Q_WP_SPEED_UP": Default(2.5, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_SPEED_UP 250 cm/s", _AC4_WPNAV),
+    "Q_WP_SPEED_DN": Default(1.5, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_SPEED_DOWN 150 cm/s", _AC4_WPNAV),
+    "Q_WP_ACCEL_Z": Default(
+        1.0, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²", _AC4_WPNAV
+    ),
+    "Q_LAND_SPEED": Default(0.5, "ArduPlane/quadplane.cpp Plane-4.5: Q_LAND_SPEED 50 cm/s", _QPLANE),
+    "Q_LAND_FINAL_ALT": Default(6.0, "ArduPlane/quadplane.cpp Plane-4.5: Q_LAND_FINAL_ALT 6 m", _QPLANE),
+    "Q_TRANSITION_MS": Default(5.0, "ArduPlane/quadplane.cpp Plane-4.5: Q_TRANSITION_MS 5000 ms", _QPLANE),
+    "TECS_CLMB_MAX": Default(5.0, "libraries/AP_TECS/AP_TECS.cpp Plane-4.5: TECS_CLMB_MAX 5 m/s", _TECS),
+    "TECS_SINK_MAX": Default(5.0, "libraries/AP_TECS/AP_TECS.cpp Plane-4.5: TECS_SINK_MAX 5 m/s", _TECS),
 }
 #: Older ArduPlane names in their logged units → the names above (SI).
 _PLANE_ALIASES = {"TRIM_ARSPD_CM": ("AIRSPEED_CRUISE", 0.01), "LIM_ROLL_CD": ("ROLL_LIMIT_DEG", 0.01),
                   "Q_WP_SPEED_UP": ("Q_WP_SPEED_UP", 0.01), "Q_WP_SPEED_DN": ("Q_WP_SPEED_DN", 0.01),
                   "Q_WP_ACCEL_Z": ("Q_WP_ACCEL_Z", 0.01), "Q_LAND_SPEED": ("Q_LAND_SPEED", 0.01),
                   "Q_TRANSITION_MS": ("Q_TRANSITION_MS", 0.001)}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ModelOptions:
+    """The modelling choices of the mission execution models that are not a firmware
+    parameter: how the vehicle follows what the firmware commands. The defaults are what the
+    firmware source implies; :mod:`uasnav.trajectory.holdout` re-chooses them on held-out
+    flights.
+
+    Attributes
+    ----------
+    ac3_slowdown_factor : float
+        ArduCopter 3.x: the waypoint target slows down at this multiple of ``WPNAV_ACCEL``
+        (``AC_WPNav::get_slow_down_speed`` v = √(4·a·d) is a deceleration of 2·a).
+    px4_tracking_lag : bool
+        PX4: the vehicle trails its smoothed trajectory by 1/``MPC_XY_P`` seconds of speed when
+        the navigator checks the acceptance radius.
+    px4_takeoff_lead : bool
+        PX4: a take-off from the ground first spools the motors up
+        (``MPC_SPOOLUP_TIME``/``COM_SPOOLUP_TIME``) and ramps the climb setpoint
+        (``MPC_TKO_RAMP_T``).
+    px4_yaw_acceptance : bool
+        PX4: a waypoint with a heading is accepted only once the heading is within
+        ``MIS_YAW_ERR`` (``Mission::is_mission_item_reached``).
+    yaw_before_move : bool
+        Turn to face the next leg before flying it where the firmware waits for the heading:
+        PX4 with ``MPC_YAW_MODE`` 4 ("towards waypoint, yaw first"); ArduCopter never waits.
+    """
+
+    ac3_slowdown_factor: float = 2.0
+    px4_tracking_lag: bool = True
+    px4_takeoff_lead: bool = True
+    px4_yaw_acceptance: bool = True
+    yaw_before_move: bool = True
 
 
 @dataclass(frozen=True)
@@ -400,12 +522,15 @@ class MissionParams:
         Parameter name → value in SI units (m, m/s, m/s², m/s³, s, deg).
     sources : dict of str → str
         Parameter name → ``"log"`` or the firmware default's citation.
+    options : ModelOptions
+        The modelling choices that are not firmware parameters.
     """
 
     family: str
     version: str | None
     values: dict[str, float]
     sources: dict[str, str] = field(default_factory=dict)
+    options: ModelOptions = field(default_factory=ModelOptions)
 
     def __getitem__(self, name: str) -> float:
         return self.values[name]
@@ -710,13 +835,15 @@ def predict_mission(
             v_out = 0.0
             if p.family == "plane":
                 v_out = cruise
-            elif nxt is not None and hold == 0.0 and cmd == MAV_CMD_NAV_WAYPOINT:
+            elif nxt is not None and hold == 0.0 and cmd == MAV_CMD_NAV_WAYPOINT and not _yaw_first(p):
                 nc = plan.items[nxt].command
                 if nc in (MAV_CMD_NAV_WAYPOINT, MAV_CMD_NAV_SPLINE_WAYPOINT) and nxt in pos:
                     theta = _turn_angle(s.ne, target, pos[nxt])
                     v_out = corner_speed(p, theta, cruise)
+            if _yaw_first(p):
+                _turn_before_leg(p, s, target)
             _leg(p, s, target, h1, cruise, v_out)
-            if p.family == "px4-mc":
+            if p.family == "px4-mc" and p.options.px4_yaw_acceptance:
                 _px4_yaw(p, s, it.params[3])
             if cmd == MAV_CMD_NAV_LOITER_TURNS:
                 turns = it.params[0] if math.isfinite(it.params[0]) else 1.0
@@ -753,6 +880,25 @@ def predict_mission(
     return MissionPrediction(
         tuple(out_items), tuple(out_cmds), np.asarray(out_t, dtype=float), float(s.t), landed, p
     )
+
+
+def _yaw_first(p: MissionParams) -> bool:
+    """Whether the firmware holds the vehicle until it faces the next waypoint: PX4 with
+    ``MPC_YAW_MODE`` 4 (``FlightTaskAuto``: ``should_wait_for_yaw_align`` zeroes the velocity
+    setpoint while the rate-limited yaw setpoint is not aligned). ArduCopter turns while it
+    flies (``WP_YAW_BEHAVIOR`` only chooses where the nose points), so it never waits."""
+    return p.family == "px4-mc" and p.options.yaw_before_move and p.values.get("MPC_YAW_MODE", 0.0) == 4.0
+
+
+def _turn_before_leg(p: MissionParams, s: _State, target: np.ndarray) -> None:
+    """Turn on the spot to face ``target`` at ``MPC_YAWRAUTO_MAX`` (the heading is unknown
+    before the first leg: no wait then)."""
+    u = np.asarray(target, dtype=float) - s.ne
+    if float(np.hypot(*u)) < 1e-6 or not math.isfinite(s.heading):
+        return
+    want = math.atan2(u[1], u[0])
+    s.t += abs(_wrap(want - s.heading)) / math.radians(p["MPC_YAWRAUTO_MAX"])
+    s.heading, s.v = want, 0.0
 
 
 def _px4_yaw(p: MissionParams, s: _State, yaw_deg: float) -> None:
@@ -829,7 +975,8 @@ def _leg(
     elif p.family == "arducopter":
         a = p["WPNAV_ACCEL"]
         if (p.major or 4) <= 3:
-            a = 2.0 * a  # the 3.x target slows down at twice WPNAV_ACCEL (get_slow_down_speed)
+            # the 3.x target slows down at twice WPNAV_ACCEL (get_slow_down_speed)
+            a = p.options.ac3_slowdown_factor * a
             t_h, v_end = leg_time(d, cruise, p["WPNAV_ACCEL"], None, v0, v_out, decel=a)
         else:
             t_h, v_end = leg_time(d, cruise, a, p["WPNAV_JERK"], v0, v_out)
@@ -838,7 +985,8 @@ def _leg(
         if accept:
             r_h = min(p["NAV_ACC_RAD"], d)
             r_v = min(p["NAV_MC_ALT_RAD"], abs(dz))
-            t_h, v_end = px4_leg_time(d, cruise, a, j, v0, v_out, p["NAV_ACC_RAD"], 1.0 / p["MPC_XY_P"])
+            lag = 1.0 / p["MPC_XY_P"] if p.options.px4_tracking_lag else 0.0
+            t_h, v_end = px4_leg_time(d, cruise, a, j, v0, v_out, p["NAV_ACC_RAD"], lag)
             t_v -= _tail_time(r_v, 0.0, vz, az)
         else:
             # to the point itself: the braking limit approaches it exponentially, so the leg
@@ -876,7 +1024,7 @@ def _climb_time(p: MissionParams, dz: float, *, vtol: bool, ground: bool) -> flo
         # on the ground: the motors spool up, then the take-off ramp raises the climb-speed
         # setpoint over MPC_TKO_RAMP_T from the one that holds the vehicle down; the
         # take-off is accepted within NAV_MC_ALT_RAD
-        lead = p["MPC_SPOOLUP_TIME"] + p["MPC_TKO_RAMP_T"] if ground else 0.0
+        lead = p["MPC_SPOOLUP_TIME"] + p["MPC_TKO_RAMP_T"] if ground and p.options.px4_takeoff_lead else 0.0
         return lead + max(dz - p["NAV_MC_ALT_RAD"], 0.0) / p["MPC_TKO_SPEED"]
     if p.family == "plane":
         if vtol:
@@ -1016,6 +1164,7 @@ __all__ = [
     "Default",
     "MissionParams",
     "MissionPrediction",
+    "ModelOptions",
     "banded_descent_time",
     "corner_speed",
     "distance_over_speed_time",

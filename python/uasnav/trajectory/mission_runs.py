@@ -15,6 +15,7 @@ the last item the altitude is within :data:`TOUCHDOWN_M` of the ground it ends o
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -417,7 +418,7 @@ def simulated_scores(
     out = np.empty(n_runs)
     for k in range(n_runs):
         vals = {n: v * (1.0 + _spread_of(n) * rng.uniform(-1.0, 1.0)) for n, v in params.values.items()}
-        truth = predict_mission(plan, MissionParams(params.family, params.version, vals, params.sources))
+        truth = predict_mission(plan, dataclasses.replace(params, values=vals))
         delay = rng.uniform(0.0, SIM_START_DELAY_S)
         t_true = np.r_[truth.arrive_s, truth.eta_s] + delay
         t_pred = np.r_[nominal.arrive_s, nominal.eta_s]

@@ -359,7 +359,8 @@ def predict_route(
         while j < n - 1 and moves[j] and route.hold_s[j] == 0:
             j += 1
         w = np.asarray(wind_ne, dtype=float)
-        if own_speeds:  # each leg at its own speed (the leg into point g + 1 flies v_leg[g + 1])
+        # each leg at its own speed (the leg into point g + 1 flies v_leg[g + 1])
+        if isinstance(predictor, KinematicPredictor):
             pred = predictor.predict(route.ne[i : j + 1], w, v_ref, leg_speed_ms=v_leg[i + 1 : j + 1])
         else:
             pred = predictor.predict(route.ne[i : j + 1], w, v_ref)  # type: ignore[attr-defined]

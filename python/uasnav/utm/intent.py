@@ -29,6 +29,7 @@ descent and hold times are predicted deterministically and carried inside the sa
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta
 from typing import Any
@@ -36,11 +37,11 @@ from typing import Any
 import numpy as np
 
 from uasnav.errors import InputError
-from uasnav.io.mission_plan import MissionPlan, RoutePoint, plan_cruise_speed, route_points
+from uasnav.io.mission_plan import ItemKind, MissionPlan, RoutePoint, plan_cruise_speed, route_points
 from uasnav.io.operational_intent import parse_details, rfc3339
 from uasnav.trajectory.models import Predictor
 from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route, vertical_limits
-from uasnav.trajectory.timebounds import DEFAULT_COVERAGE
+from uasnav.trajectory.timebounds import DEFAULT_COVERAGE, DEFAULT_TAU_S, TimeBounds
 from uasnav.utm.altitude import w84_altitudes
 
 DEFAULT_LATERAL_BUFFER_M = 15.0
@@ -102,6 +103,110 @@ def _positive(x: float, name: str) -> float:
     return float(x)
 
 
+def _predict_plan(
+    plan: MissionPlan,
+    predictor: Predictor,
+    wind_ne: np.ndarray,
+    *,
+    geoid_height_m: float | None,
+    home_amsl_m: float | None,
+    climb_ms: float,
+    descent_ms: float,
+    accel_z_ms2: float,
+    cruise_ms: float | None,
+) -> tuple[list[RoutePoint], np.ndarray, np.ndarray, RoutePrediction]:
+    """The plan's route points, their east/north (m, from the first point) and W84 heights,
+    and the predictor's times along the route."""
+    from uasnav.geo import frames
+
+    pts: list[RoutePoint] = route_points(plan)
+    for p in pts:
+        if not math.isfinite(p.hold_s):
+            what = "an unlimited loiter" if p.hold_s == math.inf else "a loiter of N turns (time unknown)"
+            raise InputError(f"{plan.source}: item {p.item}: {what} has no predictable end")
+    home = (
+        home_amsl_m if home_amsl_m is not None else (plan.home.alt_amsl_m if plan.home is not None else None)
+    )
+    z = w84_altitudes(pts, home_amsl_m=home, geoid_height_m=geoid_height_m, source=plan.source)
+    lat = np.array([p.lat_deg for p in pts])
+    lon = np.array([p.lon_deg for p in pts])
+    e, n, _ = frames.geodetic_to_enu(lat, lon, 0.0, float(lat[0]), float(lon[0]), 0.0)
+    en = np.column_stack([e, n])
+    v_ref = float(cruise_ms or plan_cruise_speed(plan) or predictor.cruise_ms_)
+    # DO_CHANGE_SPEED: the leg into a point flies the latest speed set before that point,
+    # unless the caller fixed the speed (cruise_ms)
+    speeds = np.full(len(pts), np.nan)
+    if cruise_ms is None:
+        v = np.nan
+        for i, p in enumerate(pts):
+            v = p.speed_ms if p.speed_ms is not None and i > 0 else v
+            speeds[i] = v
+    route = Route3D(en[:, ::-1], z, np.array([p.hold_s for p in pts]), speeds)
+    rp = predict_route(
+        predictor,
+        route,
+        np.asarray(wind_ne, dtype=float),
+        v_ref,
+        climb_ms=climb_ms,
+        descent_ms=descent_ms,
+        accel_z_ms2=accel_z_ms2,
+    )
+    return pts, en, z, rp
+
+
+def vehicle_run_bounds(
+    logs: Sequence[Any],
+    predictor: Predictor,
+    wind_ne: np.ndarray,
+    *,
+    climb_ms: float | None = None,
+    descent_ms: float | None = None,
+    accel_z_ms2: float | None = None,
+    cruise_ms: float | None = None,
+    tau_s: float = DEFAULT_TAU_S,
+) -> TimeBounds:
+    """Time bounds of ``predictor`` from the vehicle's own earlier flights: every AUTO run of
+    each log (:func:`uasnav.trajectory.mission_runs.mission_runs`) against the predictor's
+    times for the log's own plan, one score per run — the largest |T − T̂|/(T̂ + τ) over the
+    items it reached and its touch-down (a land item counts at the touch-down).
+
+    Raises
+    ------
+    InputError
+        A log without a mission or without an AUTO run that reaches an item.
+    """
+    from pathlib import Path
+
+    from uasnav.io.logfile import LogFile, open_log
+    from uasnav.trajectory.mission_runs import MISSION_VIEWS, mission_runs
+
+    up, down, a_z = vertical_limits(predictor, climb_ms, descent_ms, accel_z_ms2)
+    scores: list[float] = []
+    names: list[str] = []
+    for item in logs:
+        log = item if isinstance(item, LogFile) else open_log(item, need=MISSION_VIEWS)
+        plan = log.plan
+        pts, _, _, rp = _predict_plan(
+            plan, predictor, wind_ne, geoid_height_m=0.0, home_amsl_m=None, climb_ms=up, descent_ms=down,
+            accel_z_ms2=a_z, cruise_ms=cruise_ms,
+        )  # fmt: skip
+        eta = float(rp.t_depart_s[-1])
+        pred: dict[int, float] = {}
+        for k, p in enumerate(pts):
+            if p.item is not None and p.item not in pred:
+                pred[p.item] = eta if p.kind is ItemKind.LAND else float(rp.t_arrive_s[k])
+        for run in mission_runs(log, plan):
+            pairs = [(t, pred[i]) for i, t in run.reached if i in pred]
+            if run.landed:
+                pairs.append((run.duration_s, eta))
+            if pairs:
+                scores.append(max(abs(t - p) / (p + tau_s) for t, p in pairs))
+        names.append(Path(str(log.path)).name)
+    if not scores:
+        raise InputError("no AUTO run of the vehicle reaches an item of its mission")
+    return TimeBounds(np.array(scores), tau_s, f"{len(scores)} AUTO runs of the vehicle ({', '.join(names)})")
+
+
 def build_intent(
     plan: MissionPlan,
     predictor: Predictor,
@@ -157,40 +262,12 @@ def build_intent(
     if not (math.isfinite(vertical_buffer_m) and vertical_buffer_m >= 0):
         raise InputError(f"vertical buffer must be finite and ≥ 0, got {vertical_buffer_m!r}")
     bounds.quantile(coverage)  # refuses a coverage the calibration cannot give
-    pts: list[RoutePoint] = route_points(plan)
-    for p in pts:
-        if not math.isfinite(p.hold_s):
-            what = "an unlimited loiter" if p.hold_s == math.inf else "a loiter of N turns (time unknown)"
-            raise InputError(f"{plan.source}: item {p.item}: {what} has no predictable end")
-    home = (
-        home_amsl_m if home_amsl_m is not None else (plan.home.alt_amsl_m if plan.home is not None else None)
-    )
-    z = w84_altitudes(pts, home_amsl_m=home, geoid_height_m=geoid_height_m, source=plan.source)
-    lat = np.array([p.lat_deg for p in pts])
-    lon = np.array([p.lon_deg for p in pts])
-    lat0, lon0 = float(lat[0]), float(lon[0])
-    e, n, _ = frames.geodetic_to_enu(lat, lon, 0.0, lat0, lon0, 0.0)
-    en = np.column_stack([e, n])
+    pts, en, z, rp = _predict_plan(
+        plan, predictor, wind_ne, geoid_height_m=geoid_height_m, home_amsl_m=home_amsl_m, climb_ms=up,
+        descent_ms=down, accel_z_ms2=a_z, cruise_ms=cruise_ms,
+    )  # fmt: skip
+    lat0, lon0 = float(pts[0].lat_deg), float(pts[0].lon_deg)
     step = np.hypot(*np.diff(en, axis=0).T)
-    v_ref = float(cruise_ms or plan_cruise_speed(plan) or predictor.cruise_ms_)
-    # DO_CHANGE_SPEED: the leg into a point flies the latest speed set before that point,
-    # unless the caller fixed the speed (cruise_ms)
-    speeds = np.full(len(pts), np.nan)
-    if cruise_ms is None:
-        v = np.nan
-        for i, p in enumerate(pts):
-            v = p.speed_ms if p.speed_ms is not None and i > 0 else v
-            speeds[i] = v
-    route = Route3D(en[:, ::-1], z, np.array([p.hold_s for p in pts]), speeds)
-    rp = predict_route(
-        predictor,
-        route,
-        np.asarray(wind_ne, dtype=float),
-        v_ref,
-        climb_ms=up,
-        descent_ms=down,
-        accel_z_ms2=a_z,
-    )
     flags = [f for f, k in zip(rp.elements.flags, rp.elements.kind, strict=True) if k in ("leg", "turn")]
     m = len(pts)
     t_arr, t_dep, w = rp.t_arrive_s, rp.t_depart_s, rp.w_arrive_s
@@ -276,4 +353,5 @@ __all__ = [
     "DEFAULT_VERTICAL_BUFFER_M",
     "IntentBuild",
     "build_intent",
+    "vehicle_run_bounds",
 ]

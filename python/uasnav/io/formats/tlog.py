@@ -128,6 +128,27 @@ def read_tlog(path: str | os.PathLike[str]) -> dict[str, ImuLog]:
     return out
 
 
+def vz_down_sign(t: np.ndarray, alt_m: np.ndarray, vz: np.ndarray) -> float:
+    """The factor (+1 or −1) that turns ``GLOBAL_POSITION_INT.vz`` of a log into a downward
+    speed. MAVLink defines vz positive down; older ArduPilot firmware sent it positive up (its
+    ``send_location`` wrote ``vel.z * -100`` "+ve up"), so the log's own altitude decides: −1
+    when vz rises with the altitude on nearly every sample where the altitude changes by more
+    than 0.5 m/s, +1 (the definition) otherwise or when there are too few such samples."""
+    t, alt_m, vz = (np.asarray(x, dtype=np.float64) for x in (t, alt_m, vz))
+    if t.size < 3:
+        return 1.0
+    dt = np.diff(t)
+    ok = dt > 0
+    climb = np.diff(alt_m)[ok] / dt[ok]
+    v = 0.5 * (vz[1:] + vz[:-1])[ok]
+    moving = np.abs(climb) > 0.5
+    if moving.sum() < 5:
+        return 1.0
+    # positive down: vz and the climb rate have opposite signs
+    agree_down = float(np.mean(np.sign(v[moving]) == -np.sign(climb[moving])))
+    return -1.0 if agree_down < 0.2 else 1.0
+
+
 def read_tlog_flight(path: str | os.PathLike[str]) -> Flight:
     """The flight telemetry of a MAVLink log (see the module docs for the messages).
 
@@ -176,6 +197,9 @@ def read_tlog_flight(path: str | os.PathLike[str]) -> Flight:
                 wpnav = value if np.isfinite(value) and value > 0 else None
     if not fixes:
         raise DataFormatError(f"no GLOBAL_POSITION_INT messages{because(decoder)}", path=str(p))
+    fx = np.asarray(fixes, dtype=np.float64)
+    fx[:, 6] *= vz_down_sign(fx[:, 0], fx[:, 3], fx[:, 6])
+    fixes = [tuple(row) for row in fx]
     # seq 0 is the home position on ArduPilot; navigation waypoints carry a position.
     wps = {
         s: (x, y, z)
@@ -321,6 +345,7 @@ def read_tlog_nav(path: str | os.PathLike[str]) -> Flight:
     reference = None
     if len(ref) >= 2:
         r = increasing(np.asarray(ref, dtype=np.float64))
+        r[:, 6] *= vz_down_sign(r[:, 0], r[:, 3], r[:, 6])
         eul = None
         if len(att) >= 2:
             at = increasing(np.asarray(att, dtype=np.float64))
@@ -440,4 +465,4 @@ class TlogFormat(ScannedFormat):
         )
 
 
-__all__ = ["IMU_TYPES", "TlogFormat", "read_tlog", "read_tlog_flight", "read_tlog_nav"]
+__all__ = ["IMU_TYPES", "TlogFormat", "read_tlog", "read_tlog_flight", "read_tlog_nav", "vz_down_sign"]
