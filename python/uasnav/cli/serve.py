@@ -8,7 +8,6 @@ from typing import Any
 import click
 
 from uasnav.errors import InputError
-from uasnav.web.security import LOOPBACK_HOSTS
 
 
 def is_loopback(host: str) -> bool:
@@ -50,6 +49,7 @@ def command(
     import uvicorn
 
     from uasnav.web.app import create_app, load_documents
+    from uasnav.web.security import LOOPBACK_HOSTS
     from uasnav.web.server_limits import harden, uvicorn_settings
 
     settings = uvicorn_settings()  # invalid deadlines in the environment: refused first
