@@ -76,6 +76,30 @@ def _enlarge_buffer(conn: Any) -> None:
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, UDP_RCVBUF)
 
 
+def kernel_drops(conn: Any) -> int | None:
+    """Datagrams the kernel dropped for the connection's UDP socket because its receive buffer
+    was full (Linux: the ``drops`` column of ``/proc/net/udp{,6}`` for the socket's inode);
+    None when unknown (not UDP, not Linux, or the socket is closed)."""
+    import os
+    import socket
+
+    sock = getattr(conn, "port", None)
+    if not isinstance(sock, socket.socket) or sock.type != socket.SOCK_DGRAM or sock.fileno() < 0:
+        return None
+    try:
+        inode = str(os.fstat(sock.fileno()).st_ino)
+        for table in ("/proc/net/udp", "/proc/net/udp6"):
+            with open(table, encoding="ascii") as fh:
+                next(fh)  # header
+                for line in fh:
+                    cols = line.split()
+                    if len(cols) >= 13 and cols[9] == inode:
+                        return int(cols[-1])
+    except (OSError, ValueError, StopIteration):
+        return None
+    return None
+
+
 def receive(
     conn: Any,
     on_message: Callable[[Any, float], Any],
