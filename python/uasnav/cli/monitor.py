@@ -82,7 +82,7 @@ def command(  # type: ignore[no-untyped-def]
     contingent_after_loss, telemetry_timeout, exit_when_ended, idle_exit,
 ):  # fmt: skip
     """Follow each vehicle on CONNECTION (udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT,
-    /dev/ttyX,BAUD) and report its F3548 conformance state changes (Accepted, Activated,
+    tcpin:HOST:PORT, /dev/ttyX,BAUD) and report its F3548 conformance state changes (Accepted, Activated,
     Nonconforming, Contingent, Ended) and telemetry losses."""
     from uasnav.io.operational_intent import read_intents
     from uasnav.live.conformance import ENDED, ConformanceMonitor, ContingencyRule

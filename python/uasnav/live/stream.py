@@ -1,7 +1,8 @@
 """Receiving a live MAVLink stream: pymavlink connections and the receive loop.
 
 ``CONNECTION`` takes pymavlink's forms: ``udpin:HOST:PORT`` (listen), ``udpout:HOST:PORT``,
-``tcp:HOST:PORT``, ``/dev/ttyX,BAUD`` (a serial port and its baud rate). Messages are decoded
+``tcp:HOST:PORT`` (connect), ``tcpin:HOST:PORT`` (listen for one sender), ``/dev/ttyX,BAUD`` (a
+serial port and its baud rate). Messages are decoded
 with the ``ardupilotmega`` dialect; packets that fail their checksum are dropped by pymavlink.
 """
 
@@ -26,8 +27,8 @@ def open_connection(text: str) -> Any:
     head = text.split(":", 1)[0]
     if head not in ("udpin", "udpout", "udp", "tcp", "tcpin") and not text.startswith("/dev/"):
         raise InputError(
-            f"connection {text!r}: expected udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT "
-            "or /dev/ttyX,BAUD"
+            f"connection {text!r}: expected udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT, "
+            "tcpin:HOST:PORT or /dev/ttyX,BAUD"
         )
     kw: dict[str, Any] = {"dialect": "ardupilotmega", "autoreconnect": True}
     if text.startswith("/dev/"):
