@@ -208,14 +208,16 @@ CONNECT_WAIT_S = 30.0
 
 
 def open_sender(
-    target: Target, *, wait_s: float = CONNECT_WAIT_S, on_wait: Callable[[str], Any] = lambda _: None
+    target: Target, *, wait_s: float | None = None, on_wait: Callable[[str], Any] = lambda _: None
 ) -> tuple[Callable[[bytes], Any], socket.socket]:
     """A sender of encoded packets to ``target`` and its socket (close it when done).
 
     UDP is fire and forget (nobody listening is not an error). TCP is a byte stream: the
     packets are written whole, in order; a receiver that closes the connection ends the
-    replay with :class:`LinkClosed`. ``on_wait`` is told once what a ``tcpin`` replay waits for.
+    replay with :class:`LinkClosed`. ``on_wait`` is told once what a ``tcpin`` replay waits for;
+    ``wait_s`` defaults to :data:`CONNECT_WAIT_S`.
     """
+    wait_s = CONNECT_WAIT_S if wait_s is None else wait_s
     try:
         infos = socket.getaddrinfo(
             target.host,
