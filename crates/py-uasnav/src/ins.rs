@@ -222,15 +222,7 @@ fn ins_run<'py>(
     #[pyo3(from_py_with = decimation_arg)] decimation: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cfg = config;
-    let Samples {
-        imu_t: it,
-        gyro: g,
-        accel: a,
-        gnss_t: gt,
-        gnss_llh: gl,
-        gnss_vel: gv,
-        gnss_acc: ga,
-    } = samples(
+    let arrays = samples(
         py, &imu_t, &gyro, &accel, &gnss_t, &gnss_llh, &gnss_vel, &gnss_acc,
     )?;
     let gu = gnss_use
@@ -261,10 +253,14 @@ fn ins_run<'py>(
         .map(|x| crate::convert::floats::<4>("initial_attitude", x))
         .transpose()?;
     if let Some(d) = d {
-        if d.len() != g.len() {
+        if d.len() != arrays.gyro.len() {
             return Err(input_error(
                 py,
-                format!("dbias_dtemp: expected {} rows, got {}", g.len(), d.len()),
+                format!(
+                    "dbias_dtemp: expected {} rows, got {}",
+                    arrays.gyro.len(),
+                    d.len()
+                ),
             ));
         }
     }
@@ -274,15 +270,15 @@ fn ins_run<'py>(
     let baro = pair(py, "baro_t/baro_h", bt, bh)?;
     let magp = pair(py, "mag_t/mag", mt, mf)?.map(|(t_s, field)| MagnetometerAiding { t_s, field });
     let input = InsBatchInput {
-        imu_t_s: it,
-        gyro_rad_s: g,
-        accel_m_s2: a,
+        imu_t_s: arrays.imu_t,
+        gyro_rad_s: arrays.gyro,
+        accel_m_s2: arrays.accel,
         temp_c: t,
         stationary: st,
-        gnss_t_s: gt,
-        gnss_llh: gl,
-        gnss_vel_m_s: gv,
-        gnss_acc: ga,
+        gnss_t_s: arrays.gnss_t,
+        gnss_llh: arrays.gnss_llh,
+        gnss_vel_m_s: arrays.gnss_vel,
+        gnss_acc: arrays.gnss_acc,
         gnss_use: gu,
         baro,
         mag: magp,
@@ -290,8 +286,8 @@ fn ins_run<'py>(
         levelling_samples,
         gyro_bias0_rad_s: gyro_bias0,
     };
-    let n = g.len();
-    let m = gt.len();
+    let n = arrays.gyro.len();
+    let m = arrays.gnss_t.len();
     let nrows = n.div_ceil(decimation);
     let result = py.detach(|| {
         let mut h: Hist = (
