@@ -1,14 +1,18 @@
 """Live telemetry on loopback: ``uasnav replay`` → ``uasnav monitor`` (F3548 conformance) and
-``uasnav replay`` → ``uasnav nav --live`` (= ``nav --causal``), over real UDP sockets between
-processes that the tests start and that stop by themselves (``--idle-exit``,
+``uasnav replay`` → ``uasnav nav --live`` (= ``nav --causal``), over real UDP and TCP sockets
+between processes that the tests start and that stop by themselves (``--idle-exit``,
 ``--exit-when-ended``)."""
 
 from __future__ import annotations
 
 import json
+import re
 import socket
 import subprocess
+import time
+from dataclasses import dataclass
 from datetime import datetime, timezone
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,34 +25,73 @@ TLOG = "flights/phoenix_mission1_arducopter.tlog"
 LOG171 = "logs/ardupilot_log171.bin"
 #: The tlog's second flight (log seconds after its first message): armed at 289 s, disarmed at 362 s.
 RUN = (280.0, 372.0)
-SPEED = 20.0
+#: Replay speed of the monitor scenarios: the monitor judges on vehicle time, so the outcome does
+#: not depend on it; the scenarios run side by side.
+SPEED = 40.0
+#: Scenarios that are not about telemetry loss allow a long silence (vehicle s) before
+#: Contingent: at SPEED a stall of the replaying process under load must not count as a C2 loss.
+PATIENT = ("--contingent-after-loss", "60")
 
 
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+def free_port(kind: int = socket.SOCK_DGRAM) -> int:
+    with socket.socket(socket.AF_INET, kind) as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
 
 
-def run_pair(receiver: list[str], sender: list[str], timeout: float = 90.0) -> tuple[str, str]:
-    """Start the receiver, then the sender; both end by themselves. Returns the receiver's
-    stdout and stderr."""
+def listening(port: int, proto: str) -> bool:
+    """Whether a socket of this machine is bound to ``port`` (UDP) or listens on it (TCP), from
+    ``/proc/net`` (probing by binding would race with the receiver's own bind)."""
+    for table in (f"/proc/net/{proto}", f"/proc/net/{proto}6"):
+        try:
+            lines = Path(table).read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for line in lines:
+            cols = line.split()
+            if int(cols[1].rsplit(":", 1)[1], 16) == port and (proto == "udp" or cols[3] == "0A"):
+                return True
+    return False
+
+
+@dataclass
+class Pair:
+    """A receiver and a sender process; :meth:`finish` waits for both to end by themselves."""
+
+    rx: subprocess.Popen[str]
+    tx: subprocess.Popen[str]
+
+    def finish(self, timeout: float = 120.0) -> tuple[str, str, str]:
+        """(receiver stdout, receiver stderr, sender stderr); both must exit 0."""
+        try:
+            _, tx_err = self.tx.communicate(timeout=timeout)
+            out, err = self.rx.communicate(timeout=timeout)
+        finally:
+            for p in (self.rx, self.tx):
+                if p.poll() is None:
+                    p.kill()
+                    p.wait()
+        assert self.tx.returncode == 0, tx_err
+        assert self.rx.returncode == 0, err
+        return out, err, tx_err
+
+
+def start_pair(receiver: list[str], sender: list[str], port: int, proto: str = "udp") -> Pair:
+    """Start the receiver, wait until it is bound to ``port``, then start the sender."""
     rx = subprocess.Popen(
         [*uasnav_command(), *receiver], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
-    try:
-        import time
-
-        time.sleep(1.5)  # the receiver binds its socket
-        tx = subprocess.run([*uasnav_command(), *sender], capture_output=True, text=True, timeout=timeout)
-        assert tx.returncode == 0, tx.stderr
-        out, err = rx.communicate(timeout=timeout)
-    finally:
-        if rx.poll() is None:
+    deadline = time.monotonic() + 60.0
+    while not listening(port, proto):
+        if rx.poll() is not None or time.monotonic() > deadline:
             rx.kill()
-            rx.wait()
-    assert rx.returncode == 0, err
-    return out, err
+            _, err = rx.communicate()
+            pytest.fail(f"the receiver did not bind {proto} port {port}: {err}")
+        time.sleep(0.05)
+    tx = subprocess.Popen(
+        [*uasnav_command(), *sender], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    return Pair(rx, tx)
 
 
 @pytest.fixture(scope="module")
@@ -128,77 +171,204 @@ def intent(shared_data, flown, tmp_path_factory):
     return out
 
 
-def monitor_events(shared_data, intent, *replay_args: str, monitor_args: tuple[str, ...] = ()) -> list[dict]:
-    port = free_udp_port()
-    out, _ = run_pair(
-        ["monitor", f"udpin:127.0.0.1:{port}", "--intent", str(intent), "--json-lines", "--idle-exit", "2",
-         "--exit-when-ended", *monitor_args],
-        ["replay", str(shared_data / TLOG), "--to", f"udp:127.0.0.1:{port}", "--speed", str(SPEED),
-         "--from", str(RUN[0]), *replay_args],
-    )  # fmt: skip
-    return [json.loads(line) for line in out.splitlines() if line.strip()]
+#: name → (replay arguments, monitor arguments, transport); every scenario replays the tlog
+#: from RUN[0].
+SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
+    "run": (("--stop-after", str(RUN[1])), PATIENT, "udp"),
+    "offset": (
+        ("--stop-after", str(RUN[1]), "--offset-after", f"{RUN[0] + 30}:0,100",
+         "--offset-until", str(RUN[0] + 50)),
+        (*PATIENT, "--exit-when-ended"),
+        "udp",
+    ),
+    "cut": (
+        ("--stop-after", str(RUN[0] + 40)),
+        ("--telemetry-timeout", "10", "--contingent-after-loss", "20", "--idle-exit", "1.5"),
+        "udp",
+    ),
+    "lossy": (
+        ("--stop-after", str(RUN[1]), "--drop", "0.1", "--duplicate", "0.3", "--seed", "3"), PATIENT, "udp"
+    ),
+    "tcp": (("--stop-after", str(RUN[1])), PATIENT, "tcp"),
+}  # fmt: skip
+
+
+@dataclass
+class Monitored:
+    """One scenario's outcome: the monitor's events and closing line, the replay's line."""
+
+    events: list[dict]
+    summary: str
+    sent: str
+
+
+@pytest.fixture(scope="module")
+def monitored(shared_data, intent) -> dict[str, Monitored]:
+    """Every scenario of :data:`SCENARIOS`, replay → monitor over loopback, run side by side."""
+    pairs = {}
+    for name, (replay_args, monitor_args, proto) in SCENARIOS.items():
+        port = free_port(socket.SOCK_STREAM if proto == "tcp" else socket.SOCK_DGRAM)
+        listen, to = (f"tcpin:127.0.0.1:{port}", f"tcp:127.0.0.1:{port}") if proto == "tcp" else (
+            f"udpin:127.0.0.1:{port}", f"udp:127.0.0.1:{port}"
+        )  # fmt: skip
+        pairs[name] = start_pair(
+            ["monitor", listen, "--intent", str(intent), "--json-lines", "--idle-exit", "2", *monitor_args],
+            ["replay", str(shared_data / TLOG), "--to", to, "--speed", str(SPEED), "--from", str(RUN[0]),
+             *replay_args],
+            port,
+            proto,
+        )  # fmt: skip
+    out = {}
+    for name, pair in pairs.items():
+        stdout, err, sent = pair.finish()
+        events = [json.loads(line) for line in stdout.splitlines() if line.strip()]
+        out[name] = Monitored(events, err.strip().splitlines()[-1], sent.strip().splitlines()[-1])
+    return out
+
+
+def transitions(events: list[dict]) -> list[dict]:
+    """The state changes among the events (every event carries the state it happened in)."""
+    return [e for e in events if e["event"] == "state"]
 
 
 def states(events: list[dict]) -> list[str]:
-    return [e["state"] for e in events if e["event"] == "state"]
+    return [e["state"] for e in transitions(events)]
 
 
-def test_replayed_flight_stays_activated_and_ends_on_landing(shared_data, intent):
-    ev = monitor_events(shared_data, intent, "--stop-after", str(RUN[1]))
+def count(pattern: str, text: str) -> int:
+    m = re.search(pattern, text)
+    assert m, (pattern, text)
+    return int(m.group(1))
+
+
+def test_replayed_flight_stays_activated_and_ends_on_landing(monitored):
+    ev = monitored["run"].events
     assert states(ev) == ["Accepted", "Activated", "Ended"], ev
-    act = next(e for e in ev if e["state"] == "Activated")
+    act = next(e for e in transitions(ev) if e["state"] == "Activated")
     assert act["margin_m"] > 0 and act["volume"] == 0
     # each event on a message carries its latency (measured, not asserted: see BENCHMARKS.md)
     assert all(e["latency_ms"] >= 0 for e in ev if e["event"] == "state" and e["state"] != "Accepted")
 
 
-def test_offset_goes_nonconforming_and_back(shared_data, intent, flown):
+@pytest.fixture(scope="module")
+def recorded_gaps(shared_data) -> int:
+    """Gaps in the tlog's own MAVLink sequence numbers over the replayed window: packets its
+    radio link lost when it was recorded."""
+    from uasnav.live.source import log_packets
+
+    last: dict[tuple[int, int], int] = {}
+    gaps, t0 = 0, None
+    for pk in log_packets(shared_data / TLOG):
+        t0 = pk.t_s if t0 is None else t0
+        if not RUN[0] <= pk.t_s - t0 <= RUN[1]:
+            if pk.t_s - t0 > RUN[1]:
+                break
+            continue
+        key, seq = (pk.msg.get_srcSystem(), pk.msg.get_srcComponent()), pk.msg.get_seq()
+        if key in last and (seq - last[key] - 1) % 256 < 128:
+            gaps += (seq - last[key] - 1) % 256
+        last[key] = seq
+    return gaps
+
+
+@pytest.mark.parametrize("scenario", ["run", "tcp"])
+def test_monitor_receives_every_packet_sent(monitored, recorded_gaps, scenario):
+    """Every packet sent is received, or counted where this machine dropped it (UDP: a full
+    kernel receive buffer); the losses by sequence number are the recording's own."""
+    m = monitored[scenario]
+    sent = count(r"sent (\d+) packets", m.sent)
+    received = count(r"(\d+) messages received", m.summary)
+    # the kernel's count is known for a UDP socket (Linux), not for a TCP stream
+    kernel = count(r"(\d+) dropped by a full kernel receive buffer", m.summary) if scenario == "run" else 0
+    queue = count(r"(\d+) dropped by a full queue", m.summary)
+    assert received + kernel + queue == sent, (m.sent, m.summary)
+    if scenario == "tcp":  # a stream: nothing can be lost on the way
+        assert received == sent, m.summary
+    if kernel == 0:
+        assert count(r"(\d+) lost by sequence number", m.summary) == recorded_gaps > 0
+    assert states(m.events) == ["Accepted", "Activated", "Ended"], m.events
+
+
+def test_offset_goes_nonconforming_and_back(monitored, flown):
     # 100 m east from 30 s into the window (after take-off) for 20 s: outside, back, Ended
     t_on, t_off = RUN[0] + 30, RUN[0] + 50
-    ev = monitor_events(
-        shared_data, intent, "--stop-after", str(RUN[1]), "--offset-after", f"{t_on}:0,100",
-        "--offset-until", str(t_off),
-    )  # fmt: skip
+    ev = monitored["offset"].events
     assert states(ev) == ["Accepted", "Activated", "Nonconforming", "Activated", "Ended"], ev
-    nc = next(e for e in ev if e["state"] == "Nonconforming")
+    nc = next(e for e in transitions(ev) if e["state"] == "Nonconforming")
     assert nc["margin_m"] < 0 and "horizontally" in nc["reason"]
     # judged at the first report after the shift: within one report interval (≈ 1 s, vehicle time)
     assert 0 <= nc["time_boot_s"] - flown["boot_at"](t_on) <= 1.0
-    back = [e for e in ev if e["state"] == "Activated"][1]
+    back = [e for e in transitions(ev) if e["state"] == "Activated"][1]
     assert 0 <= back["time_boot_s"] - flown["boot_at"](t_off) <= 1.0
     assert back["reason"] == "back inside the intent" and back["margin_m"] > 0
+    # --exit-when-ended stops at Ended, before the replay has sent its last packets
+    s = monitored["offset"].summary
+    assert s.endswith("stopped once every intent had Ended"), s
+    assert count(r"(\d+) messages received", s) < count(r"sent (\d+) packets", monitored["offset"].sent)
 
 
-def test_cut_stream_gives_telemetry_loss_then_contingent(shared_data, intent):
-    ev = monitor_events(
-        shared_data, intent, "--stop-after", str(RUN[0] + 40),
-        monitor_args=("--telemetry-timeout", "3", "--contingent-after-loss", "6", "--idle-exit", "1.5"),
-    )  # fmt: skip
+def test_cut_stream_gives_telemetry_loss_then_contingent(monitored):
+    ev = monitored["cut"].events
     kinds = [e["event"] if e["event"] != "state" else e["state"] for e in ev]
     assert "telemetry_lost" in kinds and kinds[-1] == "Contingent", kinds
     assert kinds.index("telemetry_lost") < kinds.index("Contingent")
     assert "telemetry lost" in ev[-1]["reason"]
 
 
-def test_loss_and_duplication_are_absorbed(shared_data, intent):
-    ev = monitor_events(
-        shared_data, intent, "--stop-after", str(RUN[1]), "--drop", "0.1", "--duplicate", "0.3", "--seed", "3"
-    )
-    assert states(ev) == ["Accepted", "Activated", "Ended"], ev
+def test_loss_and_duplication_are_absorbed(monitored):
+    m = monitored["lossy"]
+    assert states(m.events) == ["Accepted", "Activated", "Ended"], m.events
+    assert count(r"(\d+) dropped, ", m.sent) > 0 and count(r"(\d+) duplicated;", m.sent) > 0
+    assert count(r"\((\d+) duplicated/late skipped", m.summary) > 0
+
+
+def test_replay_tcpin_serves_the_first_receiver(shared_data):
+    """``--to tcpin:`` waits for a receiver to connect, then streams the packets whole."""
+    port = free_port(socket.SOCK_STREAM)
+    tx = subprocess.Popen(
+        [*uasnav_command(), "replay", str(shared_data / TLOG), "--to", f"tcpin:127.0.0.1:{port}",
+         "--speed", "100", "--from", str(RUN[0]), "--stop-after", str(RUN[0] + 10)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60.0
+        while not listening(port, "tcp"):
+            assert tx.poll() is None and time.monotonic() < deadline, tx.stderr.read() if tx.stderr else ""
+            time.sleep(0.05)
+        data = bytearray()
+        with socket.create_connection(("127.0.0.1", port), timeout=60) as s:
+            while chunk := s.recv(65536):
+                data += chunk
+        _, err = tx.communicate(timeout=60)
+    finally:
+        if tx.poll() is None:
+            tx.kill()
+            tx.wait()
+    assert tx.returncode == 0, err
+    assert "waiting up to 30 s for a receiver" in err
+    from uasnav.live.source import mavlink_dialect
+
+    mav = mavlink_dialect().MAVLink(None)
+    mav.robust_parsing = True
+    msgs = [m for m in mav.parse_buffer(bytes(data)) or [] if m.get_type() != "BAD_DATA"]
+    sent = count(r"sent (\d+) packets", err)
+    assert len(msgs) == sent > 100 and count(r"\((\d+) bytes", err) == len(data)
 
 
 def test_nav_live_equals_causal_bit_for_bit(shared_data, tmp_path):
     log = str(shared_data / LOG171)
+    port = free_port()
+    live = tmp_path / "live.csv"
+    pair = start_pair(
+        ["nav", "--live", f"udpin:127.0.0.1:{port}", "--out", str(live), "--idle-exit", "2"],
+        ["replay", log, "--to", f"udp:127.0.0.1:{port}", "--speed", "10", "--stop-after", "60"],
+        port,
+    )
+    # the offline run meanwhile (the live one must keep up all the same)
     causal = tmp_path / "causal.csv"
     r = CliRunner().invoke(main, ["nav", "--causal", log, "--out", str(causal)])
     assert r.exit_code == 0, r.output
-    port = free_udp_port()
-    live = tmp_path / "live.csv"
-    _, err = run_pair(
-        ["nav", "--live", f"udpin:127.0.0.1:{port}", "--out", str(live), "--idle-exit", "2"],
-        ["replay", log, "--to", f"udp:127.0.0.1:{port}", "--speed", "10", "--stop-after", "60"],
-        timeout=120,
-    )
+    _, err, _ = pair.finish()
     a = np.loadtxt(live, delimiter=",", skiprows=1)
     b = np.loadtxt(causal, delimiter=",", skiprows=1)
     assert a.shape[0] > 1000 and "0 refused" in err
@@ -208,40 +378,76 @@ def test_nav_live_equals_causal_bit_for_bit(shared_data, tmp_path):
 
 
 def test_replay_converts_dataflash_to_ground_station_messages(shared_data):
-    import itertools
+    from uasnav.live.source import log_packets, mavlink_dialect
 
-    from uasnav.live.source import log_packets
-
-    pk = list(itertools.islice(log_packets(shared_data / LOG171), 4000))
-    types = {p.msg.get_type() for p in pk}
+    pk = list(log_packets(shared_data / LOG171))
+    types = {p.msg.get_type() for p in pk[:4000]}
     assert {"RAW_IMU", "HEARTBEAT", "SYSTEM_TIME", "GPS_RAW_INT", "GLOBAL_POSITION_INT"} <= types
-    imu_t = np.array([p.t_s for p in pk if p.msg.get_type() == "RAW_IMU"])
+    imu_t = np.array([p.t_s for p in pk[:4000] if p.msg.get_type() == "RAW_IMU"])
     assert np.median(np.diff(imu_t)) == pytest.approx(0.02, abs=0.002)  # the logged 50 Hz
     assert all(np.diff([p.t_s for p in pk]) >= 0)
     # every message encodes (MAVLink 2) and decodes back to itself (floats as float32)
-    from uasnav.live.source import mavlink_dialect
-
     mav = mavlink_dialect().MAVLink(None, srcSystem=1, srcComponent=1)
     for p in pk[:300]:
         back = mav.decode(bytearray(p.msg.pack(mav))).to_dict()
         for k, v in p.msg.to_dict().items():
             assert back[k] == (pytest.approx(v, rel=1e-6, abs=1e-30) if isinstance(v, float) else v)
+    # the whole log encodes: RAW_IMU's int16 fields saturate (log171 logs a 35 rad/s gyro reading)
+    for p in pk:
+        p.msg.pack(mav)
+    gyro = np.array([[p.msg.xgyro, p.msg.ygyro, p.msg.zgyro] for p in pk if p.msg.get_type() == "RAW_IMU"])
+    assert gyro.max() == 32767
 
 
 def test_bad_input_is_one_error_line(tmp_path):
     r = CliRunner().invoke(main, ["replay", str(tmp_path / "x.csv"), "--to", "udp:127.0.0.1:9"])
     assert r.exit_code == 1 and "cannot replay .csv" in r.output
     r = CliRunner().invoke(main, ["replay", str(tmp_path / "x.tlog"), "--to", "tcp:x"])
-    assert r.exit_code == 1 and "--to: expected udp:HOST:PORT" in r.output
+    assert r.exit_code == 1 and "--to: expected udp:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT" in r.output
+    r = CliRunner().invoke(main, ["replay", str(tmp_path / "x.tlog"), "--to", "serial:127.0.0.1:5760"])
+    assert r.exit_code == 1 and "tcpin:HOST:PORT, got 'serial:" in r.output
     r = CliRunner().invoke(main, ["monitor", "bogus", "--intent", str(tmp_path / "none.json")])
     assert r.exit_code == 1 and "error:" in r.output
     r = CliRunner().invoke(main, ["nav", "--causal"])
     assert r.exit_code == 2 and "--causal needs LOG" in r.output
+    r = CliRunner().invoke(main, ["serve", "--live-intent", str(tmp_path / "a.json")])
+    assert r.exit_code == 2 and "--live-intent needs --live CONNECTION" in r.output
+    r = CliRunner().invoke(main, ["serve", "--live", "udpin:127.0.0.1:9"])
+    assert r.exit_code == 2 and "--live needs at least one --live-intent" in r.output
 
 
-def test_live_page_shows_the_state_change_in_chromium(shared_data, intent, monkeypatch):
+def test_replay_tcp_to_nobody_is_one_error_line(shared_data, monkeypatch):
+    import uasnav.live.replay as rp
+
+    monkeypatch.setattr(rp, "CONNECT_WAIT_S", 0.3)
+    port = free_port(socket.SOCK_STREAM)  # closed again: nobody listens
+    r = CliRunner().invoke(main, ["replay", str(shared_data / TLOG), "--to", f"tcp:127.0.0.1:{port}"])
+    assert r.exit_code == 1 and r.output.startswith(f"error: --to tcp:127.0.0.1:{port}: cannot connect"), (
+        r.output
+    )
+
+
+def test_kernel_drops_counts_a_full_receive_buffer():
+    import types
+
+    from uasnav.live.stream import kernel_drops
+
+    with (
+        socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as rx,
+        socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as tx,
+    ):
+        rx.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        rx.bind(("127.0.0.1", 0))
+        conn = types.SimpleNamespace(port=rx)
+        assert kernel_drops(conn) == 0
+        for _ in range(500):  # never read: the buffer fills
+            tx.sendto(b"x" * 100, rx.getsockname())
+        assert kernel_drops(conn) > 0
+    assert kernel_drops(types.SimpleNamespace(port=None)) is None
+
+
+def test_live_page_shows_the_state_change_in_chromium(shared_data, intent):
     import shutil
-    import time
 
     from playwright.sync_api import expect, sync_playwright
 
@@ -249,10 +455,11 @@ def test_live_page_shows_the_state_change_in_chromium(shared_data, intent, monke
 
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     assert chromium, "chromium is not installed: run `make setup`"
-    port = free_udp_port()
-    monkeypatch.setenv("UASNAV_LIVE_CONNECTION", f"udpin:127.0.0.1:{port}")
-    monkeypatch.setenv("UASNAV_LIVE_INTENTS", str(intent))
-    with running_server() as server, sync_playwright() as p:
+    port = free_port()
+    with (
+        running_server("--live", f"udpin:127.0.0.1:{port}", "--live-intent", str(intent)) as server,
+        sync_playwright() as p,
+    ):
         browser = p.chromium.launch(executable_path=chromium)
         try:
             page = browser.new_page()
@@ -268,10 +475,10 @@ def test_live_page_shows_the_state_change_in_chromium(shared_data, intent, monke
             )
             page.goto(server.url + "/live")
             page.wait_for_selector("#live-map polygon")  # the intent's volumes, drawn offline
-            time.sleep(1.0)  # the page's first request started the receiver
+            assert listening(port, "udp")  # serve --live receives from its start
             tx = subprocess.Popen(
                 [*uasnav_command(), "replay", str(shared_data / TLOG), "--to", f"udp:127.0.0.1:{port}",
-                 "--speed", str(SPEED), "--from", str(RUN[0]), "--stop-after", str(RUN[1])],
+                 "--speed", "20", "--from", str(RUN[0]), "--stop-after", str(RUN[1])],
                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
             )  # fmt: skip
             try:

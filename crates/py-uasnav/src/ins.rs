@@ -143,6 +143,40 @@ fn pair<A, B>(py: Python<'_>, what: &str, a: Option<A>, b: Option<B>) -> PyResul
     }
 }
 
+/// The IMU and GNSS arrays both entry points take, viewed as slices and rows.
+struct Samples<'a> {
+    imu_t: &'a [f64],
+    gyro: &'a [[f64; 3]],
+    accel: &'a [[f64; 3]],
+    gnss_t: &'a [f64],
+    gnss_llh: &'a [[f64; 3]],
+    gnss_vel: &'a [[f64; 3]],
+    gnss_acc: &'a [[f64; 3]],
+}
+
+/// Views the IMU and GNSS arguments (zero-copy); a wrong shape or layout names the argument.
+#[allow(clippy::too_many_arguments)]
+fn samples<'a>(
+    py: Python<'_>,
+    imu_t: &'a PyReadonlyArray1<'_, f64>,
+    gyro: &'a PyReadonlyArray2<'_, f64>,
+    accel: &'a PyReadonlyArray2<'_, f64>,
+    gnss_t: &'a PyReadonlyArray1<'_, f64>,
+    gnss_llh: &'a PyReadonlyArray2<'_, f64>,
+    gnss_vel: &'a PyReadonlyArray2<'_, f64>,
+    gnss_acc: &'a PyReadonlyArray2<'_, f64>,
+) -> PyResult<Samples<'a>> {
+    Ok(Samples {
+        imu_t: slice1(py, "imu_t", imu_t)?,
+        gyro: rows::<3>(py, "gyro", gyro)?,
+        accel: rows::<3>(py, "accel", accel)?,
+        gnss_t: slice1(py, "gnss_t", gnss_t)?,
+        gnss_llh: rows::<3>(py, "gnss_llh", gnss_llh)?,
+        gnss_vel: rows::<3>(py, "gnss_vel", gnss_vel)?,
+        gnss_acc: rows::<3>(py, "gnss_acc", gnss_acc)?,
+    })
+}
+
 type Hist = (
     Vec<[f64; 3]>,
     Vec<[f64; 3]>,
@@ -188,13 +222,9 @@ fn ins_run<'py>(
     #[pyo3(from_py_with = decimation_arg)] decimation: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cfg = config;
-    let it = slice1(py, "imu_t", &imu_t)?;
-    let g = rows::<3>(py, "gyro", &gyro)?;
-    let a = rows::<3>(py, "accel", &accel)?;
-    let gt = slice1(py, "gnss_t", &gnss_t)?;
-    let gl = rows::<3>(py, "gnss_llh", &gnss_llh)?;
-    let gv = rows::<3>(py, "gnss_vel", &gnss_vel)?;
-    let ga = rows::<3>(py, "gnss_acc", &gnss_acc)?;
+    let arrays = samples(
+        py, &imu_t, &gyro, &accel, &gnss_t, &gnss_llh, &gnss_vel, &gnss_acc,
+    )?;
     let gu = gnss_use
         .as_ref()
         .map(|x| bools(py, "gnss_use", x))
@@ -223,10 +253,14 @@ fn ins_run<'py>(
         .map(|x| crate::convert::floats::<4>("initial_attitude", x))
         .transpose()?;
     if let Some(d) = d {
-        if d.len() != g.len() {
+        if d.len() != arrays.gyro.len() {
             return Err(input_error(
                 py,
-                format!("dbias_dtemp: expected {} rows, got {}", g.len(), d.len()),
+                format!(
+                    "dbias_dtemp: expected {} rows, got {}",
+                    arrays.gyro.len(),
+                    d.len()
+                ),
             ));
         }
     }
@@ -236,15 +270,15 @@ fn ins_run<'py>(
     let baro = pair(py, "baro_t/baro_h", bt, bh)?;
     let magp = pair(py, "mag_t/mag", mt, mf)?.map(|(t_s, field)| MagnetometerAiding { t_s, field });
     let input = InsBatchInput {
-        imu_t_s: it,
-        gyro_rad_s: g,
-        accel_m_s2: a,
+        imu_t_s: arrays.imu_t,
+        gyro_rad_s: arrays.gyro,
+        accel_m_s2: arrays.accel,
         temp_c: t,
         stationary: st,
-        gnss_t_s: gt,
-        gnss_llh: gl,
-        gnss_vel_m_s: gv,
-        gnss_acc: ga,
+        gnss_t_s: arrays.gnss_t,
+        gnss_llh: arrays.gnss_llh,
+        gnss_vel_m_s: arrays.gnss_vel,
+        gnss_acc: arrays.gnss_acc,
         gnss_use: gu,
         baro,
         mag: magp,
@@ -252,8 +286,8 @@ fn ins_run<'py>(
         levelling_samples,
         gyro_bias0_rad_s: gyro_bias0,
     };
-    let n = g.len();
-    let m = gt.len();
+    let n = arrays.gyro.len();
+    let m = arrays.gnss_t.len();
     let nrows = n.div_ceil(decimation);
     let result = py.detach(|| {
         let mut h: Hist = (
@@ -347,13 +381,17 @@ impl PyInsStream {
         gnss_acc: PyReadonlyArray2<'py, f64>,
         gnss_before: PyReadonlyArray1<'py, u64>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let it = slice1(py, "imu_t", &imu_t)?;
-        let g = rows::<3>(py, "gyro", &gyro)?;
-        let a = rows::<3>(py, "accel", &accel)?;
-        let gt = slice1(py, "gnss_t", &gnss_t)?;
-        let gl = rows::<3>(py, "gnss_llh", &gnss_llh)?;
-        let gv = rows::<3>(py, "gnss_vel", &gnss_vel)?;
-        let ga = rows::<3>(py, "gnss_acc", &gnss_acc)?;
+        let Samples {
+            imu_t: it,
+            gyro: g,
+            accel: a,
+            gnss_t: gt,
+            gnss_llh: gl,
+            gnss_vel: gv,
+            gnss_acc: ga,
+        } = samples(
+            py, &imu_t, &gyro, &accel, &gnss_t, &gnss_llh, &gnss_vel, &gnss_acc,
+        )?;
         let gb = gnss_before.as_slice().map_err(|_| {
             input_error(py, "gnss_before: expected a contiguous uint64 array".into())
         })?;

@@ -82,11 +82,11 @@ def command(  # type: ignore[no-untyped-def]
     contingent_after_loss, telemetry_timeout, exit_when_ended, idle_exit,
 ):  # fmt: skip
     """Follow each vehicle on CONNECTION (udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT,
-    /dev/ttyX,BAUD) and report its F3548 conformance state changes (Accepted, Activated,
+    tcpin:HOST:PORT, /dev/ttyX,BAUD) and report its F3548 conformance state changes (Accepted, Activated,
     Nonconforming, Contingent, Ended) and telemetry losses."""
     from uasnav.io.operational_intent import read_intents
     from uasnav.live.conformance import ENDED, ConformanceMonitor, ContingencyRule
-    from uasnav.live.stream import open_connection, receive, stop_on_signals
+    from uasnav.live.stream import kernel_drops, open_connection, receive, stop_on_signals
 
     check_outputs(list(intent_paths), {"--out": out_path})
     intents = [it for p in intent_paths for it in read_intents(p)]
@@ -114,9 +114,10 @@ def command(  # type: ignore[no-untyped-def]
     def done() -> bool:
         return exit_when_ended and all(s == ENDED for s in monitor.states().values())
 
+    queue_dropped, kernel_dropped = 0, None
     try:
         with stop_on_signals() as stop:
-            receive(
+            queue_dropped = receive(
                 conn,
                 lambda msg, wall: emit(monitor.on_message(msg, wall), wall),
                 lambda wall: emit(monitor.on_tick(wall), None),
@@ -124,15 +125,28 @@ def command(  # type: ignore[no-untyped-def]
                 idle_timeout_s=idle_exit,
                 done=done,
             )
+        kernel_dropped = kernel_drops(conn)
     finally:
         if out is not None:
             out.close()
         conn.close()
-    s = monitor.stats
+    click.echo(summary(monitor.stats, queue_dropped, kernel_dropped, latencies, ended=done()), err=True)
+
+
+def summary(
+    s: Any, queue_dropped: int, kernel_dropped: int | None, latencies: list[float], *, ended: bool
+) -> str:
+    """The closing line: what was received and what was lost where. Losses ``by sequence
+    number`` are gaps in each sender's MAVLink sequence, so they include what the link lost
+    before this receiver (a recorded tlog carries its radio link's gaps); packets dropped on this
+    machine are counted apart (a full kernel receive buffer, a full queue)."""
+    here = f"{queue_dropped} dropped by a full queue"
+    if kernel_dropped is not None:
+        here = f"{kernel_dropped} dropped by a full kernel receive buffer, {here}"
     worst = f", latency ≤ {max(latencies):.1f} ms" if latencies else ""
-    click.echo(
-        f"{s.messages} messages, {s.position_reports} position reports "
-        f"({s.stale_reports} duplicated/late skipped, "
-        f"{s.seq_lost} lost by sequence number), {s.events} events{worst}",
-        err=True,
+    stop = "; stopped once every intent had Ended" if ended else ""
+    return (
+        f"{s.messages} messages received ({here}), {s.position_reports} position reports "
+        f"({s.stale_reports} duplicated/late skipped, {s.seq_lost} lost by sequence number), "
+        f"{s.events} events{worst}{stop}"
     )

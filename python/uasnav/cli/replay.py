@@ -9,7 +9,14 @@ from uasnav.cli._common import POSITIVE, SEED, Real
 
 @click.command("replay")
 @click.argument("log", type=click.Path(dir_okay=False))
-@click.option("--to", "target", required=True, help="Where to send: udp:HOST:PORT.")
+@click.option(
+    "--to",
+    "target",
+    required=True,
+    help="Where to send: udp:HOST:PORT (or udpout:HOST:PORT) as datagrams; tcp:HOST:PORT to a "
+    "listening receiver (retried until it listens, 30 s at most); tcpin:HOST:PORT to the first "
+    "receiver that connects (waits 30 s at most).",
+)
 @click.option("--speed", type=POSITIVE, default=1.0, show_default=True, help="Times real time.")
 @click.option("--loop", is_flag=True, help="Start again at the end, until interrupted.")
 @click.option(
@@ -38,16 +45,16 @@ from uasnav.cli._common import POSITIVE, SEED, Real
 @click.option("--seed", type=SEED, default=0, show_default=True, help="Seed of --drop/--duplicate.")
 def command(log, target, speed, loop, offset_text, offset_until, drop, duplicate, start_s, stop_after, seed):  # type: ignore[no-untyped-def]
     """Send LOG (.tlog as recorded; .bin/.ulg converted to the MAVLink messages a ground station
-    receives) to a UDP address in its recorded timing, scaled by --speed."""
-    from uasnav.live.replay import parse_offset, parse_udp_target, replay, udp_sender
+    receives) over UDP or TCP in its recorded timing, scaled by --speed."""
+    from uasnav.live.replay import open_sender, parse_offset, parse_target, replay
     from uasnav.live.source import log_packets
 
-    host, port = parse_udp_target(target)
+    to = parse_target(target)
     if offset_until is not None and not offset_text:
         raise click.UsageError("--offset-until needs --offset-after")
     offset = parse_offset(offset_text, offset_until) if offset_text else None
     first = iter(log_packets(log))  # open (and check) the log before the first packet leaves
-    send, sock = udp_sender(host, port)
+    send, sock = open_sender(to, on_wait=lambda text: click.echo(text, err=True))
     passes = [first]
 
     def packets():  # type: ignore[no-untyped-def]

@@ -8,7 +8,6 @@ from typing import Any
 import click
 
 from uasnav.errors import InputError
-from uasnav.web.security import LOOPBACK_HOSTS
 
 
 def is_loopback(host: str) -> bool:
@@ -33,6 +32,23 @@ def is_loopback(host: str) -> bool:
     multiple=True,
     help="Further Host name the server answers to (repeatable; the loopback names always are).",
 )
+@click.option(
+    "--live",
+    "live_connection",
+    metavar="CONNECTION",
+    help="Receive live MAVLink telemetry for the /live page on CONNECTION (udpin:HOST:PORT, "
+    "udpout:HOST:PORT, tcp:HOST:PORT, tcpin:HOST:PORT, /dev/ttyX,BAUD), from the start. Without it, the "
+    "UASNAV_LIVE_CONNECTION and UASNAV_LIVE_INTENTS (paths separated by the OS path separator) "
+    "environment variables are used, if set.",
+)
+@click.option(
+    "--live-intent",
+    "live_intents",
+    multiple=True,
+    type=click.Path(dir_okay=False),
+    help="Operational intent JSON flown on the --live stream; repeat for several vehicles "
+    "(system 1 flies the first, 2 the second …).",
+)
 def command(
     host: str,
     port: int,
@@ -40,22 +56,33 @@ def command(
     regulations: str | None,
     matrices: str | None,
     allow_hosts: tuple[str, ...],
+    live_connection: str | None,
+    live_intents: tuple[str, ...],
 ) -> None:
-    """Start the web application: mission selection, trajectory prediction, database pages and
-    the JSON API (/api, /openapi.json), fully offline.
+    """Start the web application: mission selection, trajectory prediction, database pages,
+    the live telemetry page (/live) and the JSON API (/api, /openapi.json), fully offline.
 
     The documents are loaded once, at start; requests never name a file or URL. Requests whose
     Host is not this server, or cross-site form posts, are refused (DNS rebinding, CSRF).
     """
+    if live_intents and not live_connection:
+        raise click.UsageError("--live-intent needs --live CONNECTION")
+    if live_connection and not live_intents:
+        raise click.UsageError("--live needs at least one --live-intent INTENT.json")
     import uvicorn
 
     from uasnav.web.app import create_app, load_documents
+    from uasnav.web.security import LOOPBACK_HOSTS
     from uasnav.web.server_limits import harden, uvicorn_settings
 
     settings = uvicorn_settings()  # invalid deadlines in the environment: refused first
     addr = _address(host, port)
     docs = load_documents(db, matrices, regulations)
     _check_bindable(host, port, addr)
+    if live_connection:
+        from uasnav.web.live import configure
+
+        configure(live_connection, list(live_intents))
     extra = tuple(allow_hosts)
     if host.strip("[]").lower() not in LOOPBACK_HOSTS and host not in ("0.0.0.0", "::"):
         extra += (host.strip("[]"),)

@@ -1,4 +1,4 @@
-"""Send a recorded flight as a live MAVLink stream over UDP (``uasnav replay``).
+"""Send a recorded flight as a live MAVLink stream over UDP or TCP (``uasnav replay``).
 
 Messages leave in the log's timing divided by ``speed`` (a monotonic schedule, so a slow send
 does not accumulate delay); the vehicle's own clocks inside the messages (``time_boot_ms``,
@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from uasnav.errors import InputError
+from uasnav.errors import InputError, UasnavError
 from uasnav.live.source import Packet, mavlink_dialect
 
 #: Messages whose ``lat``/``lon`` (1e-7 deg) an offset shifts.
@@ -59,13 +59,38 @@ def parse_offset(text: str, until_s: float | None = None) -> Offset:
     return off
 
 
-def parse_udp_target(text: str) -> tuple[str, int]:
-    """``udp:HOST:PORT`` (or ``udpout:HOST:PORT``) → (host, port)."""
+#: Forms of ``--to``: ``udp``/``udpout`` send datagrams to HOST:PORT; ``tcp`` connects to a
+#: listening receiver; ``tcpin`` listens and sends to the first receiver that connects (as a
+#: vehicle or simulator serving ``tcp:5760``).
+TARGET_SCHEMES = ("udp", "udpout", "tcp", "tcpin")
+
+
+@dataclass(frozen=True)
+class Target:
+    """Where a replay sends: ``scheme`` (one of :data:`TARGET_SCHEMES`), ``host``, ``port``."""
+
+    scheme: str
+    host: str
+    port: int
+
+    def __str__(self) -> str:
+        return f"{self.scheme}:{self.host}:{self.port}"
+
+
+def parse_target(text: str) -> Target:
+    """``udp:HOST:PORT``, ``udpout:HOST:PORT``, ``tcp:HOST:PORT`` or ``tcpin:HOST:PORT`` →
+    :class:`Target` (pymavlink's connection strings, seen from the sender).
+
+    >>> parse_target("tcpin:127.0.0.1:5760")
+    Target(scheme='tcpin', host='127.0.0.1', port=5760)
+    """
     scheme, _, rest = text.partition(":")
     host, _, port = rest.rpartition(":")
-    if scheme not in ("udp", "udpout") or not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise InputError(f"--to: expected udp:HOST:PORT, got {text!r}")
-    return host, int(port)
+    if scheme not in TARGET_SCHEMES or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise InputError(
+            f"--to: expected udp:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT or tcpin:HOST:PORT, got {text!r}"
+        )
+    return Target(scheme, host.strip("[]"), int(port))
 
 
 def shift_position(msg: Any, north_m: float, east_m: float) -> None:
@@ -173,19 +198,92 @@ def replay(
             return stats
 
 
-def udp_sender(host: str, port: int) -> tuple[Callable[[bytes], Any], socket.socket]:
-    """A datagram sender to ``host:port`` and its socket (close it when done)."""
+class LinkClosed(UasnavError):
+    """The receiver of a TCP replay closed the connection."""
+
+
+#: How long ``tcp`` keeps trying to connect to a receiver that is not listening yet (s), and
+#: how long ``tcpin`` waits for a receiver to connect (s).
+CONNECT_WAIT_S = 30.0
+
+
+def open_sender(
+    target: Target, *, wait_s: float | None = None, on_wait: Callable[[str], Any] = lambda _: None
+) -> tuple[Callable[[bytes], Any], socket.socket]:
+    """A sender of encoded packets to ``target`` and its socket (close it when done).
+
+    UDP is fire and forget (nobody listening is not an error). TCP is a byte stream: the
+    packets are written whole, in order; a receiver that closes the connection ends the
+    replay with :class:`LinkClosed`. ``on_wait`` is told once what a ``tcpin`` replay waits for;
+    ``wait_s`` defaults to :data:`CONNECT_WAIT_S`.
+    """
+    wait_s = CONNECT_WAIT_S if wait_s is None else wait_s
     try:
-        infos = socket.getaddrinfo(host, port, type=socket.SOCK_DGRAM)
-    except OSError as e:
-        raise InputError(f"--to: cannot resolve {host}:{port} ({e})") from None
-    family, _, _, _, addr = infos[0]
-    sock = socket.socket(family, socket.SOCK_DGRAM)
+        infos = socket.getaddrinfo(
+            target.host,
+            target.port,
+            type=socket.SOCK_DGRAM if target.scheme.startswith("udp") else socket.SOCK_STREAM,
+            flags=socket.AI_PASSIVE if target.scheme == "tcpin" else 0,
+        )
+    except (OSError, UnicodeError) as e:
+        raise InputError(f"--to {target}: cannot resolve {target.host} ({e})") from None
+    family, kind, proto, _, addr = infos[0]
+    if target.scheme in ("udp", "udpout"):
+        sock = socket.socket(family, kind, proto)
 
-    def send(data: bytes) -> None:
+        def send_datagram(data: bytes) -> None:
+            try:
+                sock.sendto(data, addr)
+            except ConnectionRefusedError:
+                pass  # nobody listening yet (ICMP port unreachable): UDP telemetry is fire and forget
+
+        return send_datagram, sock
+    if target.scheme == "tcp":
+        sock = _tcp_connect(target, infos[0], wait_s)
+    else:
+        sock = _tcp_accept(target, infos[0], wait_s, on_wait)
+    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+
+    def send_stream(data: bytes) -> None:
         try:
-            sock.sendto(data, addr)
-        except ConnectionRefusedError:
-            pass  # nobody listening yet (ICMP port unreachable): UDP telemetry is fire and forget
+            sock.sendall(data)
+        except (BrokenPipeError, ConnectionResetError, ConnectionAbortedError):
+            raise LinkClosed(f"--to {target}: the receiver closed the connection") from None
 
-    return send, sock
+    return send_stream, sock
+
+
+def _tcp_connect(target: Target, info: Any, wait_s: float) -> socket.socket:
+    family, kind, proto, _, addr = info
+    deadline = time.monotonic() + wait_s
+    while True:
+        sock = socket.socket(family, kind, proto)
+        try:
+            sock.connect(addr)
+            return sock
+        except OSError as e:
+            sock.close()
+            if not isinstance(e, ConnectionRefusedError) or time.monotonic() >= deadline:
+                raise InputError(
+                    f"--to {target}: cannot connect ({e.strerror or e}; waited {wait_s:g} s)"
+                ) from None
+            time.sleep(0.1)  # the receiver is not listening yet
+
+
+def _tcp_accept(target: Target, info: Any, wait_s: float, on_wait: Callable[[str], Any]) -> socket.socket:
+    family, kind, proto, _, addr = info
+    with socket.socket(family, kind, proto) as server:
+        server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            server.bind(addr)
+        except OSError as e:
+            raise InputError(f"--to {target}: cannot listen ({e.strerror or e})") from None
+        server.listen(1)
+        server.settimeout(wait_s)
+        on_wait(f"waiting up to {wait_s:g} s for a receiver to connect to {target.host}:{target.port}")
+        try:
+            sock, _ = server.accept()
+        except TimeoutError:
+            raise InputError(f"--to {target}: no receiver connected within {wait_s:g} s") from None
+    sock.settimeout(None)
+    return sock

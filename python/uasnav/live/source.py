@@ -13,7 +13,7 @@ message               from                                                  rate
 ``GPS_RAW_INT``       ``gnss``: AMSL and ellipsoidal heights, accuracies    each fix
 ``GLOBAL_POSITION_INT`` ``autopilot_estimate`` (AMSL), else the GNSS fixes   ≤ 10 Hz
 ``ATTITUDE``          ``autopilot_estimate`` Euler angles                   ≤ 10 Hz
-``RAW_IMU`` (.bin)    the primary IMU, mG and mrad/s as ArduPilot sends     logged rate
+``RAW_IMU`` (.bin)    the primary IMU, mG and mrad/s, int16 (saturated)     logged rate
 ``HIGHRES_IMU`` (.ulg) the primary IMU, m/s² and rad/s as PX4 sends          logged rate
 ===================== ===================================================== ==============
 
@@ -139,11 +139,18 @@ def _i(x: float) -> int:
     return round(float(x))
 
 
+def _i16(x: float) -> int:
+    """``x`` rounded and saturated to an int16 field (``RAW_IMU``'s range, as the autopilot
+    clips a reading beyond it)."""
+    return min(max(_i(x), -32768), 32767)
+
+
 def _converted_packets(p: Path) -> Iterator[Packet]:
     """DataFlash/ULog → messages (module table), merged in time order."""
     from uasnav.io import open_log
 
-    log = open_log(p)
+    # one decoding pass for every view the conversion reads
+    log = open_log(p, need=("imu", "identity", "gnss", "autopilot_estimate"))
     mav = mavlink_dialect()
     px4 = p.suffix.lower() == ".ulg"
     streams: list[Iterator[Packet]] = []
@@ -161,8 +168,8 @@ def _converted_packets(p: Path) -> Iterator[Packet]:
                     us, *map(float, a), *map(float, g), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0x3F
                 )
             else:
-                acc = [_i(x / _G * 1000.0) for x in a]
-                gyr = [_i(x * 1000.0) for x in g]
+                acc = [_i16(x / _G * 1000.0) for x in a]
+                gyr = [_i16(x * 1000.0) for x in g]
                 m = mav.MAVLink_raw_imu_message(us, *acc, *gyr, 0, 0, 0)
             yield Packet(float(t), m)
 

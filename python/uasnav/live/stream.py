@@ -1,7 +1,8 @@
 """Receiving a live MAVLink stream: pymavlink connections and the receive loop.
 
 ``CONNECTION`` takes pymavlink's forms: ``udpin:HOST:PORT`` (listen), ``udpout:HOST:PORT``,
-``tcp:HOST:PORT``, ``/dev/ttyX,BAUD`` (a serial port and its baud rate). Messages are decoded
+``tcp:HOST:PORT`` (connect), ``tcpin:HOST:PORT`` (listen for one sender), ``/dev/ttyX,BAUD`` (a
+serial port and its baud rate). Messages are decoded
 with the ``ardupilotmega`` dialect; packets that fail their checksum are dropped by pymavlink.
 """
 
@@ -26,8 +27,8 @@ def open_connection(text: str) -> Any:
     head = text.split(":", 1)[0]
     if head not in ("udpin", "udpout", "udp", "tcp", "tcpin") and not text.startswith("/dev/"):
         raise InputError(
-            f"connection {text!r}: expected udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT "
-            "or /dev/ttyX,BAUD"
+            f"connection {text!r}: expected udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT, "
+            "tcpin:HOST:PORT or /dev/ttyX,BAUD"
         )
     kw: dict[str, Any] = {"dialect": "ardupilotmega", "autoreconnect": True}
     if text.startswith("/dev/"):
@@ -74,6 +75,30 @@ def _enlarge_buffer(conn: Any) -> None:
     if isinstance(sock, socket.socket) and sock.type == socket.SOCK_DGRAM:
         with contextlib.suppress(OSError):
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, UDP_RCVBUF)
+
+
+def kernel_drops(conn: Any) -> int | None:
+    """Datagrams the kernel dropped for the connection's UDP socket because its receive buffer
+    was full (Linux: the ``drops`` column of ``/proc/net/udp{,6}`` for the socket's inode);
+    None when unknown (not UDP, not Linux, or the socket is closed)."""
+    import os
+    import socket
+
+    sock = getattr(conn, "port", None)
+    if not isinstance(sock, socket.socket) or sock.type != socket.SOCK_DGRAM or sock.fileno() < 0:
+        return None
+    try:
+        inode = str(os.fstat(sock.fileno()).st_ino)
+        for table in ("/proc/net/udp", "/proc/net/udp6"):
+            with open(table, encoding="ascii") as fh:
+                next(fh)  # header
+                for line in fh:
+                    cols = line.split()
+                    if len(cols) >= 13 and cols[9] == inode:
+                        return int(cols[-1])
+    except (OSError, ValueError, StopIteration):
+        return None
+    return None
 
 
 def receive(

@@ -1,14 +1,16 @@
 """The ``/live`` page: a vehicle on live MAVLink telemetry, its intent's volumes, its F3548
 conformance state and the causal GNSS/INS solution with its protection levels.
 
-The stream is configured when the server starts, by environment variables (a web page never
-chooses which port or device the server opens):
+The stream is configured when the server starts (a web page never chooses which port or
+device the server opens): ``uasnav serve --live CONNECTION --live-intent INTENT.json …``
+(:func:`configure`: the intents are read and the connection opened before the server answers,
+and the stream is received from then on), or else by environment variables, read at the first
+request of the page:
 
 - ``UASNAV_LIVE_CONNECTION`` — a pymavlink connection string (``udpin:127.0.0.1:14550`` …);
-- ``UASNAV_LIVE_INTENTS`` — operational intent JSON files, separated by ``os.pathsep``
-  (vehicle 1 flies the first, 2 the second …).
+- ``UASNAV_LIVE_INTENTS`` — operational intent JSON files, separated by ``os.pathsep``.
 
-One background thread receives the stream (from the first request of the page on) and feeds
+Vehicle 1 flies the first intent, 2 the second … One background thread receives the stream and feeds
 the conformance monitor (:mod:`uasnav.live.conformance`) and the filter
 (:mod:`uasnav.live.nav`). ``/live/events`` sends a snapshot as a server-sent event every
 :data:`PERIOD_S` (10 Hz); ``/live/intents`` gives the volumes for the offline SVG map.
@@ -55,6 +57,14 @@ class LiveHub:
         self.error: str | None = None
         self._thread: threading.Thread | None = None
         self._stop = [False]
+        self._conn: Any = None
+
+    def open(self) -> None:
+        """Open the connection now (a bad string or a port in use is an ``InputError``)."""
+        from uasnav.live.stream import open_connection
+
+        if self._conn is None:
+            self._conn = open_connection(self.connection)
 
     def start(self) -> None:
         if self._thread is None:
@@ -69,7 +79,7 @@ class LiveHub:
         from uasnav.live.stream import open_connection, receive
 
         try:
-            conn = open_connection(self.connection)
+            conn = self._conn if self._conn is not None else open_connection(self.connection)
             nav = LiveNav()
         except Exception as e:  # shown on the page: the server itself keeps serving
             self.error = str(e)
@@ -162,9 +172,26 @@ _hub: LiveHub | None = None
 _hub_lock = threading.Lock()
 
 
-def hub() -> LiveHub | None:
-    """The hub of the configured stream (started on first use), or None when not configured."""
+def configure(connection: str, intent_paths: list[str]) -> LiveHub:
+    """Serve ``connection`` with ``intent_paths`` on ``/live`` (``serve --live``): read the
+    intents, open the connection and start receiving now; errors are ``InputError``s."""
     global _hub
+    h = LiveHub(connection, intent_paths)
+    h.open()
+    with _hub_lock:
+        if _hub is not None:
+            _hub.stop()
+        _hub = h
+    h.start()
+    return h
+
+
+def hub() -> LiveHub | None:
+    """The hub of the configured stream (:func:`configure`, else the environment variables,
+    started on first use), or None when not configured."""
+    global _hub
+    if _hub is not None:
+        return _hub
     conn = os.environ.get(CONNECTION_ENV, "").strip()
     paths = [p for p in os.environ.get(INTENTS_ENV, "").split(os.pathsep) if p.strip()]
     if not conn or not paths:
@@ -186,7 +213,7 @@ def live_intents() -> JSONResponse:
     h = hub()
     if h is None:
         return JSONResponse(
-            {"volumes": [], "error": f"no live stream configured ({CONNECTION_ENV}, {INTENTS_ENV})"}
+            {"volumes": [], "error": f"no live stream configured (serve --live, or {CONNECTION_ENV})"}
         )
     return JSONResponse(h.volumes())
 
@@ -199,7 +226,10 @@ async def live_events(request: Request) -> StreamingResponse:
             snap = (
                 h.snapshot()
                 if h is not None
-                else {"error": f"no live stream configured: set {CONNECTION_ENV} and {INTENTS_ENV}"}
+                else {
+                    "error": "no live stream configured: start uasnav serve with --live CONNECTION "
+                    f"--live-intent INTENT.json (or set {CONNECTION_ENV} and {INTENTS_ENV})"
+                }
             )
             yield f"data: {json.dumps(snap, ensure_ascii=False)}\n\n"
             await asyncio.sleep(PERIOD_S)

@@ -787,6 +787,26 @@ impl<T: Real> InsFilter<T> {
         self.p[(8, 8)] = std_rad * std_rad;
         Ok(())
     }
+
+    /// Resets the yaw to the course over ground of the GNSS velocity `vel_m_s` (m/s, NED) when
+    /// the ground speed exceeds `course_min_speed_m_s`; returns whether it did. The course's σ
+    /// is 5° (crab, sideslip) plus the speed accuracy `speed_acc_m_s` (m/s, floored at
+    /// `gnss_min_std_velocity_m_s`) over the ground speed.
+    pub fn reset_heading_to_course(
+        &mut self,
+        vel_m_s: &[T; 3],
+        speed_acc_m_s: T,
+    ) -> Result<bool, NavError> {
+        let speed = num_traits::Float::sqrt(vel_m_s[0] * vel_m_s[0] + vel_m_s[1] * vel_m_s[1]);
+        if speed > self.cfg.course_min_speed_m_s {
+            let course = num_traits::Float::atan2(vel_m_s[1], vel_m_s[0]);
+            let sd = lit::<T>(5.0_f64.to_radians())
+                + num_traits::Float::max(speed_acc_m_s, self.cfg.gnss_min_std_velocity_m_s) / speed;
+            self.reset_heading(course, sd)?;
+            return Ok(true);
+        }
+        Ok(false)
+    }
 }
 
 /// Magnetometer input of the batch runner.
@@ -1198,17 +1218,9 @@ impl<T: Real> InsFilter<T> {
             while jg < m && input.gnss_t_s[jg] <= tk {
                 if usable(jg) {
                     let vel = input.gnss_vel_m_s[jg];
-                    if !heading_known {
-                        let speed = num_traits::Float::sqrt(vel[0] * vel[0] + vel[1] * vel[1]);
-                        if speed > config.course_min_speed_m_s {
-                            let course = num_traits::Float::atan2(vel[1], vel[0]);
-                            // Crab/sideslip and speed noise: 5° plus s_acc/speed.
-                            let sd = lit::<T>(5.0_f64.to_radians())
-                                + num_traits::Float::max(input.gnss_acc[jg][2], floor_v) / speed;
-                            f.reset_heading(course, sd)?;
-                            heading_known = true;
-                            summary.course_reset = true;
-                        }
+                    if !heading_known && f.reset_heading_to_course(&vel, input.gnss_acc[jg][2])? {
+                        heading_known = true;
+                        summary.course_reset = true;
                     }
                     let age = tk - input.gnss_t_s[jg];
                     let st = f.update_gnss(&input.gnss_llh[jg], &vel, &input.gnss_acc[jg], age)?;

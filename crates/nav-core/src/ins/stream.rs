@@ -241,18 +241,9 @@ impl<T: Real> InsStream<T> {
                 what: "stream",
                 reason: "filter not running",
             })?;
-            let floor_v = self.config.gnss_min_std_velocity_m_s;
-            if !self.heading_known {
-                let v = fx.vel_m_s;
-                let speed = num_traits::Float::sqrt(v[0] * v[0] + v[1] * v[1]);
-                if speed > self.config.course_min_speed_m_s {
-                    let course = num_traits::Float::atan2(v[1], v[0]);
-                    let sd = lit::<T>(5.0_f64.to_radians())
-                        + num_traits::Float::max(fx.acc[2], floor_v) / speed;
-                    f.reset_heading(course, sd)?;
-                    self.heading_known = true;
-                    self.counts.course_reset = true;
-                }
+            if !self.heading_known && f.reset_heading_to_course(&fx.vel_m_s, fx.acc[2])? {
+                self.heading_known = true;
+                self.counts.course_reset = true;
             }
             let st = f.update_gnss(&fx.llh, &fx.vel_m_s, &fx.acc, t_s - fx.t_s)?;
             if matches!(st, FixStatus::Used | FixStatus::SeparationAlert) {
