@@ -8,6 +8,7 @@ far above its expected time, so a regression fails instead of stalling CI.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import random
 import subprocess
@@ -417,3 +418,286 @@ def test_an_output_name_ending_in_a_separator_is_a_usage_error(tmp_path: Path) -
     res = CliRunner().invoke(main, ["simulate", "--profile", "static", "--duration", "1", "--out", out])
     assert res.exit_code == 2 and "names a directory" in res.stderr
     assert not (tmp_path / "m.json").exists()
+
+
+# -- 4. internal errors that are input errors (second pass) -------------------------------------
+
+_GNSS_HEADER = "t,lat,lon,alt,vn,ve,vd,h_acc,v_acc,s_acc\n"
+
+
+def _imu_csv(p: Path, n: int = 600) -> Path:
+    p.write_text("t,gx,gy,gz,ax,ay,az\n" + "".join(f"{i / 100:.2f},0,0,0,0,0,9.81\n" for i in range(n)))
+    return p
+
+
+def _gnss_csv(p: Path, lon: str = "8.0", alt: str = "400") -> Path:
+    rows = "".join(f"{i / 5:.1f},47.0,{lon},{alt},0,0,0,1,1,0.1\n" for i in range(30))
+    p.write_text(_GNSS_HEADER + rows)
+    return p
+
+
+def _unchanged(paths: list[Path]) -> dict[Path, bytes]:
+    return {p: p.read_bytes() for p in paths}
+
+
+@pytest.mark.parametrize(
+    "make,needle",
+    [
+        (lambda p: p.write_text(_GNSS_HEADER), "no fixes (a header only)"),
+        (lambda p: _gnss_csv(p, lon="1000"), "gnss.lon: 1000° is outside -180…360° at row 0"),
+        (lambda p: _gnss_csv(p, alt="1e308"), "gnss.alt: 1e+308 m is beyond ±100000 m at row 0"),
+    ],
+)
+def test_a_bad_gnss_csv_is_one_line_naming_the_file(tmp_path: Path, make, needle: str) -> None:  # type: ignore[no-untyped-def]
+    imu = _imu_csv(tmp_path / "imu.csv")
+    gnss = tmp_path / "gnss.csv"
+    make(gnss)
+    before = _unchanged([imu, gnss])
+    out = tmp_path / "track.csv"
+    res = CliRunner().invoke(main, ["nav", str(imu), "--gnss", str(gnss), "--out", str(out)])
+    line = _one_error_line(res)
+    assert needle in line and "gnss.csv" in line, line
+    assert _unchanged([imu, gnss]) == before and not out.exists()
+
+
+def test_a_parquet_of_another_schema_is_not_an_element_dataset(tmp_path: Path) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from uasnav.trajectory.element_table import ELEMENT_SCHEMA
+
+    wrong = tmp_path / "wrong.parquet"
+    pq.write_table(pa.table({"a": [1, 2], "b": ["x", "y"]}), wrong)
+    texts = tmp_path / "texts.parquet"
+    pq.write_table(pa.table({f.name: pa.array(["x", "y"]) for f in ELEMENT_SCHEMA}), texts)
+    out = tmp_path / "m.json"
+    line = _one_error_line(CliRunner().invoke(main, ["trajectory", "train", str(wrong), "--out", str(out)]))
+    assert "wrong.parquet: not an element dataset: missing column(s) run, element" in line
+    line = _one_error_line(CliRunner().invoke(main, ["trajectory", "train", str(texts), "--out", str(out)]))
+    assert "texts.parquet: column 'run' is string, expected int32" in line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "mounting,needle",
+    [
+        ("[[1,0", "is not a 3×3 JSON matrix"),
+        ('{"a": 1}', "is not a 3×3 JSON matrix"),
+        ("[[1,0,0],[0,1,0]]", "got shape (2, 3)"),
+        ("[[1e999,0,0],[0,1,0],[0,0,1]]", "non-finite entries"),
+        ("[" * 3000 + "]" * 3000, "is not a 3×3 JSON matrix"),
+    ],
+)
+def test_a_malformed_mounting_comment_is_one_line(tmp_path: Path, mounting: str, needle: str) -> None:
+    body = _imu_csv(tmp_path / "body.csv", 200).read_text()
+    bad = tmp_path / "s1.csv"
+    bad.write_text(f"# mounting: {mounting}\n" + body)
+    good = tmp_path / "s2.csv"
+    good.write_text("# mounting: [[1,0,0],[0,1,0],[0,0,1]]\n" + body)
+    out = tmp_path / "fused.csv"
+    res = CliRunner().invoke(
+        main, ["redundancy", "fuse", "--shape", "meta", str(bad), str(good), str(good), "--out", str(out)]
+    )
+    line = _one_error_line(res)
+    assert "s1.csv: '# mounting:'" in line and needle in line, line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "text,needle",
+    [
+        ("", "not a preset: not valid JSON"),
+        ("[1, 2]", "not a preset: expected a JSON object, got list"),
+        ('{"a":' * 3000 + "1" + "}" * 3000, "nested deeper than 64 levels"),
+    ],
+)
+@pytest.mark.parametrize("profile", ["static", "flight"])
+def test_a_bad_preset_json_is_one_line(tmp_path: Path, text: str, needle: str, profile: str) -> None:
+    preset = tmp_path / "p.json"
+    preset.write_text(text)
+    out = tmp_path / "s.csv"
+    res = CliRunner().invoke(
+        main,
+        ["simulate", "--preset", str(preset), "--profile", profile, "--duration", "1", "--out", str(out)],
+    )
+    line = _one_error_line(res)
+    assert "p.json" in line and needle in line, line
+    assert not out.exists() and preset.read_text() == text
+
+
+def _area(tmp_path: Path, ring: list[list[float]]) -> Path:
+    import json
+
+    p = tmp_path / "area.geojson"
+    p.write_text(json.dumps({"type": "Polygon", "coordinates": [ring]}))
+    return p
+
+
+ZONES = DATA / "utm" / "interuss_ed269_geozone_sample.json"
+
+
+@pytest.mark.parametrize(
+    "ring", [[[8.0, 47.0], [8.01, 47.0]], [[8.0, 47.0], [8.01, 47.0], [8.0, 47.0]]], ids=["two", "closed-two"]
+)
+def test_a_two_point_area_with_zones_is_a_usage_error(tmp_path: Path, ring: list[list[float]]) -> None:
+    res = CliRunner().invoke(main, ["select", "--area", str(_area(tmp_path, ring)), "--zones", str(ZONES)])
+    assert res.exit_code == 2, res.output
+    assert "a polygon ring needs at least 3 distinct corners, got 2" in res.stderr
+    assert "Traceback" not in res.output and "internal error" not in res.output
+
+
+def test_an_unclosed_area_ring_is_closed_with_a_warning(tmp_path: Path) -> None:
+    from uasnav.mission.zones import parse_area
+
+    ring = [[8.0, 47.0], [8.01, 47.0], [8.01, 47.01], [8.0, 47.01]]
+    with pytest.warns(UserWarning, match=r"area.coordinates\[0\]: polygon ring not closed"):
+        area = parse_area({"type": "Polygon", "coordinates": [ring]})
+    closed = parse_area({"type": "Polygon", "coordinates": [[*ring, ring[0]]]})
+    assert area.parts == closed.parts
+
+
+def _fleet_with_manifest(tmp_path: Path) -> tuple[Path, Path]:
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    _imu_csv(logs / "a.csv", 300)
+    out = tmp_path / "scan.parquet"
+    res = CliRunner().invoke(main, ["fleet", "scan", str(logs), "--out", str(out), "--workers", "0"])
+    assert res.exit_code == 0, res.output
+    return logs, out
+
+
+@pytest.mark.parametrize(
+    "extra,needle",
+    [
+        ("junk\n", "line 2: corrupt manifest line"),
+        ("[" * 100_000 + "]" * 100_000 + "\n", "nested deeper than 64 levels"),
+        ("[1, 2]\n", "expected a JSON object, got list"),
+        ('{"path": [1], "size": 1, "mtime_ns": 1, "log_hash": "h", "table": "scan", "status": "ok"}\n',
+         "path: [1] is not of the expected type"),
+        ('{"path": "p", "size": "x", "mtime_ns": 1, "log_hash": "h", "table": "scan", "status": "ok"}\n',
+         'size: "x" is not of the expected type'),
+    ],
+)  # fmt: skip
+def test_fleet_resume_refuses_a_junk_manifest_in_one_line(tmp_path: Path, extra: str, needle: str) -> None:
+    logs, out = _fleet_with_manifest(tmp_path)
+    manifest = out / "_manifest.jsonl"
+    manifest.write_text(manifest.read_text() + extra + "{}\n")  # not the last line: not a torn write
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    res = CliRunner().invoke(
+        main, ["fleet", "scan", str(logs), "--out", str(out), "--workers", "0", "--resume"]
+    )
+    line = _one_error_line(res)
+    assert "_manifest.jsonl" in line and needle in line, line
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+
+
+def test_fleet_resume_with_another_analysis_is_refused(tmp_path: Path) -> None:
+    logs, out = _fleet_with_manifest(tmp_path)
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    res = CliRunner().invoke(
+        main, ["fleet", "imu-health", str(logs), "--out", str(out), "--workers", "0", "--resume"]
+    )
+    line = _one_error_line(res)
+    assert "a dataset of scan, not imu_health" in line
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+
+
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["--scheduler", "xyz://"], "unknown address scheme 'xyz'"),
+        (["--scheduler-file", "{garbage}"], "not a Dask scheduler file"),
+        (["--scheduler-file", "{noaddress}"], "expected an address like tcp://HOST:8786"),
+    ],
+)
+def test_fleet_refuses_a_bad_scheduler_in_one_line(tmp_path: Path, args: list[str], needle: str) -> None:
+    (tmp_path / "garbage.json").write_text("garbage\n")
+    (tmp_path / "noaddress.json").write_text('{"address": 5}\n')
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    _imu_csv(logs / "a.csv", 100)
+    out = tmp_path / "o.parquet"
+    argv = [a.format(garbage=tmp_path / "garbage.json", noaddress=tmp_path / "noaddress.json") for a in args]
+    line = _one_error_line(CliRunner().invoke(main, ["fleet", "scan", str(logs), "--out", str(out), *argv]))
+    assert needle in line, line
+    assert not out.exists()
+
+
+# -- 5. slow peers (loopback) ------------------------------------------------------------------
+
+
+class _Loopback:
+    """A TCP server on 127.0.0.1 that accepts and then, per connection, either says nothing
+    (not a Dask scheduler) or answers an HTTP request one byte per second; it stops by itself."""
+
+    def __init__(self, mode: str, lifetime_s: float = 60.0) -> None:
+        import socket
+
+        self.mode, self.end = mode, time.monotonic() + lifetime_s
+        self.sock = socket.create_server(("127.0.0.1", 0))
+        self.sock.settimeout(0.2)
+        self.port = self.sock.getsockname()[1]
+        self.conns: list[object] = []
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        while time.monotonic() < self.end:
+            try:
+                c, _ = self.sock.accept()
+            except OSError:
+                continue
+            self.conns.append(c)
+            if self.mode == "drip":
+                threading.Thread(target=self._drip, args=(c,), daemon=True).start()
+        self.close()
+
+    def _drip(self, c) -> None:  # type: ignore[no-untyped-def]
+        try:
+            c.recv(65536)
+            c.sendall(b"HTTP/1.1 200 OK\r\nContent-Length: 1000000\r\n\r\n")
+            while time.monotonic() < self.end:
+                c.sendall(b"x")
+                time.sleep(1.0)
+        except OSError:
+            pass
+
+    def close(self) -> None:
+        self.end = 0.0
+        for c in [self.sock, *self.conns]:
+            with contextlib.suppress(OSError):
+                c.close()  # type: ignore[attr-defined]
+
+
+def test_a_port_that_never_speaks_dask_is_refused_within_the_deadline(tmp_path: Path) -> None:
+    from uasnav.fleet.runner import check_scheduler
+
+    srv = _Loopback("silent")
+    try:
+        t0 = time.monotonic()
+        with pytest.raises(InputError, match=r"no Dask scheduler answered within 1 s"):
+            check_scheduler(f"tcp://127.0.0.1:{srv.port}", timeout_s=1.0)
+        assert time.monotonic() - t0 < 30  # a hang detector; the deadline is 1 s
+    finally:
+        srv.close()
+
+
+def test_a_slow_drip_url_in_a_fleet_list_is_bounded_by_the_log_timeout(tmp_path: Path) -> None:
+    srv = _Loopback("drip")
+    try:
+        urls = tmp_path / "logs.urls"
+        urls.write_text(f"http://127.0.0.1:{srv.port}/a.ulg\n")
+        out = tmp_path / "u.parquet"
+        t0 = time.monotonic()
+        res = CliRunner().invoke(
+            main,
+            ["fleet", "scan", str(urls), "--out", str(out), "--workers", "0", "--log-timeout", "2", "--json"],
+        )
+        assert time.monotonic() - t0 < 30
+        assert res.exit_code == 0, res.output
+        import json
+
+        summary = json.loads(res.stdout)
+        assert summary["errors"] == 1
+        assert "no complete answer within the timeout of 2 s" in summary["error_list"][0]["error"]
+    finally:
+        srv.close()
