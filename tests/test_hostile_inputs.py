@@ -701,3 +701,78 @@ def test_a_slow_drip_url_in_a_fleet_list_is_bounded_by_the_log_timeout(tmp_path:
         assert "no complete answer within the timeout of 2 s" in summary["error_list"][0]["error"]
     finally:
         srv.close()
+
+
+# -- 7. progress lines end before the error line -------------------------------------------------
+
+
+def test_a_fleet_progress_bar_ends_its_line_when_the_run_fails(monkeypatch: pytest.MonkeyPatch) -> None:
+    import io
+
+    from uasnav.cli.fleet import _progress
+
+    class Tty(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    err = Tty()
+    monkeypatch.setattr(sys, "stderr", err)
+    progress = _progress()
+    progress(1, 4)  # the run fails here: the bar is left at 1/4
+    assert not err.getvalue().endswith("\n")
+    progress.close()  # type: ignore[attr-defined]
+    assert err.getvalue().endswith("\n")
+
+
+def test_a_progress_bar_then_an_error_is_one_clean_error_line(tmp_path: Path) -> None:
+    """``trajectory calibrate`` shows its runs on a click progress bar: a failure inside it
+    ends with the bar's line and then exactly one ``error:`` line, no library warning folded in."""
+    import click
+
+    from uasnav.cli import _Group
+
+    @click.group(cls=_Group)
+    def grp() -> None:
+        pass
+
+    @grp.command()
+    def runs() -> None:
+        with click.progressbar(length=10, label="simulated runs", file=sys.stderr) as bar:
+            bar.update(3)
+            raise InputError("run 4: the model diverged")
+
+    res = CliRunner().invoke(grp, ["runs"])
+    assert res.exit_code == 1
+    assert res.stderr.endswith("\nerror: run 4: the model diverged\n"), repr(res.stderr)
+    assert [ln for ln in res.stderr.splitlines() if ln.startswith("error")] == [
+        "error: run 4: the model diverged"
+    ]
+
+
+def test_trajectory_progress_bars_use_no_deprecated_click_stream() -> None:
+    src = (Path(__file__).resolve().parents[1] / "python" / "uasnav" / "cli" / "trajectory.py").read_text()
+    assert "get_text_stream" not in src  # deprecated in click 8.2: its warning joined the error line
+
+
+# -- 8. extreme speeds ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("speed,needle", [("1e6", "1e6 is not <= 150"), ("1e-300", "1e-300 is not >= 0.1")])
+@pytest.mark.parametrize(
+    "cmd,option",
+    [
+        (["trajectory", "predict", "--wind", "0@0"], "--speed"),
+        (["trajectory", "intent", "--wind", "0@0"], "--speed"),
+        (["trajectory", "intent", "--wind", "0@0"], "--climb-rate"),
+        (["trajectory", "intent", "--wind", "0@0"], "--descent-rate"),
+    ],
+)
+def test_an_extreme_speed_is_a_usage_error(
+    tmp_path: Path, cmd: list[str], option: str, speed: str, needle: str
+) -> None:
+    model = tmp_path / "m.json"
+    model.write_text("{}")
+    plan = tmp_path / "p.csv"
+    plan.write_text("lat,lon,alt\n47,8,50\n47.001,8,50\n")
+    res = CliRunner().invoke(main, [*cmd, "--model", str(model), "--plan", str(plan), option, speed])
+    assert res.exit_code == 2 and needle in res.stderr, res.output

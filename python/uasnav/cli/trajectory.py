@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -16,6 +17,7 @@ from uasnav.cli._common import (
     POSITIVE,
     PROBABILITY,
     SEED,
+    UAS_SPEED,
     OutputPath,
     Real,
     check_outputs,
@@ -58,7 +60,7 @@ _common_opts = [
         "--plan", type=click.Path(dir_okay=False), help="Plan CSV (lat,lon,alt) for logs without a mission."
     ),
     click.option(
-        "--speed", type=POSITIVE, help="Commanded speed (m/s); default from the log (WPNAV_SPEED …)."
+        "--speed", type=UAS_SPEED, help="Commanded speed (m/s); default from the log (WPNAV_SPEED …)."
     ),
     click.option(
         "--wind", "wind_text", help="Wind SPEED@DIR (m/s, deg wind comes from); default the log's or calm."
@@ -198,7 +200,7 @@ def train(
 @click.option("--model", "model_path", required=True, type=click.Path(dir_okay=False))
 @click.option("--plan", "plan_path", required=True, type=click.Path(dir_okay=False))
 @click.option("--wind", "wind_text", required=True, help="SPEED@DIR: m/s @ degrees the wind comes from.")
-@click.option("--speed", type=POSITIVE, help="Commanded speed (m/s); default the model's.")
+@click.option("--speed", type=UAS_SPEED, help="Commanded speed (m/s); default the model's.")
 @click.option("--required", help="4D plan: required time (s from start) at each waypoint, T0,T1,….")
 @click.option("--tolerance", type=NON_NEGATIVE, default=5.0, show_default=True, help="4D time tolerance (s).")
 @click.option(
@@ -634,9 +636,7 @@ def calibrate(model_path, out, runs, test_runs, coverage, flight_logs, seed, as_
     check_runs(runs + test_runs, "--runs + --test-runs")
     check_outputs([model_path], {"--out": out})
     model = load_model(model_path)
-    with click.progressbar(
-        length=runs + test_runs, label="simulated runs", file=click.get_text_stream("stderr")
-    ) as bar:
+    with click.progressbar(length=runs + test_runs, label="simulated runs", file=sys.stderr) as bar:
         cal = simulated_runs(model, runs, seed=2 * seed, progress=lambda i, n: bar.update(1))
         test = simulated_runs(model, test_runs, seed=2 * seed + 1, progress=lambda i, n: bar.update(1))
     model.time_bounds_ = fit_bounds(cal, source=f"{runs} simulated runs, seed {seed}")
@@ -738,15 +738,15 @@ def _calibrate_from_flights(
     "point (NGA's 15′ grid, shipped with uasnav).",
 )
 @click.option("--home-alt", type=Real(-1000.0, 9000.0), help="Home altitude AMSL (m) if the plan has none.")
-@click.option("--speed", type=POSITIVE, help="Horizontal speed (m/s); default the plan's, else the model's.")
+@click.option("--speed", type=UAS_SPEED, help="Horizontal speed (m/s); default the plan's, else the model's.")
 @click.option(
     "--climb-rate",
-    type=POSITIVE,
+    type=UAS_SPEED,
     help="Climb speed (m/s); default a kinematic model's own limit, else ArduPilot's 2.5.",
 )
 @click.option(
     "--descent-rate",
-    type=POSITIVE,
+    type=UAS_SPEED,
     help="Descent speed (m/s); default a kinematic model's own limit, else ArduPilot's 1.5.",
 )
 @click.option(
@@ -816,7 +816,7 @@ def intent(  # type: ignore[no-untyped-def]
 
         check_runs(calibration_runs, "--calibration-runs")
         with click.progressbar(
-            length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
+            length=calibration_runs, label="calibrating time bounds", file=sys.stderr
         ) as bar:
             # calibrated at the speed this mission flies (the band depends on it)
             v = speed or plan_cruise_speed(plan) or model.cruise_ms_
