@@ -776,3 +776,76 @@ def test_an_extreme_speed_is_a_usage_error(
     plan.write_text("lat,lon,alt\n47,8,50\n47.001,8,50\n")
     res = CliRunner().invoke(main, [*cmd, "--model", str(model), "--plan", str(plan), option, speed])
     assert res.exit_code == 2 and needle in res.stderr, res.output
+
+
+# -- 8. silent wrong answers -----------------------------------------------------------------------
+
+
+def test_the_link_range_is_tested_against_the_pilot_distance() -> None:
+    """A Phantom 4 Pro's link does not reach 50 km: --max-distance, not only --range, is what the
+    C2 link must cover."""
+    res = CliRunner().invoke(main, ["select", "--max-distance", "50000", "--json"])
+    assert res.exit_code == 0, res.output
+    import json
+
+    out = json.loads(res.stdout)
+    text = json.dumps(out)
+    assert "link-range" in text
+    feasible = out.get("feasible_uas") or out.get("feasible") or []
+    assert not any("Phantom 4 Pro" in json.dumps(u) for u in feasible)
+
+
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["--range", "1e-320"], "1e-320 is not >= 1"),
+        (["--range", "1e308"], "1e308 is not <= 1e+06"),
+        (["--max-distance", "1e308"], "1e308 is not <= 1e+06"),
+    ],
+)
+def test_absurd_ranges_are_usage_errors(args: list[str], needle: str) -> None:
+    res = CliRunner().invoke(main, ["select", *args])
+    assert res.exit_code == 2 and needle in res.stderr, res.output
+
+
+def test_limits_from_a_log_without_limits_is_refused(tmp_path: Path) -> None:
+    empty = tmp_path / "empty.tlog"
+    empty.write_bytes(b"")
+    rnd = tmp_path / "random.bin"
+    rnd.write_bytes(random.Random(3).randbytes(5000))
+    model = tmp_path / "m.json"
+    out = tmp_path / "i.json"
+    res = CliRunner().invoke(
+        main, ["trajectory", "train", str(TLOG), "--method", "kinematic", "--out", str(model)]
+    )
+    assert res.exit_code == 0, res.output
+    plan = DATA / "missions" / "mavsdk_qgroundcontrol_sample.plan"
+    for bad in (empty, rnd):
+        res = CliRunner().invoke(
+            main,
+            ["trajectory", "intent", "--model", str(model), "--plan", str(plan), "--wind", "0@0",
+             "--start", "2026-01-01T10:00:00Z", "--limits-from", str(bad), "--out", str(out)],
+        )  # fmt: skip
+        line = _one_error_line(res)
+        assert f"--limits-from {bad}: no vehicle limits in this log" in line, line
+        assert not out.exists()
+
+
+def test_a_die_temperature_below_absolute_zero_is_refused(tmp_path: Path) -> None:
+    p = tmp_path / "cold.csv"
+    rows = "".join(f"{i / 100:.2f},0,0,0,0,0,9.81,{-300 if i == 50 else 25}\n" for i in range(300))
+    p.write_text("t,gx,gy,gz,ax,ay,az,temp\n" + rows)
+    line = _one_error_line(CliRunner().invoke(main, ["allan", str(p)]))
+    assert "cold.csv: temp: -300 °C at sample 50 is outside -273.15…1000 °C" in line
+
+
+@pytest.mark.parametrize("kw", [{"window_s": -1.0}, {"window_s": float("nan")}, {"min_duration_s": -1.0}])
+def test_detect_static_refuses_a_negative_or_nan_duration(kw: dict[str, float]) -> None:
+    import numpy as np
+
+    from uasnav.imu import ImuLog
+    from uasnav.stationary import detect_static
+
+    log = ImuLog(t=np.arange(500) / 100, gyro=np.zeros((500, 3)), accel=np.tile([0, 0, 9.81], (500, 1)))
+    with pytest.raises(ValueError, match=next(iter(kw))):
+        detect_static(log, **kw)

@@ -811,6 +811,24 @@ def intent(  # type: ignore[no-untyped-def]
             accel_z, from_log = lim.accel_z_ms2, [*from_log, "accel_z_ms2"]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
+        found = [
+            k for k in ("climb_ms", "descent_ms", "accel_z_ms2", "cruise_ms") if getattr(lim, k) is not None
+        ]
+        if not found:
+            raise InputError(
+                f"--limits-from {limits_log}: no vehicle limits in this log (empty, corrupt, or without "
+                "autopilot parameters); give --climb-rate/--descent-rate/--speed or another log"
+            )
+        explicit = {"climb_ms": climb_rate, "descent_ms": descent_rate, "cruise_ms": speed}
+        defaulted = [
+            k for k in ("climb_ms", "descent_ms", "accel_z_ms2") if k not in found and explicit.get(k) is None
+        ]
+        if defaulted:
+            warnings.warn(
+                f"--limits-from {limits_log}: {', '.join(defaulted)} not in the log's parameters; "
+                "the model's defaults are used for them",
+                stacklevel=1,
+            )
     if model.time_bounds_ is None:
         from uasnav.trajectory.calibration import check_runs
 
