@@ -849,3 +849,36 @@ def test_detect_static_refuses_a_negative_or_nan_duration(kw: dict[str, float]) 
     log = ImuLog(t=np.arange(500) / 100, gyro=np.zeros((500, 3)), accel=np.tile([0, 0, 9.81], (500, 1)))
     with pytest.raises(ValueError, match=next(iter(kw))):
         detect_static(log, **kw)
+
+
+# -- 6. a plan's prediction work, estimated before it is accepted -----------------------------------
+
+
+def _big_plan_csv(n: int) -> bytes:
+    return ("north,east\n" + "".join(f"{(i % 2) * 50.0:.1f},{i * 10.0:.1f}\n" for i in range(n))).encode()
+
+
+def test_the_web_refuses_a_plan_too_costly_to_predict_with_its_estimate() -> None:
+    from uasnav.web.prediction import FieldError, read_uploaded_plan
+
+    t0 = time.perf_counter()
+    with pytest.raises(FieldError, match=r"plan: 100000 plan points need about 1\.5e\+11 operations") as e:
+        read_uploaded_plan("big.csv", _big_plan_csv(100_000))
+    assert e.value.field == "plan" and "split the plan" in str(e.value)
+    assert time.perf_counter() - t0 < 30  # refused before any prediction
+    assert read_uploaded_plan("small.csv", _big_plan_csv(50)).route_ne.shape == (50, 2)
+
+
+def test_the_cli_estimates_a_prediction_before_running_it(tmp_path: Path) -> None:
+    plan = tmp_path / "big.csv"
+    plan.write_bytes(_big_plan_csv(1000))
+    model = tmp_path / "m.json"
+    model.write_text("{}")
+    res = CliRunner(env={"UASNAV_MAX_WORK": "1e6"}).invoke(
+        main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "0@0"]
+    )
+    line = _one_error_line(res)
+    assert (
+        "a prediction of 1000 plan points needs about 1.5e+09 operations" in line
+        and "UASNAV_MAX_WORK" in line
+    )

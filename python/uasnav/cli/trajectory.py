@@ -237,8 +237,14 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3
     # options first, files second: a typo in an option is reported before any file is read
     wind = parse_wind(wind_text)
     req = parse_float_list(required, "--required") if required else None
-    model = load_model(model_path)
+    from uasnav.limits import PREDICTION_OPS_PER_POINT, check_work
+
     plan_ne, _ = read_plan_route(plan_path, other_as_csv=True)
+    # estimated before the model is even read: a plan of 10⁵ points costs minutes of CPU
+    check_work(
+        len(plan_ne) * PREDICTION_OPS_PER_POINT, f"{plan_path}: a prediction of {len(plan_ne)} plan points"
+    )
+    model = load_model(model_path)
     p = model.predict(plan_ne, wind, speed)
     feas = None
     if req is not None:
