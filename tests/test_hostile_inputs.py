@@ -836,7 +836,7 @@ def test_a_die_temperature_below_absolute_zero_is_refused(tmp_path: Path) -> Non
     rows = "".join(f"{i / 100:.2f},0,0,0,0,0,9.81,{-300 if i == 50 else 25}\n" for i in range(300))
     p.write_text("t,gx,gy,gz,ax,ay,az,temp\n" + rows)
     line = _one_error_line(CliRunner().invoke(main, ["allan", str(p)]))
-    assert "cold.csv: temp: -300 °C at sample 50 is outside -273.15…1000 °C" in line
+    assert "cold.csv: temp: -300 °C at row 50 is outside -273.15…1000 °C" in line
 
 
 @pytest.mark.parametrize("kw", [{"window_s": -1.0}, {"window_s": float("nan")}, {"min_duration_s": -1.0}])

@@ -155,7 +155,7 @@ class ImuLog:
             if bad.size:  # a corrupt or mis-scaled column (K, m°C), not a temperature in °C
                 i = int(bad[0])
                 raise InputError(
-                    f"temp: {temp[i]:g} °C at sample {i} is outside "
+                    f"temp: {temp[i]:g} °C at row {i} is outside "
                     f"{ABSOLUTE_ZERO_C:g}…{MAX_DIE_TEMP_C:g} °C "
                     "(absolute zero to beyond any working sensor die)"
                 )
