@@ -8,6 +8,7 @@ far above its expected time, so a regression fails instead of stalling CI.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import random
 import subprocess
@@ -417,3 +418,467 @@ def test_an_output_name_ending_in_a_separator_is_a_usage_error(tmp_path: Path) -
     res = CliRunner().invoke(main, ["simulate", "--profile", "static", "--duration", "1", "--out", out])
     assert res.exit_code == 2 and "names a directory" in res.stderr
     assert not (tmp_path / "m.json").exists()
+
+
+# -- 4. internal errors that are input errors (second pass) -------------------------------------
+
+_GNSS_HEADER = "t,lat,lon,alt,vn,ve,vd,h_acc,v_acc,s_acc\n"
+
+
+def _imu_csv(p: Path, n: int = 600) -> Path:
+    p.write_text("t,gx,gy,gz,ax,ay,az\n" + "".join(f"{i / 100:.2f},0,0,0,0,0,9.81\n" for i in range(n)))
+    return p
+
+
+def _gnss_csv(p: Path, lon: str = "8.0", alt: str = "400") -> Path:
+    rows = "".join(f"{i / 5:.1f},47.0,{lon},{alt},0,0,0,1,1,0.1\n" for i in range(30))
+    p.write_text(_GNSS_HEADER + rows)
+    return p
+
+
+def _unchanged(paths: list[Path]) -> dict[Path, bytes]:
+    return {p: p.read_bytes() for p in paths}
+
+
+@pytest.mark.parametrize(
+    "make,needle",
+    [
+        (lambda p: p.write_text(_GNSS_HEADER), "no fixes (a header only)"),
+        (lambda p: _gnss_csv(p, lon="1000"), "gnss.lon: 1000° is outside -180…360° at row 0"),
+        (lambda p: _gnss_csv(p, alt="1e308"), "gnss.alt: 1e+308 m is beyond ±100000 m at row 0"),
+    ],
+)
+def test_a_bad_gnss_csv_is_one_line_naming_the_file(tmp_path: Path, make, needle: str) -> None:  # type: ignore[no-untyped-def]
+    imu = _imu_csv(tmp_path / "imu.csv")
+    gnss = tmp_path / "gnss.csv"
+    make(gnss)
+    before = _unchanged([imu, gnss])
+    out = tmp_path / "track.csv"
+    res = CliRunner().invoke(main, ["nav", str(imu), "--gnss", str(gnss), "--out", str(out)])
+    line = _one_error_line(res)
+    assert needle in line and "gnss.csv" in line, line
+    assert _unchanged([imu, gnss]) == before and not out.exists()
+
+
+def test_a_parquet_of_another_schema_is_not_an_element_dataset(tmp_path: Path) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from uasnav.trajectory.element_table import ELEMENT_SCHEMA
+
+    wrong = tmp_path / "wrong.parquet"
+    pq.write_table(pa.table({"a": [1, 2], "b": ["x", "y"]}), wrong)
+    texts = tmp_path / "texts.parquet"
+    pq.write_table(pa.table({f.name: pa.array(["x", "y"]) for f in ELEMENT_SCHEMA}), texts)
+    out = tmp_path / "m.json"
+    line = _one_error_line(CliRunner().invoke(main, ["trajectory", "train", str(wrong), "--out", str(out)]))
+    assert "wrong.parquet: not an element dataset: missing column(s) run, element" in line
+    line = _one_error_line(CliRunner().invoke(main, ["trajectory", "train", str(texts), "--out", str(out)]))
+    assert "texts.parquet: column 'run' is string, expected int32" in line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "mounting,needle",
+    [
+        ("[[1,0", "is not a 3×3 JSON matrix"),
+        ('{"a": 1}', "is not a 3×3 JSON matrix"),
+        ("[[1,0,0],[0,1,0]]", "got shape (2, 3)"),
+        ("[[1e999,0,0],[0,1,0],[0,0,1]]", "non-finite entries"),
+        ("[" * 3000 + "]" * 3000, "is not a 3×3 JSON matrix"),
+    ],
+)
+def test_a_malformed_mounting_comment_is_one_line(tmp_path: Path, mounting: str, needle: str) -> None:
+    body = _imu_csv(tmp_path / "body.csv", 200).read_text()
+    bad = tmp_path / "s1.csv"
+    bad.write_text(f"# mounting: {mounting}\n" + body)
+    good = tmp_path / "s2.csv"
+    good.write_text("# mounting: [[1,0,0],[0,1,0],[0,0,1]]\n" + body)
+    out = tmp_path / "fused.csv"
+    res = CliRunner().invoke(
+        main, ["redundancy", "fuse", "--shape", "meta", str(bad), str(good), str(good), "--out", str(out)]
+    )
+    line = _one_error_line(res)
+    assert "s1.csv: '# mounting:'" in line and needle in line, line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "text,needle",
+    [
+        ("", "not a preset: not valid JSON"),
+        ("[1, 2]", "not a preset: expected a JSON object, got list"),
+        ('{"a":' * 3000 + "1" + "}" * 3000, "nested deeper than 64 levels"),
+    ],
+)
+@pytest.mark.parametrize("profile", ["static", "flight"])
+def test_a_bad_preset_json_is_one_line(tmp_path: Path, text: str, needle: str, profile: str) -> None:
+    preset = tmp_path / "p.json"
+    preset.write_text(text)
+    out = tmp_path / "s.csv"
+    res = CliRunner().invoke(
+        main,
+        ["simulate", "--preset", str(preset), "--profile", profile, "--duration", "1", "--out", str(out)],
+    )
+    line = _one_error_line(res)
+    assert "p.json" in line and needle in line, line
+    assert not out.exists() and preset.read_text() == text
+
+
+def _area(tmp_path: Path, ring: list[list[float]]) -> Path:
+    import json
+
+    p = tmp_path / "area.geojson"
+    p.write_text(json.dumps({"type": "Polygon", "coordinates": [ring]}))
+    return p
+
+
+ZONES = DATA / "utm" / "interuss_ed269_geozone_sample.json"
+
+
+@pytest.mark.parametrize(
+    "ring", [[[8.0, 47.0], [8.01, 47.0]], [[8.0, 47.0], [8.01, 47.0], [8.0, 47.0]]], ids=["two", "closed-two"]
+)
+def test_a_two_point_area_with_zones_is_a_usage_error(tmp_path: Path, ring: list[list[float]]) -> None:
+    res = CliRunner().invoke(main, ["select", "--area", str(_area(tmp_path, ring)), "--zones", str(ZONES)])
+    assert res.exit_code == 2, res.output
+    assert "a polygon ring needs at least 3 distinct corners, got 2" in res.stderr
+    assert "Traceback" not in res.output and "internal error" not in res.output
+
+
+def test_an_unclosed_area_ring_is_closed_with_a_warning(tmp_path: Path) -> None:
+    from uasnav.mission.zones import parse_area
+
+    ring = [[8.0, 47.0], [8.01, 47.0], [8.01, 47.01], [8.0, 47.01]]
+    with pytest.warns(UserWarning, match=r"area.coordinates\[0\]: polygon ring not closed"):
+        area = parse_area({"type": "Polygon", "coordinates": [ring]})
+    closed = parse_area({"type": "Polygon", "coordinates": [[*ring, ring[0]]]})
+    assert area.parts == closed.parts
+
+
+def _fleet_with_manifest(tmp_path: Path) -> tuple[Path, Path]:
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    _imu_csv(logs / "a.csv", 300)
+    out = tmp_path / "scan.parquet"
+    res = CliRunner().invoke(main, ["fleet", "scan", str(logs), "--out", str(out), "--workers", "0"])
+    assert res.exit_code == 0, res.output
+    return logs, out
+
+
+@pytest.mark.parametrize(
+    "extra,needle",
+    [
+        ("junk\n", "line 2: corrupt manifest line"),
+        ("[" * 100_000 + "]" * 100_000 + "\n", "nested deeper than 64 levels"),
+        ("[1, 2]\n", "expected a JSON object, got list"),
+        ('{"path": [1], "size": 1, "mtime_ns": 1, "log_hash": "h", "table": "scan", "status": "ok"}\n',
+         "path: [1] is not of the expected type"),
+        ('{"path": "p", "size": "x", "mtime_ns": 1, "log_hash": "h", "table": "scan", "status": "ok"}\n',
+         'size: "x" is not of the expected type'),
+    ],
+)  # fmt: skip
+def test_fleet_resume_refuses_a_junk_manifest_in_one_line(tmp_path: Path, extra: str, needle: str) -> None:
+    logs, out = _fleet_with_manifest(tmp_path)
+    manifest = out / "_manifest.jsonl"
+    manifest.write_text(manifest.read_text() + extra + "{}\n")  # not the last line: not a torn write
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    res = CliRunner().invoke(
+        main, ["fleet", "scan", str(logs), "--out", str(out), "--workers", "0", "--resume"]
+    )
+    line = _one_error_line(res)
+    assert "_manifest.jsonl" in line and needle in line, line
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+
+
+def test_fleet_resume_with_another_analysis_is_refused(tmp_path: Path) -> None:
+    logs, out = _fleet_with_manifest(tmp_path)
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    res = CliRunner().invoke(
+        main, ["fleet", "imu-health", str(logs), "--out", str(out), "--workers", "0", "--resume"]
+    )
+    line = _one_error_line(res)
+    assert "a dataset of scan, not imu_health" in line
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+
+
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["--scheduler", "xyz://"], "unknown address scheme 'xyz'"),
+        (["--scheduler-file", "{garbage}"], "not a Dask scheduler file"),
+        (["--scheduler-file", "{noaddress}"], "expected an address like tcp://HOST:8786"),
+    ],
+)
+def test_fleet_refuses_a_bad_scheduler_in_one_line(tmp_path: Path, args: list[str], needle: str) -> None:
+    (tmp_path / "garbage.json").write_text("garbage\n")
+    (tmp_path / "noaddress.json").write_text('{"address": 5}\n')
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    _imu_csv(logs / "a.csv", 100)
+    out = tmp_path / "o.parquet"
+    argv = [a.format(garbage=tmp_path / "garbage.json", noaddress=tmp_path / "noaddress.json") for a in args]
+    line = _one_error_line(CliRunner().invoke(main, ["fleet", "scan", str(logs), "--out", str(out), *argv]))
+    assert needle in line, line
+    assert not out.exists()
+
+
+# -- 5. slow peers (loopback) ------------------------------------------------------------------
+
+
+class _Loopback:
+    """A TCP server on 127.0.0.1 that accepts and then, per connection, either says nothing
+    (not a Dask scheduler) or answers an HTTP request one byte per second; it stops by itself."""
+
+    def __init__(self, mode: str, lifetime_s: float = 60.0) -> None:
+        import socket
+
+        self.mode, self.end = mode, time.monotonic() + lifetime_s
+        self.sock = socket.create_server(("127.0.0.1", 0))
+        self.sock.settimeout(0.2)
+        self.port = self.sock.getsockname()[1]
+        self.conns: list[object] = []
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        while time.monotonic() < self.end:
+            try:
+                c, _ = self.sock.accept()
+            except OSError:
+                continue
+            self.conns.append(c)
+            if self.mode == "drip":
+                threading.Thread(target=self._drip, args=(c,), daemon=True).start()
+        self.close()
+
+    def _drip(self, c) -> None:  # type: ignore[no-untyped-def]
+        try:
+            c.recv(65536)
+            c.sendall(b"HTTP/1.1 200 OK\r\nContent-Length: 1000000\r\n\r\n")
+            while time.monotonic() < self.end:
+                c.sendall(b"x")
+                time.sleep(1.0)
+        except OSError:
+            pass
+
+    def close(self) -> None:
+        self.end = 0.0
+        for c in [self.sock, *self.conns]:
+            with contextlib.suppress(OSError):
+                c.close()  # type: ignore[attr-defined]
+
+
+def test_a_port_that_never_speaks_dask_is_refused_within_the_deadline(tmp_path: Path) -> None:
+    from uasnav.fleet.runner import check_scheduler
+
+    srv = _Loopback("silent")
+    try:
+        t0 = time.monotonic()
+        with pytest.raises(InputError, match=r"no Dask scheduler answered within 1 s"):
+            check_scheduler(f"tcp://127.0.0.1:{srv.port}", timeout_s=1.0)
+        assert time.monotonic() - t0 < 30  # a hang detector; the deadline is 1 s
+    finally:
+        srv.close()
+
+
+def test_a_slow_drip_url_in_a_fleet_list_is_bounded_by_the_log_timeout(tmp_path: Path) -> None:
+    srv = _Loopback("drip")
+    try:
+        urls = tmp_path / "logs.urls"
+        urls.write_text(f"http://127.0.0.1:{srv.port}/a.ulg\n")
+        out = tmp_path / "u.parquet"
+        t0 = time.monotonic()
+        res = CliRunner().invoke(
+            main,
+            ["fleet", "scan", str(urls), "--out", str(out), "--workers", "0", "--log-timeout", "2", "--json"],
+        )
+        assert time.monotonic() - t0 < 30
+        assert res.exit_code == 0, res.output
+        import json
+
+        summary = json.loads(res.stdout)
+        assert summary["errors"] == 1
+        assert "no complete answer within the timeout of 2 s" in summary["error_list"][0]["error"]
+    finally:
+        srv.close()
+
+
+# -- 7. progress lines end before the error line -------------------------------------------------
+
+
+def test_a_fleet_progress_bar_ends_its_line_when_the_run_fails(monkeypatch: pytest.MonkeyPatch) -> None:
+    import io
+
+    from uasnav.cli.fleet import _progress
+
+    class Tty(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    err = Tty()
+    monkeypatch.setattr(sys, "stderr", err)
+    progress = _progress()
+    progress(1, 4)  # the run fails here: the bar is left at 1/4
+    assert not err.getvalue().endswith("\n")
+    progress.close()  # type: ignore[attr-defined]
+    assert err.getvalue().endswith("\n")
+
+
+def test_a_progress_bar_then_an_error_is_one_clean_error_line(tmp_path: Path) -> None:
+    """``trajectory calibrate`` shows its runs on a click progress bar: a failure inside it
+    ends with the bar's line and then exactly one ``error:`` line, no library warning folded in."""
+    import click
+
+    from uasnav.cli import _Group
+
+    @click.group(cls=_Group)
+    def grp() -> None:
+        pass
+
+    @grp.command()
+    def runs() -> None:
+        with click.progressbar(length=10, label="simulated runs", file=sys.stderr) as bar:
+            bar.update(3)
+            raise InputError("run 4: the model diverged")
+
+    res = CliRunner().invoke(grp, ["runs"])
+    assert res.exit_code == 1
+    assert res.stderr.endswith("\nerror: run 4: the model diverged\n"), repr(res.stderr)
+    assert [ln for ln in res.stderr.splitlines() if ln.startswith("error")] == [
+        "error: run 4: the model diverged"
+    ]
+
+
+def test_trajectory_progress_bars_use_no_deprecated_click_stream() -> None:
+    src = (Path(__file__).resolve().parents[1] / "python" / "uasnav" / "cli" / "trajectory.py").read_text()
+    assert "get_text_stream" not in src  # deprecated in click 8.2: its warning joined the error line
+
+
+# -- 8. extreme speeds ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("speed,needle", [("1e6", "1e6 is not <= 150"), ("1e-300", "1e-300 is not >= 0.1")])
+@pytest.mark.parametrize(
+    "cmd,option",
+    [
+        (["trajectory", "predict", "--wind", "0@0"], "--speed"),
+        (["trajectory", "intent", "--wind", "0@0"], "--speed"),
+        (["trajectory", "intent", "--wind", "0@0"], "--climb-rate"),
+        (["trajectory", "intent", "--wind", "0@0"], "--descent-rate"),
+    ],
+)
+def test_an_extreme_speed_is_a_usage_error(
+    tmp_path: Path, cmd: list[str], option: str, speed: str, needle: str
+) -> None:
+    model = tmp_path / "m.json"
+    model.write_text("{}")
+    plan = tmp_path / "p.csv"
+    plan.write_text("lat,lon,alt\n47,8,50\n47.001,8,50\n")
+    res = CliRunner().invoke(main, [*cmd, "--model", str(model), "--plan", str(plan), option, speed])
+    assert res.exit_code == 2 and needle in res.stderr, res.output
+
+
+# -- 8. silent wrong answers -----------------------------------------------------------------------
+
+
+def test_the_link_range_is_tested_against_the_pilot_distance() -> None:
+    """A Phantom 4 Pro's link does not reach 50 km: --max-distance, not only --range, is what the
+    C2 link must cover."""
+    res = CliRunner().invoke(main, ["select", "--max-distance", "50000", "--json"])
+    assert res.exit_code == 0, res.output
+    import json
+
+    out = json.loads(res.stdout)
+    text = json.dumps(out)
+    assert "link-range" in text
+    feasible = out.get("feasible_uas") or out.get("feasible") or []
+    assert not any("Phantom 4 Pro" in json.dumps(u) for u in feasible)
+
+
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["--range", "1e-320"], "1e-320 is not >= 1"),
+        (["--range", "1e308"], "1e308 is not <= 1e+06"),
+        (["--max-distance", "1e308"], "1e308 is not <= 1e+06"),
+    ],
+)
+def test_absurd_ranges_are_usage_errors(args: list[str], needle: str) -> None:
+    res = CliRunner().invoke(main, ["select", *args])
+    assert res.exit_code == 2 and needle in res.stderr, res.output
+
+
+def test_limits_from_a_log_without_limits_is_refused(tmp_path: Path) -> None:
+    empty = tmp_path / "empty.tlog"
+    empty.write_bytes(b"")
+    rnd = tmp_path / "random.bin"
+    rnd.write_bytes(random.Random(3).randbytes(5000))
+    model = tmp_path / "m.json"
+    out = tmp_path / "i.json"
+    res = CliRunner().invoke(
+        main, ["trajectory", "train", str(TLOG), "--method", "kinematic", "--out", str(model)]
+    )
+    assert res.exit_code == 0, res.output
+    plan = DATA / "missions" / "mavsdk_qgroundcontrol_sample.plan"
+    for bad in (empty, rnd):
+        res = CliRunner().invoke(
+            main,
+            ["trajectory", "intent", "--model", str(model), "--plan", str(plan), "--wind", "0@0",
+             "--start", "2026-01-01T10:00:00Z", "--limits-from", str(bad), "--out", str(out)],
+        )  # fmt: skip
+        line = _one_error_line(res)
+        assert f"--limits-from {bad}: no vehicle limits in this log" in line, line
+        assert not out.exists()
+
+
+def test_a_die_temperature_below_absolute_zero_is_refused(tmp_path: Path) -> None:
+    p = tmp_path / "cold.csv"
+    rows = "".join(f"{i / 100:.2f},0,0,0,0,0,9.81,{-300 if i == 50 else 25}\n" for i in range(300))
+    p.write_text("t,gx,gy,gz,ax,ay,az,temp\n" + rows)
+    line = _one_error_line(CliRunner().invoke(main, ["allan", str(p)]))
+    assert "cold.csv: temp: -300 °C at row 50 is outside -273.15…1000 °C" in line
+
+
+@pytest.mark.parametrize("kw", [{"window_s": -1.0}, {"window_s": float("nan")}, {"min_duration_s": -1.0}])
+def test_detect_static_refuses_a_negative_or_nan_duration(kw: dict[str, float]) -> None:
+    import numpy as np
+
+    from uasnav.imu import ImuLog
+    from uasnav.stationary import detect_static
+
+    log = ImuLog(t=np.arange(500) / 100, gyro=np.zeros((500, 3)), accel=np.tile([0, 0, 9.81], (500, 1)))
+    with pytest.raises(ValueError, match=next(iter(kw))):
+        detect_static(log, **kw)
+
+
+# -- 6. a plan's prediction work, estimated before it is accepted -----------------------------------
+
+
+def _big_plan_csv(n: int) -> bytes:
+    return ("north,east\n" + "".join(f"{(i % 2) * 50.0:.1f},{i * 10.0:.1f}\n" for i in range(n))).encode()
+
+
+def test_the_web_refuses_a_plan_too_costly_to_predict_with_its_estimate() -> None:
+    from uasnav.web.prediction import FieldError, read_uploaded_plan
+
+    t0 = time.perf_counter()
+    with pytest.raises(FieldError, match=r"plan: 100000 plan points need about 1\.5e\+11 operations") as e:
+        read_uploaded_plan("big.csv", _big_plan_csv(100_000))
+    assert e.value.field == "plan" and "split the plan" in str(e.value)
+    assert time.perf_counter() - t0 < 30  # refused before any prediction
+    assert read_uploaded_plan("small.csv", _big_plan_csv(50)).route_ne.shape == (50, 2)
+
+
+def test_the_cli_estimates_a_prediction_before_running_it(tmp_path: Path) -> None:
+    plan = tmp_path / "big.csv"
+    plan.write_bytes(_big_plan_csv(1000))
+    model = tmp_path / "m.json"
+    model.write_text("{}")
+    res = CliRunner(env={"UASNAV_MAX_WORK": "1e6"}).invoke(
+        main, ["trajectory", "predict", "--model", str(model), "--plan", str(plan), "--wind", "0@0"]
+    )
+    line = _one_error_line(res)
+    assert (
+        "a prediction of 1000 plan points needs about 1.5e+09 operations" in line
+        and "UASNAV_MAX_WORK" in line
+    )

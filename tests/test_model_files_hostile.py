@@ -378,8 +378,9 @@ def test_training_log_with_an_absurd_temperature_names_the_log_row(tmp_path) -> 
     n = 200
     temp = np.linspace(27.0, 34.0, n)
     temp[120] = 1e308  # one corrupt row: without the check, a "valid" model over [27, 1e308] °C
-    log = ImuLog(t=np.arange(n) * 1.0, gyro=np.zeros((n, 3)), accel=np.zeros((n, 3)), temp=temp)
-    write_log(log, tmp_path / "ramp.csv")
+    # written as text: ImuLog itself refuses such a temperature, so a file is the only way in
+    rows = "".join(f"{i:.1f},0,0,0,0,0,0,{float(x)!r}\n" for i, x in enumerate(temp))
+    (tmp_path / "ramp.csv").write_text("t,gx,gy,gz,ax,ay,az,temp\n" + rows)
     with pytest.raises(InputError, match=r"ramp\.csv: temp: 1e\+308 °C at row 120 is outside"):
         load_training_data(tmp_path / "ramp.csv", average_s=1.0)
     from uasnav.cli import main

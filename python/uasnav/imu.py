@@ -110,6 +110,13 @@ def check_time(t: FloatArray, name: str = "t") -> None:
             )
 
 
+#: Absolute zero (°C): no die temperature is below it.
+ABSOLUTE_ZERO_C = -273.15
+#: Highest die temperature taken as data (°C): MEMS dies are specified to 85–125 °C and solder
+#: melts near 220 °C; 1000 °C is a unit error, not a temperature.
+MAX_DIE_TEMP_C = 1000.0
+
+
 @dataclass(frozen=True)
 class ImuLog:
     """An IMU recording in SI units (see the module docs for shapes and units).
@@ -143,7 +150,16 @@ class ImuLog:
         object.__setattr__(self, "gyro", _as_float_array("gyro", self.gyro, (3,), n))
         object.__setattr__(self, "accel", _as_float_array("accel", self.accel, (3,), n))
         if self.temp is not None:
-            object.__setattr__(self, "temp", _as_float_array("temp", self.temp, (), n))
+            temp = _as_float_array("temp", self.temp, (), n)
+            bad = np.flatnonzero((temp < ABSOLUTE_ZERO_C) | (temp > MAX_DIE_TEMP_C))
+            if bad.size:  # a corrupt or mis-scaled column (K, m°C), not a temperature in °C
+                i = int(bad[0])
+                raise InputError(
+                    f"temp: {temp[i]:g} °C at row {i} is outside "
+                    f"{ABSOLUTE_ZERO_C:g}…{MAX_DIE_TEMP_C:g} °C "
+                    "(absolute zero to beyond any working sensor die)"
+                )
+            object.__setattr__(self, "temp", temp)
         if self.mag is not None:
             object.__setattr__(self, "mag", _as_float_array("mag", self.mag, (3,), n))
         truth = {}

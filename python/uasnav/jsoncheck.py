@@ -37,7 +37,7 @@ from uasnav.limits import read_file_limited
 #: Deepest nesting of arrays/objects a model file may have (ours have at most 6 levels; serde_json,
 #: which reads the same thermal files in Rust, stops at 128).
 MAX_DEPTH = 64
-_TOO_DEEP = f"not a model file: arrays/objects nested deeper than {MAX_DEPTH} levels"
+_TOO_DEEP = f"arrays/objects nested deeper than {MAX_DEPTH} levels"
 
 
 def at(path: str, key: str | int) -> str:

@@ -677,6 +677,21 @@ def load_logs(paths: Sequence[str | os.PathLike[str]]) -> list[ImuLog]:
     return [read_log(p) for p in paths]
 
 
+def _mounting(value: Any, where: str) -> NDArray[np.float64]:
+    """A log's ``mounting`` (a 3×3 matrix, or its JSON text) as a finite 3×3 array; anything
+    else is an :class:`InputError` naming the log."""
+    try:
+        m = json.loads(value) if isinstance(value, str) else value
+        a = np.asarray(m, dtype=float)
+    except (ValueError, TypeError, RecursionError):
+        text = value if isinstance(value, str) else type(value).__name__
+        raise InputError(f"{where}: '# mounting:' is not a 3×3 JSON matrix: {text[:80]!r}") from None
+    if a.shape != (3, 3) or not np.all(np.isfinite(a)):
+        what = f"shape {a.shape}" if a.shape != (3, 3) else "non-finite entries"
+        raise InputError(f"{where}: '# mounting:' must be a finite 3×3 matrix, got {what}")
+    return a
+
+
 def array_for_logs(shape: str, logs: Sequence[ImuLog], *, names: Sequence[str] | None = None) -> SensorArray:
     """The triaxial sensor array that carries ``logs`` (one log per sensor, in order).
 
@@ -718,8 +733,7 @@ def array_for_logs(shape: str, logs: Sequence[ImuLog], *, names: Sequence[str] |
         for p, lg in zip(labels, logs, strict=True):
             if "mounting" not in lg.meta:
                 raise InputError(f"{p}: no '# mounting:' comment (needed by --shape meta)")
-            m = lg.meta["mounting"]
-            mounts.append(json.loads(m) if isinstance(m, str) else m)
+            mounts.append(_mounting(lg.meta["mounting"], p))
         return from_mountings(np.asarray(mounts, dtype=float))
     if shape not in FACES:
         raise InputError(f"shape: expected one of {', '.join(SHAPES)}, aligned, meta; got {shape!r}")

@@ -212,6 +212,15 @@ def detect_static(
     log = require_log(log)
     if method not in ("glrt", "shoe"):
         raise InputError(f"method: expected 'glrt' (SHOE), got {method!r}")
+    for name, value, lo in (("window_s", window_s, 0.0), ("min_duration_s", min_duration_s, None)):
+        ok = (
+            isinstance(value, int | float)
+            and math.isfinite(value)
+            and (value > lo if lo is not None else value >= 0)
+        )
+        if not ok:
+            bound = "> 0" if lo is not None else ">= 0"
+            raise InputError(f"{name}: expected a finite number of seconds {bound}, got {value!r}")
     if window_samples is None:
         w = max(3, round(window_s * log.uniform_rate(rtol=0.05)))
         what = "window_s"

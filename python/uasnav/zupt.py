@@ -449,7 +449,7 @@ def run(
         dbias_dtemp=dbdt,
         mag=mag,
         stationary=mask,
-        levelling_samples=max(1, round(cfg.levelling_s * rate)),
+        levelling_samples=max(1, round(min(cfg.levelling_s * rate, log.n))),  # a longer window: the whole log
         heading_rad=heading,
         declination_rad=declination if heading is None else None,
         accel_bias0=[float(v) for v in cfg.accel_bias0_m_s2],

@@ -95,6 +95,10 @@ NON_NEGATIVE = Real(0.0)
 LATITUDE = Real(-90.0, 90.0)
 #: A probability strictly between 0 and 1.
 PROBABILITY = Real(0.0, 1.0, lo_open=True, hi_open=True)
+#: A small UAS's commanded speed or vertical rate (m/s): 0.1 m/s (slower is a hover, and makes
+#: elements of 10¹⁰ s) to 150 m/s (above any small UAS; a model asked for 10⁶ m/s returns
+#: negative times).
+UAS_SPEED = Real(0.1, 150.0)
 #: A random seed: what every generator of the package (numpy, Rust) accepts.
 SEED = click.IntRange(0, 2**32 - 1)
 

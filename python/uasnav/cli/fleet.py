@@ -8,7 +8,7 @@ from typing import Any
 
 import click
 
-from uasnav.cli._common import POSITIVE, SEED, OutputPath, echo_json
+from uasnav.cli._common import POSITIVE, SEED, UAS_SPEED, OutputPath, echo_json
 from uasnav.errors import InputError
 
 
@@ -103,6 +103,12 @@ def _progress() -> Any:
         if done >= total:
             bar[0].close()
 
+    def close() -> None:
+        # a run that fails mid-way ends the bar's line, so its "error: …" starts a line of its own
+        if bar:
+            bar[0].close()
+
+    update.close = close  # type: ignore[attr-defined]
     return update
 
 
@@ -118,11 +124,15 @@ def _execute(analysis: Any, sources: tuple[str, ...], out: str, scheduler: str |
         raise click.UsageError("--workers sizes the local cluster; it does not apply with --scheduler")
     if memory_limit is not None and (scheduler or scheduler_file or workers == 0):
         raise click.UsageError("--memory-limit applies to the local cluster's workers only")
-    return run(
-        analysis, list(sources), out, scheduler=scheduler, scheduler_file=scheduler_file,
-        workers=workers, resume=resume, progress=_progress(), memory_limit=memory_limit or "auto",
-        **({} if log_timeout is None else {"fetch_timeout_s": log_timeout, "log_timeout_s": log_timeout}),
-    )  # fmt: skip
+    progress = _progress()
+    try:
+        return run(
+            analysis, list(sources), out, scheduler=scheduler, scheduler_file=scheduler_file,
+            workers=workers, resume=resume, progress=progress, memory_limit=memory_limit or "auto",
+            **({} if log_timeout is None else {"fetch_timeout_s": log_timeout, "log_timeout_s": log_timeout}),
+        )  # fmt: skip
+    finally:
+        progress.close()  # type: ignore[attr-defined]
 
 
 def _print(summary: Any, as_json: bool) -> None:
@@ -198,7 +208,7 @@ def imu_health(
 @command.command("elements")
 @_run_options
 @click.option("--segment", type=POSITIVE, default=10.0, show_default=True, help="Segment length L (m).")
-@click.option("--speed", type=POSITIVE, help="Commanded speed (m/s); default each log's waypoint speed.")
+@click.option("--speed", type=UAS_SPEED, help="Commanded speed (m/s); default each log's waypoint speed.")
 @click.option(
     "--max-gap",
     type=POSITIVE,

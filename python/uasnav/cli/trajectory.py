@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -16,6 +17,7 @@ from uasnav.cli._common import (
     POSITIVE,
     PROBABILITY,
     SEED,
+    UAS_SPEED,
     OutputPath,
     Real,
     check_outputs,
@@ -58,7 +60,7 @@ _common_opts = [
         "--plan", type=click.Path(dir_okay=False), help="Plan CSV (lat,lon,alt) for logs without a mission."
     ),
     click.option(
-        "--speed", type=POSITIVE, help="Commanded speed (m/s); default from the log (WPNAV_SPEED …)."
+        "--speed", type=UAS_SPEED, help="Commanded speed (m/s); default from the log (WPNAV_SPEED …)."
     ),
     click.option(
         "--wind", "wind_text", help="Wind SPEED@DIR (m/s, deg wind comes from); default the log's or calm."
@@ -198,7 +200,7 @@ def train(
 @click.option("--model", "model_path", required=True, type=click.Path(dir_okay=False))
 @click.option("--plan", "plan_path", required=True, type=click.Path(dir_okay=False))
 @click.option("--wind", "wind_text", required=True, help="SPEED@DIR: m/s @ degrees the wind comes from.")
-@click.option("--speed", type=POSITIVE, help="Commanded speed (m/s); default the model's.")
+@click.option("--speed", type=UAS_SPEED, help="Commanded speed (m/s); default the model's.")
 @click.option("--required", help="4D plan: required time (s from start) at each waypoint, T0,T1,….")
 @click.option("--tolerance", type=NON_NEGATIVE, default=5.0, show_default=True, help="4D time tolerance (s).")
 @click.option(
@@ -235,8 +237,14 @@ def predict(model_path, plan_path, wind_text, speed, required, tolerance, route3
     # options first, files second: a typo in an option is reported before any file is read
     wind = parse_wind(wind_text)
     req = parse_float_list(required, "--required") if required else None
-    model = load_model(model_path)
+    from uasnav.limits import PREDICTION_OPS_PER_POINT, check_work
+
     plan_ne, _ = read_plan_route(plan_path, other_as_csv=True)
+    # estimated before the model is even read: a plan of 10⁵ points costs minutes of CPU
+    check_work(
+        len(plan_ne) * PREDICTION_OPS_PER_POINT, f"{plan_path}: a prediction of {len(plan_ne)} plan points"
+    )
+    model = load_model(model_path)
     p = model.predict(plan_ne, wind, speed)
     feas = None
     if req is not None:
@@ -657,9 +665,7 @@ def calibrate(model_path, out, runs, test_runs, coverage, flight_logs, seed, as_
     check_runs(runs + test_runs, "--runs + --test-runs")
     check_outputs([model_path], {"--out": out})
     model = load_model(model_path)
-    with click.progressbar(
-        length=runs + test_runs, label="simulated runs", file=click.get_text_stream("stderr")
-    ) as bar:
+    with click.progressbar(length=runs + test_runs, label="simulated runs", file=sys.stderr) as bar:
         cal = simulated_runs(model, runs, seed=2 * seed, progress=lambda i, n: bar.update(1))
         test = simulated_runs(model, test_runs, seed=2 * seed + 1, progress=lambda i, n: bar.update(1))
     model.time_bounds_ = fit_bounds(cal, source=f"{runs} simulated runs, seed {seed}")
@@ -799,15 +805,15 @@ def _own_run_bounds(
     "point (NGA's 15′ grid, shipped with uasnav).",
 )
 @click.option("--home-alt", type=Real(-1000.0, 9000.0), help="Home altitude AMSL (m) if the plan has none.")
-@click.option("--speed", type=POSITIVE, help="Horizontal speed (m/s); default the plan's, else the model's.")
+@click.option("--speed", type=UAS_SPEED, help="Horizontal speed (m/s); default the plan's, else the model's.")
 @click.option(
     "--climb-rate",
-    type=POSITIVE,
+    type=UAS_SPEED,
     help="Climb speed (m/s); default a kinematic model's own limit, else ArduPilot's 2.5.",
 )
 @click.option(
     "--descent-rate",
-    type=POSITIVE,
+    type=UAS_SPEED,
     help="Descent speed (m/s); default a kinematic model's own limit, else ArduPilot's 1.5.",
 )
 @click.option(
@@ -886,6 +892,24 @@ def intent(  # type: ignore[no-untyped-def]
             accel_z, from_log = lim.accel_z_ms2, [*from_log, "accel_z_ms2"]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
+        found = [
+            k for k in ("climb_ms", "descent_ms", "accel_z_ms2", "cruise_ms") if getattr(lim, k) is not None
+        ]
+        if not found:
+            raise InputError(
+                f"--limits-from {limits_log}: no vehicle limits in this log (empty, corrupt, or without "
+                "autopilot parameters); give --climb-rate/--descent-rate/--speed or another log"
+            )
+        explicit = {"climb_ms": climb_rate, "descent_ms": descent_rate, "cruise_ms": speed}
+        defaulted = [
+            k for k in ("climb_ms", "descent_ms", "accel_z_ms2") if k not in found and explicit.get(k) is None
+        ]
+        if defaulted:
+            warnings.warn(
+                f"--limits-from {limits_log}: {', '.join(defaulted)} not in the log's parameters; "
+                "the model's defaults are used for them",
+                stacklevel=1,
+            )
     own_note = _own_run_bounds(
         model, flight_logs, limits_source, coverage, wind, climb_rate, descent_rate, accel_z, speed
     )
@@ -894,7 +918,7 @@ def intent(  # type: ignore[no-untyped-def]
 
         check_runs(calibration_runs, "--calibration-runs")
         with click.progressbar(
-            length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
+            length=calibration_runs, label="calibrating time bounds", file=sys.stderr
         ) as bar:
             # calibrated at the speed this mission flies (the band depends on it)
             v = speed or plan_cruise_speed(plan) or model.cruise_ms_

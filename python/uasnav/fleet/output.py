@@ -139,6 +139,28 @@ def stat_key(path: str) -> tuple[str, int, int]:
     return (os.path.abspath(path), int(st.st_size), int(st.st_mtime_ns))
 
 
+#: The manifest's fields and their JSON types (``log_hash`` may also be null).
+_ENTRY_TYPES: dict[str, type | tuple[type, ...]] = {
+    "path": str, "size": int, "mtime_ns": int, "log_hash": (str, type(None)), "table": str, "status": str,
+}  # fmt: skip
+
+
+def _entry(line: str) -> ManifestEntry:
+    """One manifest line, every field checked (a hand-edited or foreign line is refused, never
+    half-read: a list where a path belongs would otherwise surface far from its cause)."""
+    from uasnav import jsoncheck
+
+    d = jsoncheck.parse(line, "not JSON")
+    if not isinstance(d, dict):
+        raise DataFormatError(f"expected a JSON object, got {type(d).__name__}")
+    if set(d) != set(_ENTRY_TYPES):
+        raise DataFormatError(f"expected the keys {', '.join(sorted(_ENTRY_TYPES))}")
+    for k, want in _ENTRY_TYPES.items():
+        if not isinstance(d[k], want) or isinstance(d[k], bool):
+            raise DataFormatError(f"{k}: {jsoncheck.show(d[k])} is not of the expected type")
+    return ManifestEntry(**d)
+
+
 class Manifest:
     """The append-only record of finished logs in ``OUT/_manifest.jsonl`` (client side only)."""
 
@@ -158,11 +180,15 @@ class Manifest:
             if not line.strip():
                 continue
             try:
-                yield ManifestEntry(**json.loads(line))
-            except (json.JSONDecodeError, TypeError) as e:
+                yield _entry(line)
+            except DataFormatError as e:
                 if i == len(lines) or (i == len(lines) - 1 and not lines[-1]):
                     continue  # a torn last line: the client died while appending it
                 raise DataFormatError(f"corrupt manifest line ({e})", path=str(self.path), line=i) from None
+
+    def tables(self) -> set[str]:
+        """The analyses (``table`` names) this manifest records."""
+        return {t for t, _ in self._paths}
 
     def done(self, table: str, key: tuple[str, int, int]) -> bool:
         """True if the log with this :func:`stat_key` was finished for ``table``."""

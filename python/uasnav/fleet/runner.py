@@ -88,6 +88,11 @@ MAX_LISTED_ERRORS = 1000
 FETCH_TIMEOUT_S = 600.0
 #: Task statuses that are not committed to the manifest (``--resume`` tries them again).
 RETRIED = ("lost", "unfetched")
+#: Deadline (s) for an existing scheduler to answer Dask's handshake: a port that accepts the
+#: connection and never speaks (another service) would otherwise hold the run indefinitely.
+SCHEDULER_CONNECT_S = 5.0
+#: Largest scheduler file read (bytes); Dask writes a few hundred.
+MAX_SCHEDULER_FILE_BYTES = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -427,6 +432,11 @@ def run(
     paths = discover(sources)
     t0 = time.perf_counter()
     manifest = Manifest(out_p) if out_p.is_dir() else None
+    if manifest is not None and (other := manifest.tables() - {analysis.name}):
+        raise InputError(
+            f"--out {out_p}: a dataset of {', '.join(sorted(other))}, not {analysis.name}; "
+            "--resume continues the same analysis (give another --out)"
+        )
     todo, skipped = [], 0
     for p in paths:
         try:
@@ -530,6 +540,63 @@ def _run(
     return summary
 
 
+def scheduler_address(scheduler: str | None, scheduler_file: str | None) -> str:
+    """The address of an existing scheduler, from ``scheduler`` or the ``address`` of the JSON
+    ``scheduler_file`` (``dask scheduler --scheduler-file``).
+
+    Raises
+    ------
+    InputError
+        A scheduler file that is not Dask's (not JSON, no ``address`` text), naming the file.
+    """
+    if scheduler is not None:
+        return scheduler
+    from uasnav import jsoncheck
+
+    src = os.fspath(scheduler_file or "")
+    with jsoncheck.reraise_in(src):
+        d = jsoncheck.parse(jsoncheck.read_text(src, MAX_SCHEDULER_FILE_BYTES), "not a Dask scheduler file")
+        address = d.get("address") if isinstance(d, dict) else None
+        if not isinstance(address, str) or "://" not in address:
+            raise jsoncheck.fail(
+                "address", "not a Dask scheduler file: expected an address like tcp://HOST:8786"
+            )
+    return address
+
+
+def check_scheduler(
+    address: str, option: str = "--scheduler", timeout_s: float = SCHEDULER_CONNECT_S
+) -> None:
+    """Refuse, within ``timeout_s``, an address where no Dask scheduler answers: an unknown
+    scheme, nothing listening, or a peer that accepts and never completes Dask's handshake
+    (``distributed``'s own connect bounds the TCP connection, not the handshake after it).
+
+    Raises
+    ------
+    InputError
+        Naming ``option``, the address and what went wrong.
+    """
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def probe() -> None:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout_s), timeout_s)
+        await comm.close()
+
+    try:
+        asyncio.run(probe())
+    except TimeoutError:
+        raise InputError(
+            f"{option} {address}: no Dask scheduler answered within {timeout_s:g} s "
+            "(nothing listening, or another service on that port)"
+        ) from None
+    except (OSError, ValueError, TypeError) as e:  # CommClosedError is an OSError; ValueError: scheme
+        raise InputError(
+            f"{option} {address}: not a reachable Dask scheduler ({' '.join(str(e).split())})"
+        ) from None
+
+
 def _run_distributed(
     analysis: Analysis,
     todo: list[str],
@@ -549,7 +616,11 @@ def _run_distributed(
     own = client is None
     if own:
         if scheduler is not None or scheduler_file is not None:
-            client = Client(address=scheduler, scheduler_file=scheduler_file, timeout="30s")
+            address = scheduler_address(scheduler, scheduler_file)
+            check_scheduler(
+                address, "--scheduler" if scheduler is not None else f"--scheduler-file {scheduler_file}:"
+            )
+            client = Client(address=address, timeout=f"{SCHEDULER_CONNECT_S:g}s")
         else:
             cluster = local_cluster(workers, memory_limit)
             client = Client(cluster)
@@ -594,7 +665,9 @@ __all__ = [
     "LogTimeout",
     "RunSummary",
     "TaskResult",
+    "check_scheduler",
     "local_cluster",
     "process_log",
     "run",
+    "scheduler_address",
 ]

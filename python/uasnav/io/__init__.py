@@ -54,7 +54,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from uasnav.errors import DataFormatError, InputError
+from uasnav.errors import DataFormatError, InputError, ResourceLimitError
 from uasnav.imu import ImuLog, require_log
 from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.io.flight import Flight
@@ -84,7 +84,12 @@ def read_log(path: str | os.PathLike[str]) -> ImuLog:
     log = open_log(p, need=("imu",))
     if log.format_name == "flight-csv":
         return read_csv_v1(p)  # a flight CSV is no IMU log: the CSV v1 reader says what is missing
-    return log.imu  # type: ignore[no-any-return]
+    try:
+        return log.imu  # type: ignore[no-any-return]
+    except (DataFormatError, ResourceLimitError):
+        raise
+    except InputError as e:  # ImuLog's own checks (e.g. a temperature below absolute zero): name the file
+        raise DataFormatError(str(e), path=str(p)) from None
 
 
 def read_flight(path: str | os.PathLike[str]) -> Flight:

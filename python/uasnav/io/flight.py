@@ -23,6 +23,8 @@ log (see :func:`valid_fixes`).
 
 from __future__ import annotations
 
+import math
+
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -38,6 +40,9 @@ from uasnav.io._common import nothing_valid, report_corruption, salvage
 from uasnav.io._quiet import LibraryOutput
 
 FloatArray = NDArray[np.float64]
+#: Largest |height| of a GNSS fix (m) taken as data: the nav filter's own bound (no UAS flies
+#: 100 km above or below the ellipsoid; 1e308 m is a corrupt cell).
+MAX_GNSS_HEIGHT_M = 1e5
 
 _TRACK_FIELDS = ("t", "lat", "lon", "alt", "vel_ned")
 
@@ -51,7 +56,7 @@ def _arr(owner: str, name: str, value: ArrayLike, shape_tail: tuple[int, ...], n
     if a.ndim != want_ndim or a.shape[1:] != shape_tail or (n is not None and a.shape[0] != n):
         want = ("n" if n is None else str(n),) + tuple(str(k) for k in shape_tail)
         raise InputError(f"{owner}.{name}: expected shape ({', '.join(want)}), got {a.shape}")
-    bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(a.shape[0], -1)), axis=1))
+    bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(a.shape[0], math.prod(shape_tail))), axis=1))
     if bad.size:
         raise InputError(f"{owner}.{name}: non-finite value at row {int(bad[0])}")
     return a
@@ -109,6 +114,13 @@ class GnssData:
         object.__setattr__(self, "vel", _arr("gnss", "vel", self.vel, (3,), n))
         if np.any(np.abs(self.lat) > 90.0):
             raise InputError(f"gnss.lat: outside ±90° at row {int(np.argmax(np.abs(self.lat) > 90))}")
+        bad_lon = (self.lon < -180.0) | (self.lon > 360.0)  # 0…360° east is a convention too
+        if np.any(bad_lon):
+            row = int(np.argmax(bad_lon))
+            raise InputError(f"gnss.lon: {self.lon[row]:g}° is outside -180…360° at row {row}")
+        if np.any(np.abs(self.alt) > MAX_GNSS_HEIGHT_M):
+            row = int(np.argmax(np.abs(self.alt) > MAX_GNSS_HEIGHT_M))
+            raise InputError(f"gnss.alt: {self.alt[row]:g} m is beyond ±{MAX_GNSS_HEIGHT_M:g} m at row {row}")
         for k in ("h_acc", "v_acc", "s_acc"):
             a = getattr(self, k)
             if np.any(a <= 0):

@@ -47,6 +47,8 @@ def read_gnss_csv(path: str | os.PathLike[str]) -> GnssData:
         raise DataFormatError(
             f"GNSS CSV: missing column(s) {', '.join(missing)}", path=str(path), column=missing[0]
         )
+    if len(cols["t"]) == 0:
+        raise DataFormatError("GNSS CSV: no fixes (a header only)", path=str(path))
     try:
         return GnssData(
             cols["t"],

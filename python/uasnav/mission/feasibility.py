@@ -222,9 +222,10 @@ def uas_tests(u: UasTable, req: Requirements, max_mtom_g: float) -> list[TestRes
     t_req = mission_time_s(req.range_m, req.cruise_fraction * u.max_speed_ms, req.wind_ms)
     t_avail = u.endurance_min * 60.0 * (1.0 - req.reserve)
     out.append(TestResult("endurance", t_req <= t_avail, t_avail, t_req, "s", ">="))
-    out.append(
-        TestResult("link-range", u.max_range_m >= req.range_m, u.max_range_m, full * req.range_m, "m", ">=")
-    )
+    # the C2 link must reach the UA where it flies farthest from the pilot (--max-distance),
+    # not only the mission range
+    link_m = req.range_m if req.max_distance_m is None else max(req.range_m, req.max_distance_m)
+    out.append(TestResult("link-range", u.max_range_m >= link_m, u.max_range_m, full * link_m, "m", ">="))
     out.append(
         TestResult(
             "altitude", u.max_altitude_m >= req.altitude_m, u.max_altitude_m, full * req.altitude_m, "m", ">="

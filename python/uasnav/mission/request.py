@@ -119,7 +119,17 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "mission", "text", "precision-agriculture", "Mission id (Table 18).", label="Mission", group="mission"
     ),
     SelectOption(
-        "range", "real", 1500.0, "Mission range (m).", "m", 0.0, True, label="Range", group="requirements"
+        # 1 m … 1000 km: below, every aircraft is "open category"; above, no small UAS flies
+        "range",
+        "real",
+        1500.0,
+        "Mission range (m).",
+        "m",
+        1.0,
+        False,
+        1e6,
+        label="Range",
+        group="requirements",
     ),
     SelectOption(
         "resolution",
@@ -242,6 +252,7 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         "m",
         0.0,
         True,
+        1e6,
         label="Max pilot distance",
         group="requirements",
     ),

@@ -25,6 +25,7 @@ from __future__ import annotations
 import datetime as dt
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -106,13 +107,26 @@ def _geom(g: Any, path: str, buffer_m: float) -> list[Any]:
             out.append((float(x[0]), float(x[1])))
         return out
 
+    def ring(seq: Any, p: str) -> list[tuple[float, float]]:
+        # RFC 7946 §3.1.6: a linear ring is closed and has >= 4 positions (3 distinct corners)
+        r = pts(seq, p)
+        if len(r) >= 2 and r[0] != r[-1]:
+            warnings.warn(
+                f"{p}: polygon ring not closed (its last position differs from the first); closed it",
+                stacklevel=2,
+            )
+            r = [*r, r[0]]
+        if len(set(r)) < 3:
+            raise jc.fail(p, f"a polygon ring needs at least 3 distinct corners, got {len(set(r))}")
+        return r
+
     if t == "Polygon":
         rings = jc.array(coords, cpath, max_len=1000)
-        return [("poly", [pts(r, jc.at(cpath, i)) for i, r in enumerate(rings)])]
+        return [("poly", [ring(r, jc.at(cpath, i)) for i, r in enumerate(rings)])]
     if t == "MultiPolygon":
         polys = jc.array(coords, cpath, max_len=1000)
         return [
-            ("poly", [pts(r, jc.at(jc.at(cpath, k), i)) for i, r in enumerate(jc.array(p, jc.at(cpath, k)))])
+            ("poly", [ring(r, jc.at(jc.at(cpath, k), i)) for i, r in enumerate(jc.array(p, jc.at(cpath, k)))])
             for k, p in enumerate(polys)
         ]
     if t in ("Point", "LineString"):

@@ -371,6 +371,10 @@ def model_from_dict(d: dict[str, Any], source: str = "<dict>") -> SensorModel:
         raise DataFormatError(f"{source}: {e}") from None
 
 
+#: Largest preset file read (bytes); the shipped ones are about 2 KiB.
+MAX_PRESET_BYTES = 1 << 20
+
+
 def load_preset(name: str) -> SensorModel:
     """Load a preset by name (``crs05-02``, ``ms8010``, ``ax1``, ``lsm6dsm``) or JSON path."""
     if isinstance(name, SensorModel):
@@ -378,12 +382,16 @@ def load_preset(name: str) -> SensorModel:
     if name.endswith(".json"):
         from pathlib import Path
 
+        from uasnav import jsoncheck
+
         p = Path(name)
-        try:
-            text = p.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise DataFormatError("no such preset file", path=str(p)) from None
-        return model_from_dict(json.loads(text), str(p))
+        if not p.exists():
+            raise DataFormatError("no such preset file", path=str(p))
+        with jsoncheck.reraise_in(str(p)):
+            d = jsoncheck.parse(jsoncheck.read_text(p, MAX_PRESET_BYTES), "not a preset: not valid JSON")
+            if not isinstance(d, dict):
+                raise DataFormatError(f"not a preset: expected a JSON object, got {type(d).__name__}")
+        return model_from_dict(d, str(p))
     if name not in PRESET_NAMES:
         raise InputError(f"unknown preset {name!r}; available: {', '.join(PRESET_NAMES)}")
     text = resources.files("uasnav.sim").joinpath("presets", f"{name}.json").read_text(encoding="utf-8")

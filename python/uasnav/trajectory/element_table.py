@@ -133,6 +133,28 @@ def is_element_dataset(path: str | os.PathLike[str]) -> bool:
     return p.is_dir() or p.suffix.lower() == ".parquet"
 
 
+def _conform(table: pa.Table, path: Path) -> pa.Table:
+    """``table`` with the element columns cast to :data:`ELEMENT_SCHEMA`'s types; a file of
+    another schema (missing columns, text where numbers belong) is an :class:`InputError`
+    naming the file and the column."""
+    missing = [n for n in ELEMENT_SCHEMA.names if n not in table.column_names and n not in OPTIONAL_COLUMNS]
+    if missing:
+        raise InputError(f"{path}: not an element dataset: missing column(s) {', '.join(missing)}")
+    for field in ELEMENT_SCHEMA:
+        if field.name not in table.column_names:
+            continue
+        i = table.schema.get_field_index(field.name)
+        if table.schema.field(i).type == field.type:
+            continue
+        try:
+            table = table.set_column(i, field, table.column(i).cast(field.type))
+        except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+            raise InputError(
+                f"{path}: column {field.name!r} is {table.schema.field(i).type}, expected {field.type}"
+            ) from None
+    return table
+
+
 def read_element_dataset(path: str | os.PathLike[str]) -> tuple[ElementSamples, float, int]:
     """Samples, segment length (m) and number of runs of a Parquet element file or dataset.
 
@@ -160,6 +182,7 @@ def read_element_dataset(path: str | os.PathLike[str]) -> tuple[ElementSamples, 
     except (pa.ArrowInvalid, OSError):
         # Arrow's message repeats the path; one line naming the input is what the user needs
         raise InputError(f"{p}: not a Parquet element dataset (unreadable or not Parquet)") from None
+    table = _conform(table, p)
     key = ("log_hash", "run") if "log_hash" in table.column_names else ("run",)
     table = table.sort_by([(k, "ascending") for k in (*key, "element")])
     samples, seg = from_table(table, key)

@@ -97,6 +97,12 @@ def read_uploaded_plan(filename: str, data: bytes) -> UploadedPlan:
             raise FieldError("plan", "plan: " + str(e).replace(str(path), filename or "plan")) from None
     if route.shape[0] < 2:
         raise FieldError("plan", "plan: needs at least two positioned waypoints")
+    from uasnav.web.server_limits import check_plan_work
+
+    try:
+        check_plan_work(route.shape[0])
+    except InputError as e:
+        raise FieldError("plan", f"plan: {e}") from None
     return UploadedPlan(np.asarray(route, dtype=float)[:, :2], origin, plan_cruise_speed(plan))
 
 
@@ -220,10 +226,11 @@ def predict_plan(
             w["ok"] = bool(feas.ok[i])
         waypoints.append(w)
     # the predictor's own rows (as `uasnav trajectory predict --json`), plus what the page draws
+    starts = np.concatenate([[0.0], np.cumsum(p.time_s)[:-1]]) if len(p.time_s) else np.zeros(0)
     elements = [
         {
             **row,
-            "start_time_s": float(np.sum(p.time_s[:i])),
+            "start_time_s": float(starts[i]),
             "path_ne_m": [
                 [float(el.start_ne[i, 0]), float(el.start_ne[i, 1])],
                 [float(el.mid_ne[i, 0]), float(el.mid_ne[i, 1])],

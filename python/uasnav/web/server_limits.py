@@ -62,6 +62,28 @@ def _seconds(env: str, default: float) -> float:
     return env_positive(env, default, "seconds")
 
 
+#: Work one plan prediction may cost on the server (elementary operations, ≈ 10⁹ per second):
+#: a plan within the upload limit can hold 10⁵ points (minutes of CPU); beyond this it is refused
+#: up front with its estimate. ``UASNAV_WEB_MAX_PLAN_WORK`` overrides it.
+MAX_PLAN_WORK = 2e10
+
+
+def check_plan_work(n_points: int) -> None:
+    """Refuse, before predicting, a plan of ``n_points`` whose estimated work exceeds the server's
+    limit (:data:`MAX_PLAN_WORK`), naming the estimate (an :class:`~uasnav.errors.InputError`)."""
+    from uasnav.errors import InputError
+    from uasnav.limits import PREDICTION_OPS_PER_POINT, env_positive
+
+    limit = env_positive("UASNAV_WEB_MAX_PLAN_WORK", MAX_PLAN_WORK, "operations such as 2e10")
+    ops = n_points * PREDICTION_OPS_PER_POINT
+    if ops > limit:
+        raise InputError(
+            f"{n_points} plan points need about {ops:.2g} operations (≈ {ops / 1e9:.0f} s of CPU), more than "
+            f"this server's limit of {limit:.2g} per prediction; split the plan, or run "
+            "`uasnav trajectory predict` on your own machine"
+        )
+
+
 async def _answer(
     send: Send, status: int, message: str, headers: list[tuple[bytes, bytes]] | None = None
 ) -> None:
