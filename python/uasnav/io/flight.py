@@ -24,7 +24,6 @@ log (see :func:`valid_fixes`).
 from __future__ import annotations
 
 import math
-
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
