@@ -253,3 +253,56 @@ def test_a_resolution_no_camera_reaches_is_said_as_such() -> None:
     assert res["survey"] is None and not res["authorisation"]["authorisable"]
     assert res["authorisation"]["verdict"].startswith("no camera in the database meets resolution")
     assert set(res.files) == {"result.json"}
+
+
+def _prohibited_sample(shared_data, tmp_path):
+    """The ED-269 sample with its zone made PROHIBITED, and a field inside the zone."""
+    doc = json.loads((shared_data / "utm" / "interuss_ed269_geozone_sample.json").read_text())
+    doc["UASZoneList"][0]["restriction"] = "PROHIBITED"
+    zones = tmp_path / "prohibited.json"
+    zones.write_text(json.dumps(doc))
+    inside = {
+        "type": "Polygon",
+        "coordinates": [
+            [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+        ],
+    }
+    area = tmp_path / "inside.geojson"
+    area.write_text(json.dumps(inside))
+    return area, zones
+
+
+def test_a_prohibited_zone_leaves_no_plan(shared_data, tmp_path) -> None:
+    area, zones = _prohibited_sample(shared_data, tmp_path)
+    res = uasnav.plan(area=str(area), resolution=0.05, zones=str(zones), start=START)
+    # no configuration, no flight, no flight file: the verdict names the zone
+    assert res["configuration"] is None and res["survey"] is None and res["flights"] == []
+    assert not res["authorisation"]["authorisable"]
+    assert "PROHIBITED zone LSXX" in res["authorisation"]["verdict"]
+    assert [h["identifier"] for h in res["zones"]["hits"]] == ["LSXX"]
+    assert res.selection.to_dict()["withheld_ranking"]
+    assert set(res.files) == {"result.json"}
+
+
+@pytest.mark.parametrize("case", ["prohibited", "resolution"])
+def test_cli_without_a_plan_is_one_error_line_and_writes_nothing(shared_data, tmp_path, case) -> None:
+    area, zones = _prohibited_sample(shared_data, tmp_path)
+    if case == "prohibited":
+        args = ["--area", str(area), "--resolution", "0.05", "--zones", str(zones)]
+        why = "PROHIBITED zone LSXX"
+    else:
+        args = ["--area", str(area), "--resolution", "0.0005"]
+        why = "no camera in the database meets resolution"
+    fresh, kept = tmp_path / "fresh", tmp_path / "kept"
+    kept.mkdir()
+    (kept / "result.json").write_text("earlier plan\n")
+    for out in (fresh, kept):
+        r = CliRunner().invoke(main, ["plan", *args, "--start", START, "--out", str(out), "--json"])
+        assert r.exit_code == 1, r.output
+        assert r.stdout == ""
+        lines = r.stderr.splitlines()
+        assert len(lines) == 1 and lines[0].startswith(f"error: no survey plan for {area}: ")
+        assert why in lines[0]
+    assert not fresh.exists()
+    assert [p.name for p in kept.iterdir()] == ["result.json"]
+    assert (kept / "result.json").read_text() == "earlier plan\n"

@@ -9,6 +9,7 @@ import click
 
 from uasnav.cli._common import OutputPath, Real, echo_json
 from uasnav.cli.select import _USAGE_KINDS, _options
+from uasnav.errors import InputError
 from uasnav.mission.planner import PLAN_OPTIONS
 from uasnav.mission.request import SELECT_OPTIONS, OptionError, read_file_option
 
@@ -52,7 +53,9 @@ def command(
     with bounds, writes one F3548 intent per flight, checks the ED-269 --zones over the
     predicted window and deconflicts against --intents. Writes flight-NN.plan (QGroundControl),
     flight-NN.waypoints (Mission Planner), flight-NN.intent.json, summary.html, summary.json and
-    result.json into --out, all or nothing.
+    result.json into --out, all or nothing. When no UAS/camera can fly it (none meets the
+    requirements, or a PROHIBITED zone covers the area over the flight's window) it exits
+    with one error line giving the verdict and writes nothing.
     """
     from uasnav.mission.planner import plan, write_outputs
 
@@ -83,15 +86,15 @@ def command(
         if opt is None or opt.kind not in _USAGE_KINDS:
             raise
         raise click.BadParameter(str(e), param_hint=f"'{opt.flag}'") from None
-    written = write_outputs(res, out)
-    if as_json:
-        echo_json(res.result)
-        return
     r = res.result
     auth = r["authorisation"]
     if r["survey"] is None:
-        click.echo(f"Verdict: {auth['verdict']}")
-        click.echo(f"wrote {len(written)} file(s) to {out}")
+        # nothing ranks: no flight to write; the verdict says why (no UAS/camera meets the
+        # requirements, or a zone forbids the area over the flight's window)
+        raise InputError(f"no survey plan for {options['area']}: {auth['verdict']}")
+    written = write_outputs(res, out)
+    if as_json:
+        echo_json(res.result)
         return
     c, s, op = r["configuration"], r["survey"], r["operation"]
     d = r.get("distances") or {}

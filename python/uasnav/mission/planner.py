@@ -317,21 +317,8 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     lat0, lon0 = request.takeoff
     sel_kw = dict(targets=request.targets, weights=request.weights, top=request.top, regulations=regs)
     sel = select(req, **sel_kw)
-    base = {
-        "configuration": None,
-        "operation": None,
-        "survey": None,
-        "flights": [],
-        "eta_s": None,
-        "zones": None,
-        "conflicts": [],
-        "authorisation": sel.authorisation,
-        "distances": request.distances,
-        "selection": sel.to_dict(),
-    }
     if sel.chosen is None:
-        files = {"result.json": _json(base)}
-        return PlanResult(to_jsonable(base), files, sel, None)
+        return _no_plan(sel, request)
     best = sel.chosen
     u = sel.database.uas
     i = u.ids.index(best.uas_id)
@@ -402,6 +389,10 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     if pick is None or (pick.uas_id, pick.camera_id) != (best.uas_id, best.camera_id):
         again = select(replace(req, flight_duration_s=max(total_s, 1.0)), **sel_kw, **zone_kw)
     sel = again
+    if sel.chosen is None:
+        # the zones over the flight's window leave nothing to rank (a PROHIBITED zone withholds
+        # every configuration): no flight is planned, and none of its files is offered
+        return _no_plan(sel, request)
     if sel.flight_window is not None:
         sel.flight_window["from"] = "predicted flight time of the survey (upper bounds, turnarounds included)"
     conflicts = _deconflict(flights, _read_intents(list(intents_in), dt.datetime.now(dt.timezone.utc)))
@@ -464,6 +455,24 @@ def _deconflict(flights: list[FlightResult], others: list[Any]) -> list[dict[str
             }
         )
     return out
+
+
+def _no_plan(sel: Any, request: Any) -> PlanResult:
+    """The answer when no configuration ranks (none meets the requirements, or a zone withholds
+    them all): the selection's verdict, no survey and no flight; ``result.json`` only."""
+    base = {
+        "configuration": None,
+        "operation": None,
+        "survey": None,
+        "flights": [],
+        "eta_s": None,
+        "zones": sel.zones.to_dict() if sel.zones else None,
+        "conflicts": [],
+        "authorisation": sel.authorisation,
+        "distances": request.distances,
+        "selection": sel.to_dict(),
+    }
+    return PlanResult(to_jsonable(base), {"result.json": _json(base)}, sel, None)
 
 
 def _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap) -> dict[str, Any]:
