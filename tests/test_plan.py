@@ -306,3 +306,91 @@ def test_cli_without_a_plan_is_one_error_line_and_writes_nothing(shared_data, tm
     assert not fresh.exists()
     assert [p.name for p in kept.iterdir()] == ["result.json"]
     assert (kept / "result.json").read_text() == "earlier plan\n"
+
+
+def _volumes(intent_path) -> list[dict]:
+    return [v["volume"] for v in json.loads(intent_path.read_text())["volumes"]]
+
+
+def test_intent_heights_stand_on_the_stated_ground_and_geoid(large) -> None:
+    """h_W84 = H_AMSL(ground) + height + N: the take-off volume starts at the ground's ellipsoidal
+    height less the vertical buffer, and the survey's top is the survey height above it."""
+    from uasnav.geo.geoid import geoid_height
+    from uasnav.utm.intent import DEFAULT_VERTICAL_BUFFER_M as BUF
+
+    res, out = large
+    g = res["ground"]
+    n = float(geoid_height(LAT0, LON0))
+    assert 40.0 < n < 50.0  # EGM96 in northern Italy: a geoid height no plan may ignore
+    assert g["elevation_m"] == 200.0 and g["datum"] == "AMSL" and not g["assumed"]
+    assert "--ground-elevation" in g["source"]
+    assert g["at"] == [LAT0, LON0]
+    assert g["geoid_height_m"] == pytest.approx(n, abs=1e-9)
+    assert g["ellipsoidal_height_m"] == pytest.approx(200.0 + n, abs=1e-9)
+    vols = [v for f in res["flights"] for v in _volumes(out / f"{f['name']}.intent.json")]
+    assert {v[k]["reference"] for v in vols for k in ("altitude_lower", "altitude_upper")} == {"W84"}
+    # the take-off volume begins on the ground; N varies by centimetres over the field
+    assert vols[0]["altitude_lower"]["value"] == pytest.approx(200.0 + n - BUF, abs=0.05)
+    top = max(v["altitude_upper"]["value"] for v in vols)
+    assert top == pytest.approx(200.0 + res["survey"]["altitude_m"] + n + BUF, abs=0.1)
+    # the same datum in the summary written beside the intents
+    assert json.loads((out / "summary.json").read_text())["plan"]["ground"] == g
+    assert "Ground at take-off" in (out / "summary.html").read_text()
+
+
+def test_ground_elevation_shifts_every_intent_altitude_by_itself() -> None:
+    a = uasnav.plan(area=rect(10, 10, 70, 70), takeoff=f"{LAT0},{LON0}", resolution=0.05, start=START)
+    b = uasnav.plan(
+        area=rect(10, 10, 70, 70),
+        takeoff=f"{LAT0},{LON0}",
+        resolution=0.05,
+        start=START,
+        ground_elevation=812.5,
+    )
+    assert a["ground"]["assumed"] and a["ground"]["elevation_m"] == 0.0
+    assert "assumed" in a["ground"]["source"]
+    assert any("give --ground-elevation" in x for x in a["survey"]["assumptions"])
+    assert not any("ground elevation not given" in x for x in b["survey"]["assumptions"])
+    za = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(a)]
+    zb = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(b)]
+    assert len(za) == len(zb) > 0
+    assert np.allclose(np.array(zb) - np.array(za), 812.5, atol=1e-6)
+
+
+def _intent_volumes(res) -> list[dict]:
+    return [
+        v["volume"]
+        for f in res["flights"]
+        for v in json.loads(res.files[f"{f['name']}.intent.json"])["volumes"]
+    ]
+
+
+def test_a_plan_as_area_gives_the_ground_from_its_home(large, tmp_path) -> None:
+    _res, out = large
+    again = uasnav.plan(area=str(out / "flight-01.plan"), resolution=0.05, start=START)
+    g = again["ground"]
+    assert g["elevation_m"] == pytest.approx(200.0) and not g["assumed"]
+    assert "home position of the plan" in g["source"]
+
+
+def test_cli_warns_when_the_ground_is_assumed(tmp_path) -> None:
+    area = tmp_path / "field.geojson"
+    area.write_text(json.dumps(rect(10, 10, 70, 70)))
+    args = [
+        "plan",
+        "--area",
+        str(area),
+        "--takeoff",
+        f"{LAT0},{LON0}",
+        "--resolution",
+        "0.05",
+        "--start",
+        START,
+    ]
+    r = CliRunner().invoke(main, [*args, "--out", str(tmp_path / "a")])
+    assert r.exit_code == 0, r.output
+    assert "Ground at take-off: 0.0 m AMSL (assumed" in r.stdout
+    assert next(x for x in r.stderr.splitlines() if "--ground-elevation" in x).startswith("warning: ")
+    r = CliRunner().invoke(main, [*args, "--ground-elevation", "250", "--out", str(tmp_path / "b")])
+    assert r.exit_code == 0, r.output
+    assert "Ground at take-off: 250.0 m AMSL (the operator" in r.stdout and "warning" not in r.stderr

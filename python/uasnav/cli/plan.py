@@ -106,6 +106,11 @@ def command(
             f"({d.get('pilot_from')})"
         )
     click.echo(f"Survey: {s['altitude_m']:.1f} m {s['altitude_datum']} — {s['height_reason']}")
+    g = r["ground"]
+    click.echo(
+        f"Ground at take-off: {g['elevation_m']:.1f} m {g['datum']} ({g['source']}); geoid height "
+        f"{g['geoid_height_m']:.1f} m ({g['geoid']}), so {g['ellipsoidal_height_m']:.1f} m WGS-84"
+    )
     click.echo(
         f"  {s['gsd_m'] * 100:.2f} cm/px, {s['lines']} lines, {s['photos']} photos, {s['length_m']:.0f} m, "
         f"{s['flights']} flight(s), {s['speed_ms']:.1f} m/s ({s['speed_reason']})"
@@ -130,3 +135,9 @@ def command(
     for a in s["assumptions"]:
         click.echo(f"  assumption: {a}")
     click.echo(f"wrote {len(written)} files to {out}")
+    if g["assumed"]:
+        click.echo(
+            f"warning: the intents' WGS-84 altitudes assume the take-off ground at {g['elevation_m']:g} m "
+            "AMSL: give --ground-elevation (m AMSL) before filing them",
+            err=True,
+        )
