@@ -394,3 +394,45 @@ def test_cli_warns_when_the_ground_is_assumed(tmp_path) -> None:
     r = CliRunner().invoke(main, [*args, "--ground-elevation", "250", "--out", str(tmp_path / "b")])
     assert r.exit_code == 0, r.output
     assert "Ground at take-off: 250.0 m AMSL (the operator" in r.stdout and "warning" not in r.stderr
+
+
+def test_camera_timing_comes_from_the_database_where_it_is_known(tmp_path) -> None:
+    from importlib import resources
+
+    from uasnav.mission.database import load_database
+    from uasnav.mission.survey import DEFAULT_EXPOSURE_S, DEFAULT_TIMING, DEFAULT_TRIGGER_INTERVAL_S, Camera
+
+    shipped = load_database()
+    cams = shipped.cameras
+    mx = Camera.from_table(cams, cams.ids.index("micasense-rededge-mx"))
+    assert mx.trigger_interval_s == 1.0 and "capture interval 1 s from the database" in mx.timing_source
+    assert "support.micasense.com" in cams.sources[cams.ids.index("micasense-rededge-mx")]
+    assert mx.exposure_s == DEFAULT_EXPOSURE_S and "stated default" in mx.timing_source
+    other = Camera.from_table(cams, cams.ids.index("sony-a6000-20-mm"))
+    assert (other.trigger_interval_s, other.exposure_s) == (DEFAULT_TRIGGER_INTERVAL_S, DEFAULT_EXPOSURE_S)
+    assert other.timing_source == DEFAULT_TIMING
+
+    # a database giving both: the survey's speed obeys them (closed forms of the module doc)
+    xml = resources.files("uasnav.mission").joinpath("data", "database.xml").read_text()
+    entry = '<camera id="sony-a6000-20-mm"'
+    at = xml.index("<source>", xml.index(entry))
+    xml = xml[:at] + "<capture_interval_s>2.5</capture_interval_s><exposure_s>0.004</exposure_s>" + xml[at:]
+    db_path = tmp_path / "database.xml"
+    db_path.write_text(xml)
+    db = load_database(str(db_path))
+    cam = Camera.from_table(db.cameras, db.cameras.ids.index("sony-a6000-20-mm"))
+    assert (cam.trigger_interval_s, cam.exposure_s) == (2.5, 0.004)
+    assert "capture interval 2.5 s from the database; exposure 0.004 s from the database" in cam.timing_source
+    from uasnav.mission.survey import DEFAULT_BLUR_PX, plan_survey
+
+    sp = plan_survey(
+        sg.box(0, 0, 200, 150),
+        cam,
+        resolution_m=0.02,
+        origin=(LAT0, LON0),
+        cruise_ms=30.0,
+        overlap=(0.8, 0.7),
+    )
+    expected = min(sp.trigger_m / 2.5, DEFAULT_BLUR_PX * sp.gsd_m / 0.004, 30.0)
+    assert sp.speed_ms == pytest.approx(expected, rel=1e-9)
+    assert any(cam.timing_source in a for a in sp.assumptions)
