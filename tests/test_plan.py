@@ -388,6 +388,9 @@ def test_cli_warns_when_the_ground_is_assumed(tmp_path) -> None:
         START,
     ]
     r = CliRunner().invoke(main, [*args, "--out", str(tmp_path / "a")])
+    j = CliRunner().invoke(main, [*args, "--json", "--out", str(tmp_path / "j")])
+    assert j.exit_code == 0 and json.loads(j.stdout)["ground"]["assumed"]
+    assert j.stderr.startswith("warning: ") and "--ground-elevation" in j.stderr
     assert r.exit_code == 0, r.output
     assert "Ground at take-off: 0.0 m AMSL (assumed" in r.stdout
     assert next(x for x in r.stderr.splitlines() if "--ground-elevation" in x).startswith("warning: ")

@@ -93,8 +93,10 @@ def command(
         # requirements, or a zone forbids the area over the flight's window)
         raise InputError(f"no survey plan for {options['area']}: {auth['verdict']}")
     written = write_outputs(res, out)
+    g = r["ground"]
     if as_json:
         echo_json(res.result)
+        _warn_assumed_ground(g)
         return
     c, s, op = r["configuration"], r["survey"], r["operation"]
     d = r.get("distances") or {}
@@ -106,7 +108,6 @@ def command(
             f"({d.get('pilot_from')})"
         )
     click.echo(f"Survey: {s['altitude_m']:.1f} m {s['altitude_datum']} — {s['height_reason']}")
-    g = r["ground"]
     click.echo(
         f"Ground at take-off: {g['elevation_m']:.1f} m {g['datum']} ({g['source']}); geoid height "
         f"{g['geoid_height_m']:.1f} m ({g['geoid']}), so {g['ellipsoidal_height_m']:.1f} m WGS-84"
@@ -135,6 +136,11 @@ def command(
     for a in s["assumptions"]:
         click.echo(f"  assumption: {a}")
     click.echo(f"wrote {len(written)} files to {out}")
+    _warn_assumed_ground(g)
+
+
+def _warn_assumed_ground(g: dict[str, Any]) -> None:
+    """One warning line when the intents' heights stand on an assumed ground elevation."""
     if g["assumed"]:
         click.echo(
             f"warning: the intents' WGS-84 altitudes assume the take-off ground at {g['elevation_m']:g} m "
