@@ -200,18 +200,21 @@ def _load_command(name: str, module: str) -> click.Command:
 class _Group(click.Group):
     """Turns every error into one ``error: …`` line on stderr and exit code 1: uasnav's domain
     errors and OS errors as they are, anything else as an internal error to report (with the
-    traceback only when ``UASNAV_DEBUG=1``). Subcommands are imported when they run
-    (``lazy_subcommands``, see :data:`SUBCOMMANDS`)."""
+    traceback only when ``UASNAV_DEBUG=1``). With ``lazy_subcommands`` (see :data:`SUBCOMMANDS`)
+    each subcommand is imported when it runs; without, it is an ordinary group."""
 
-    def __init__(self, *args: Any, lazy_subcommands: Mapping[str, tuple[str, str]], **kwargs: Any) -> None:
+    def __init__(
+        self, *args: Any, lazy_subcommands: Mapping[str, tuple[str, str]] | None = None, **kwargs: Any
+    ) -> None:
         super().__init__(*args, **kwargs)
-        self.commands: MutableMapping[str, click.Command] = _LazyCommands(lazy_subcommands)  # type: ignore[assignment]
+        if lazy_subcommands is not None:
+            self.commands: MutableMapping[str, click.Command] = _LazyCommands(lazy_subcommands)  # type: ignore[assignment]
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         # click's own listing, except that a command not yet imported is shown by the summary in
         # the table: the same line click would make from its help, at any terminal width
         commands = self.commands
-        if not isinstance(commands, _LazyCommands):  # pragma: no cover - set in __init__
+        if not isinstance(commands, _LazyCommands):
             return super().format_commands(ctx, formatter)
         names = self.list_commands(ctx)
         rows = []
