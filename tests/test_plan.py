@@ -253,3 +253,189 @@ def test_a_resolution_no_camera_reaches_is_said_as_such() -> None:
     assert res["survey"] is None and not res["authorisation"]["authorisable"]
     assert res["authorisation"]["verdict"].startswith("no camera in the database meets resolution")
     assert set(res.files) == {"result.json"}
+
+
+def _prohibited_sample(shared_data, tmp_path):
+    """The ED-269 sample with its zone made PROHIBITED, and a field inside the zone."""
+    doc = json.loads((shared_data / "utm" / "interuss_ed269_geozone_sample.json").read_text())
+    doc["UASZoneList"][0]["restriction"] = "PROHIBITED"
+    zones = tmp_path / "prohibited.json"
+    zones.write_text(json.dumps(doc))
+    inside = {
+        "type": "Polygon",
+        "coordinates": [
+            [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+        ],
+    }
+    area = tmp_path / "inside.geojson"
+    area.write_text(json.dumps(inside))
+    return area, zones
+
+
+def test_a_prohibited_zone_leaves_no_plan(shared_data, tmp_path) -> None:
+    area, zones = _prohibited_sample(shared_data, tmp_path)
+    res = uasnav.plan(area=str(area), resolution=0.05, zones=str(zones), start=START)
+    # no configuration, no flight, no flight file: the verdict names the zone
+    assert res["configuration"] is None and res["survey"] is None and res["flights"] == []
+    assert not res["authorisation"]["authorisable"]
+    assert "PROHIBITED zone LSXX" in res["authorisation"]["verdict"]
+    assert [h["identifier"] for h in res["zones"]["hits"]] == ["LSXX"]
+    assert res.selection.to_dict()["withheld_ranking"]
+    assert set(res.files) == {"result.json"}
+
+
+@pytest.mark.parametrize("case", ["prohibited", "resolution"])
+def test_cli_without_a_plan_is_one_error_line_and_writes_nothing(shared_data, tmp_path, case) -> None:
+    area, zones = _prohibited_sample(shared_data, tmp_path)
+    if case == "prohibited":
+        args = ["--area", str(area), "--resolution", "0.05", "--zones", str(zones)]
+        why = "PROHIBITED zone LSXX"
+    else:
+        args = ["--area", str(area), "--resolution", "0.0005"]
+        why = "no camera in the database meets resolution"
+    fresh, kept = tmp_path / "fresh", tmp_path / "kept"
+    kept.mkdir()
+    (kept / "result.json").write_text("earlier plan\n")
+    for out in (fresh, kept):
+        r = CliRunner().invoke(main, ["plan", *args, "--start", START, "--out", str(out), "--json"])
+        assert r.exit_code == 1, r.output
+        assert r.stdout == ""
+        lines = r.stderr.splitlines()
+        assert len(lines) == 1 and lines[0].startswith(f"error: no survey plan for {area}: ")
+        assert why in lines[0]
+    assert not fresh.exists()
+    assert [p.name for p in kept.iterdir()] == ["result.json"]
+    assert (kept / "result.json").read_text() == "earlier plan\n"
+
+
+def _volumes(intent_path) -> list[dict]:
+    return [v["volume"] for v in json.loads(intent_path.read_text())["volumes"]]
+
+
+def test_intent_heights_stand_on_the_stated_ground_and_geoid(large) -> None:
+    """h_W84 = H_AMSL(ground) + height + N: the take-off volume starts at the ground's ellipsoidal
+    height less the vertical buffer, and the survey's top is the survey height above it."""
+    from uasnav.geo.geoid import geoid_height
+    from uasnav.utm.intent import DEFAULT_VERTICAL_BUFFER_M as BUF
+
+    res, out = large
+    g = res["ground"]
+    n = float(geoid_height(LAT0, LON0))
+    assert 40.0 < n < 50.0  # EGM96 in northern Italy: a geoid height no plan may ignore
+    assert g["elevation_m"] == 200.0 and g["datum"] == "AMSL" and not g["assumed"]
+    assert "--ground-elevation" in g["source"]
+    assert g["at"] == [LAT0, LON0]
+    assert g["geoid_height_m"] == pytest.approx(n, abs=1e-9)
+    assert g["ellipsoidal_height_m"] == pytest.approx(200.0 + n, abs=1e-9)
+    vols = [v for f in res["flights"] for v in _volumes(out / f"{f['name']}.intent.json")]
+    assert {v[k]["reference"] for v in vols for k in ("altitude_lower", "altitude_upper")} == {"W84"}
+    # the take-off volume begins on the ground; N varies by centimetres over the field
+    assert vols[0]["altitude_lower"]["value"] == pytest.approx(200.0 + n - BUF, abs=0.05)
+    top = max(v["altitude_upper"]["value"] for v in vols)
+    assert top == pytest.approx(200.0 + res["survey"]["altitude_m"] + n + BUF, abs=0.1)
+    # the same datum in the summary written beside the intents
+    assert json.loads((out / "summary.json").read_text())["plan"]["ground"] == g
+    assert "Ground at take-off" in (out / "summary.html").read_text()
+
+
+def test_ground_elevation_shifts_every_intent_altitude_by_itself() -> None:
+    a = uasnav.plan(area=rect(10, 10, 70, 70), takeoff=f"{LAT0},{LON0}", resolution=0.05, start=START)
+    b = uasnav.plan(
+        area=rect(10, 10, 70, 70),
+        takeoff=f"{LAT0},{LON0}",
+        resolution=0.05,
+        start=START,
+        ground_elevation=812.5,
+    )
+    assert a["ground"]["assumed"] and a["ground"]["elevation_m"] == 0.0
+    assert "assumed" in a["ground"]["source"]
+    assert any("give --ground-elevation" in x for x in a["survey"]["assumptions"])
+    assert not any("ground elevation not given" in x for x in b["survey"]["assumptions"])
+    za = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(a)]
+    zb = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(b)]
+    assert len(za) == len(zb) > 0
+    assert np.allclose(np.array(zb) - np.array(za), 812.5, atol=1e-6)
+
+
+def _intent_volumes(res) -> list[dict]:
+    return [
+        v["volume"]
+        for f in res["flights"]
+        for v in json.loads(res.files[f"{f['name']}.intent.json"])["volumes"]
+    ]
+
+
+def test_a_plan_as_area_gives_the_ground_from_its_home(large, tmp_path) -> None:
+    _res, out = large
+    again = uasnav.plan(area=str(out / "flight-01.plan"), resolution=0.05, start=START)
+    g = again["ground"]
+    assert g["elevation_m"] == pytest.approx(200.0) and not g["assumed"]
+    assert "home position of the plan" in g["source"]
+
+
+def test_cli_warns_when_the_ground_is_assumed(tmp_path) -> None:
+    area = tmp_path / "field.geojson"
+    area.write_text(json.dumps(rect(10, 10, 70, 70)))
+    args = [
+        "plan",
+        "--area",
+        str(area),
+        "--takeoff",
+        f"{LAT0},{LON0}",
+        "--resolution",
+        "0.05",
+        "--start",
+        START,
+    ]
+    r = CliRunner().invoke(main, [*args, "--out", str(tmp_path / "a")])
+    j = CliRunner().invoke(main, [*args, "--json", "--out", str(tmp_path / "j")])
+    assert j.exit_code == 0 and json.loads(j.stdout)["ground"]["assumed"]
+    assert j.stderr.startswith("warning: ") and "--ground-elevation" in j.stderr
+    assert r.exit_code == 0, r.output
+    assert "Ground at take-off: 0.0 m AMSL (assumed" in r.stdout
+    assert next(x for x in r.stderr.splitlines() if "--ground-elevation" in x).startswith("warning: ")
+    r = CliRunner().invoke(main, [*args, "--ground-elevation", "250", "--out", str(tmp_path / "b")])
+    assert r.exit_code == 0, r.output
+    assert "Ground at take-off: 250.0 m AMSL (the operator" in r.stdout and "warning" not in r.stderr
+
+
+def test_camera_timing_comes_from_the_database_where_it_is_known(tmp_path) -> None:
+    from importlib import resources
+
+    from uasnav.mission.database import load_database
+    from uasnav.mission.survey import DEFAULT_EXPOSURE_S, DEFAULT_TIMING, DEFAULT_TRIGGER_INTERVAL_S, Camera
+
+    shipped = load_database()
+    cams = shipped.cameras
+    mx = Camera.from_table(cams, cams.ids.index("micasense-rededge-mx"))
+    assert mx.trigger_interval_s == 1.0 and "capture interval 1 s from the database" in mx.timing_source
+    assert "support.micasense.com" in cams.sources[cams.ids.index("micasense-rededge-mx")]
+    assert mx.exposure_s == DEFAULT_EXPOSURE_S and "stated default" in mx.timing_source
+    other = Camera.from_table(cams, cams.ids.index("sony-a6000-20-mm"))
+    assert (other.trigger_interval_s, other.exposure_s) == (DEFAULT_TRIGGER_INTERVAL_S, DEFAULT_EXPOSURE_S)
+    assert other.timing_source == DEFAULT_TIMING
+
+    # a database giving both: the survey's speed obeys them (closed forms of the module doc)
+    xml = resources.files("uasnav.mission").joinpath("data", "database.xml").read_text()
+    entry = '<camera id="sony-a6000-20-mm"'
+    at = xml.index("<source>", xml.index(entry))
+    xml = xml[:at] + "<capture_interval_s>2.5</capture_interval_s><exposure_s>0.004</exposure_s>" + xml[at:]
+    db_path = tmp_path / "database.xml"
+    db_path.write_text(xml)
+    db = load_database(str(db_path))
+    cam = Camera.from_table(db.cameras, db.cameras.ids.index("sony-a6000-20-mm"))
+    assert (cam.trigger_interval_s, cam.exposure_s) == (2.5, 0.004)
+    assert "capture interval 2.5 s from the database; exposure 0.004 s from the database" in cam.timing_source
+    from uasnav.mission.survey import DEFAULT_BLUR_PX, plan_survey
+
+    sp = plan_survey(
+        sg.box(0, 0, 200, 150),
+        cam,
+        resolution_m=0.02,
+        origin=(LAT0, LON0),
+        cruise_ms=30.0,
+        overlap=(0.8, 0.7),
+    )
+    expected = min(sp.trigger_m / 2.5, DEFAULT_BLUR_PX * sp.gsd_m / 0.004, 30.0)
+    assert sp.speed_ms == pytest.approx(expected, rel=1e-9)
+    assert any(cam.timing_source in a for a in sp.assumptions)

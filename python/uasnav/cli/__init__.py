@@ -1,8 +1,10 @@
 """The ``uasnav`` command line: one click group, one module per subcommand.
 
-Each module in this package that defines a module-level ``command`` (a ``click.Command`` or
-``click.Group``) is registered automatically, so a capability adds its subcommand by adding a
-file here and nothing else.
+Each subcommand is a module in this package that defines a module-level ``command`` (a
+``click.Command`` or ``click.Group``), named with the first paragraph of its help in
+:data:`SUBCOMMANDS`. A module is imported only when its command runs (or shows its own
+``--help``): ``uasnav --help`` lists every command from the table and imports none of them, so
+the start-up of one command does not pay for the libraries of all the others.
 
 Exit codes: 0 success; 1 a domain error (bad input file, invalid data, numerical failure) with a
 one-line ``error: …`` message on stderr; 2 a usage error (unknown option, missing argument, an
@@ -15,9 +17,9 @@ from __future__ import annotations
 import functools
 import importlib
 import os
-import pkgutil
 import sys
 import warnings
+from collections.abc import Iterator, Mapping, MutableMapping
 from typing import Any
 
 import click
@@ -30,6 +32,75 @@ from uasnav.limits import check_environment, check_input_file
 _MAX_MESSAGE = 2000
 #: Set to 1 to let unexpected exceptions through with their traceback (for bug reports).
 DEBUG_ENV = "UASNAV_DEBUG"
+
+#: The subcommands: name → (the module that defines it as ``command``, the first paragraph of
+#: its help, which ``uasnav --help`` shortens to its one-line summary). A test checks it against
+#: the modules; a new subcommand is a module here and a line in this table.
+SUBCOMMANDS: Mapping[str, tuple[str, str]] = {
+    "allan": (
+        "uasnav.cli.allan",
+        "Allan deviation of the gyro and accelerometer axes of LOG, and their noise terms.",
+    ),
+    "calibrate": (
+        "uasnav.cli.calibrate",
+        "Fit a thermal gyro-bias model to TRAIN (static log with temp), or test --model on --test.",
+    ),
+    "db": ("uasnav.cli.db", "Inspect and validate the mission selector's XML databases."),
+    "fleet": ("uasnav.cli.fleet", "Process a fleet's logs on a Dask cluster (a local one by default)."),
+    "monitor": (
+        "uasnav.cli.monitor",
+        "Follow each vehicle on CONNECTION (udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT, "
+        "/dev/ttyX,BAUD) and report its F3548 conformance state changes (Accepted, Activated, "
+        "Nonconforming, Contingent, Ended) and telemetry losses.",
+    ),
+    "nav": (
+        "uasnav.cli.nav",
+        "Replay LOG (.ulg, .bin, .tlog, .csv with --gnss, or an ALFA ROS-topic CSV folder) through "
+        "the loosely coupled GNSS/INS filter, compare it with the autopilot's own estimate, and "
+        "optionally mask GNSS to measure dead-reckoning drift.",
+    ),
+    "plan": ("uasnav.cli.plan", "Plan the survey of an --area and everything its authorisation needs."),
+    "redundancy": (
+        "uasnav.cli.redundancy",
+        "Redundant IMUs on regular polyhedra (thesis §4.3): k_r, fusion, FDI.",
+    ),
+    "replay": (
+        "uasnav.cli.replay",
+        "Send LOG (.tlog as recorded; .bin/.ulg converted to the MAVLink messages a ground station "
+        "receives) to a UDP address in its recorded timing, scaled by --speed.",
+    ),
+    "report": (
+        "uasnav.cli.report",
+        "Reproduce the thesis' experiments on embedded, simulated data and write OUT/report.html "
+        "(self-contained, with figures) and OUT/report.json.",
+    ),
+    "select": (
+        "uasnav.cli.select",
+        "Equipment, feasible UAS and cameras, and ranked UAS/camera configurations for a mission.",
+    ),
+    "serve": (
+        "uasnav.cli.serve",
+        "Start the web application: mission selection, trajectory prediction, database pages and "
+        "the JSON API (/api, /openapi.json), fully offline.",
+    ),
+    "simulate": (
+        "uasnav.cli.simulate",
+        "Simulate a static IMU with every error term and write it (with ground truth) to OUT.",
+    ),
+    "trajectory": (
+        "uasnav.cli.trajectory",
+        "Trajectory prediction (kinematic point mass with the autopilot's limits, or the thesis' "
+        "LVQ networks): element times, ETA, 4D waypoint times, time bounds, operational intents.",
+    ),
+    "utm": ("uasnav.cli.utm", "UTM: deconfliction of ASTM F3548 operational intents."),
+    "zupt": (
+        "uasnav.cli.zupt",
+        "Estimate the gyro and accelerometer biases of a stationary LOG with the 15-state ZUPT "
+        "filter (calibrated gyro data) or the thermally compensated TCZUPT filter (raw gyro data "
+        "and a thermal model's derivative).",
+    ),
+}
+
 
 # click's own control flow (usage errors → exit 2, --help, ctx.exit) and the interpreter's
 # (Ctrl-C, sys.exit) pass through the handler untouched.
@@ -74,10 +145,94 @@ def _show_held(caught: list[warnings.WarningMessage]) -> None:
         click.echo(f"warning: {text}", err=True)
 
 
+class _LazyCommands(MutableMapping[str, click.Command]):
+    """The group's commands, each imported from its module the first time it is looked up.
+
+    Names and membership come from the table without importing anything; ``[name]``, ``get``,
+    ``values()`` and ``items()`` import what they return, so code that walks every command
+    (completion, the option tests) sees them all, loaded."""
+
+    def __init__(self, table: Mapping[str, tuple[str, str]]) -> None:
+        self._table = table
+        self._loaded: dict[str, click.Command] = {}
+
+    def __getitem__(self, name: str) -> click.Command:
+        if name not in self._loaded:
+            if name not in self._table:
+                raise KeyError(name)
+            self._loaded[name] = _load_command(name, self._table[name][0])
+        return self._loaded[name]
+
+    def __setitem__(self, name: str, cmd: click.Command) -> None:
+        self._loaded[name] = cmd
+
+    def __delitem__(self, name: str) -> None:
+        if name not in self:
+            raise KeyError(name)
+        self._loaded.pop(name, None)
+        self._table = {k: v for k, v in self._table.items() if k != name}
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._loaded or name in self._table
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(dict.fromkeys([*self._table, *self._loaded]))
+
+    def __len__(self) -> int:
+        return len(dict.fromkeys([*self._table, *self._loaded]))
+
+    def is_loaded(self, name: str) -> bool:
+        return name in self._loaded
+
+    def summary(self, name: str) -> str:
+        """The first paragraph of ``name``'s help, from the table (nothing imported)."""
+        return self._table[name][1]
+
+
+def _load_command(name: str, module: str) -> click.Command:
+    cmd = getattr(importlib.import_module(module), "command", None)
+    if not isinstance(cmd, click.Command) or cmd.name != name:
+        raise RuntimeError(f"{module} does not define the click command {name!r} as `command`")
+    _guarded(cmd)
+    return cmd
+
+
 class _Group(click.Group):
     """Turns every error into one ``error: …`` line on stderr and exit code 1: uasnav's domain
     errors and OS errors as they are, anything else as an internal error to report (with the
-    traceback only when ``UASNAV_DEBUG=1``)."""
+    traceback only when ``UASNAV_DEBUG=1``). With ``lazy_subcommands`` (see :data:`SUBCOMMANDS`)
+    each subcommand is imported when it runs; without, it is an ordinary group."""
+
+    def __init__(
+        self, *args: Any, lazy_subcommands: Mapping[str, tuple[str, str]] | None = None, **kwargs: Any
+    ) -> None:
+        super().__init__(*args, **kwargs)
+        if lazy_subcommands is not None:
+            self.commands: MutableMapping[str, click.Command] = _LazyCommands(lazy_subcommands)  # type: ignore[assignment]
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        # click's own listing, except that a command not yet imported is shown by the summary in
+        # the table: the same line click would make from its help, at any terminal width
+        commands = self.commands
+        if not isinstance(commands, _LazyCommands):
+            return super().format_commands(ctx, formatter)
+        names = self.list_commands(ctx)
+        rows = []
+        if names:
+            limit = formatter.width - 6 - max(len(n) for n in names)
+            for name in names:
+                if commands.is_loaded(name):
+                    cmd = commands[name]
+                    if cmd.hidden:
+                        continue
+                    rows.append((name, cmd.get_short_help_str(limit)))
+                else:
+                    rows.append(
+                        (name, click.Command(name, help=commands.summary(name)).get_short_help_str(limit))
+                    )
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
 
     def invoke(self, ctx: click.Context) -> Any:
         # A warning (ours, e.g. CorruptDataWarning, or a library's that we let through on
@@ -126,7 +281,9 @@ class _Group(click.Group):
         ctx.exit(1)
 
 
-@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(
+    cls=_Group, lazy_subcommands=SUBCOMMANDS, context_settings={"help_option_names": ["-h", "--help"]}
+)
 @click.version_option(__version__, "--version", prog_name="uasnav")
 def main() -> None:
     """Navigation and mission management for small unmanned aircraft.
@@ -188,20 +345,6 @@ def _guarded(cmd: click.Command, staged: bool = True) -> None:
             return callback(*args, **kwargs)
 
     cmd.callback = functools.update_wrapper(checked, callback)
-
-
-def _register() -> None:
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        if info.name.startswith("_"):
-            continue
-        mod = importlib.import_module(f"{__name__}.{info.name}")
-        cmd = getattr(mod, "command", None)
-        if isinstance(cmd, click.Command):
-            _guarded(cmd)
-            main.add_command(cmd)
-
-
-_register()
 
 
 def run() -> None:  # pragma: no cover - console entry point alias

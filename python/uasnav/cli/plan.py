@@ -9,6 +9,7 @@ import click
 
 from uasnav.cli._common import OutputPath, Real, echo_json
 from uasnav.cli.select import _USAGE_KINDS, _options
+from uasnav.errors import InputError
 from uasnav.mission.planner import PLAN_OPTIONS
 from uasnav.mission.request import SELECT_OPTIONS, OptionError, read_file_option
 
@@ -52,7 +53,9 @@ def command(
     with bounds, writes one F3548 intent per flight, checks the ED-269 --zones over the
     predicted window and deconflicts against --intents. Writes flight-NN.plan (QGroundControl),
     flight-NN.waypoints (Mission Planner), flight-NN.intent.json, summary.html, summary.json and
-    result.json into --out, all or nothing.
+    result.json into --out, all or nothing. When no UAS/camera can fly it (none meets the
+    requirements, or a PROHIBITED zone covers the area over the flight's window) it exits
+    with one error line giving the verdict and writes nothing.
     """
     from uasnav.mission.planner import plan, write_outputs
 
@@ -83,15 +86,17 @@ def command(
         if opt is None or opt.kind not in _USAGE_KINDS:
             raise
         raise click.BadParameter(str(e), param_hint=f"'{opt.flag}'") from None
-    written = write_outputs(res, out)
-    if as_json:
-        echo_json(res.result)
-        return
     r = res.result
     auth = r["authorisation"]
     if r["survey"] is None:
-        click.echo(f"Verdict: {auth['verdict']}")
-        click.echo(f"wrote {len(written)} file(s) to {out}")
+        # nothing ranks: no flight to write; the verdict says why (no UAS/camera meets the
+        # requirements, or a zone forbids the area over the flight's window)
+        raise InputError(f"no survey plan for {options['area']}: {auth['verdict']}")
+    written = write_outputs(res, out)
+    g = r["ground"]
+    if as_json:
+        echo_json(res.result)
+        _warn_assumed_ground(g)
         return
     c, s, op = r["configuration"], r["survey"], r["operation"]
     d = r.get("distances") or {}
@@ -103,6 +108,10 @@ def command(
             f"({d.get('pilot_from')})"
         )
     click.echo(f"Survey: {s['altitude_m']:.1f} m {s['altitude_datum']} — {s['height_reason']}")
+    click.echo(
+        f"Ground at take-off: {g['elevation_m']:.1f} m {g['datum']} ({g['source']}); geoid height "
+        f"{g['geoid_height_m']:.1f} m ({g['geoid']}), so {g['ellipsoidal_height_m']:.1f} m WGS-84"
+    )
     click.echo(
         f"  {s['gsd_m'] * 100:.2f} cm/px, {s['lines']} lines, {s['photos']} photos, {s['length_m']:.0f} m, "
         f"{s['flights']} flight(s), {s['speed_ms']:.1f} m/s ({s['speed_reason']})"
@@ -127,3 +136,14 @@ def command(
     for a in s["assumptions"]:
         click.echo(f"  assumption: {a}")
     click.echo(f"wrote {len(written)} files to {out}")
+    _warn_assumed_ground(g)
+
+
+def _warn_assumed_ground(g: dict[str, Any]) -> None:
+    """One warning line when the intents' heights stand on an assumed ground elevation."""
+    if g["assumed"]:
+        click.echo(
+            f"warning: the intents' WGS-84 altitudes assume the take-off ground at {g['elevation_m']:g} m "
+            "AMSL: give --ground-elevation (m AMSL) before filing them",
+            err=True,
+        )

@@ -80,6 +80,8 @@ class CameraTable:
     bands: list[str]
     sources: list[str]
     estimated: list[frozenset[str]]
+    capture_interval_s: np.ndarray  # shortest interval between two captures, s; NaN where unknown
+    exposure_s: np.ndarray  # fixed exposure, s; NaN where unknown (automatic exposure)
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -163,5 +165,7 @@ def load_database(source: str | os.PathLike | None = None, **fetch_kw) -> Databa
         sensor_w_mm=col(cs, "sensor_w_mm"),
         focal_mm=col(cs, "focal_mm"),
         bands=[e.findtext("bands") or "" for e in cs],
+        capture_interval_s=col(cs, "capture_interval_s"),
+        exposure_s=col(cs, "exposure_s"),
     )
     return Database(uas, cams, where)

@@ -40,6 +40,9 @@ COVERAGE = 0.95
 CALIBRATION_RUNS = 40
 #: Ground elevation taken when none is given, m AMSL (stated in the output).
 DEFAULT_GROUND_ELEVATION_M = 0.0
+#: Farthest a plan's home position may be from the take-off point (m) for its altitude to be
+#: taken as the take-off ground's.
+HOME_AS_TAKEOFF_M = 100.0
 #: Files written per flight (``{k:02d}`` is the flight number).
 FLIGHT_FILES = ("flight-{k:02d}.plan", "flight-{k:02d}.waypoints", "flight-{k:02d}.intent.json")
 
@@ -317,21 +320,8 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     lat0, lon0 = request.takeoff
     sel_kw = dict(targets=request.targets, weights=request.weights, top=request.top, regulations=regs)
     sel = select(req, **sel_kw)
-    base = {
-        "configuration": None,
-        "operation": None,
-        "survey": None,
-        "flights": [],
-        "eta_s": None,
-        "zones": None,
-        "conflicts": [],
-        "authorisation": sel.authorisation,
-        "distances": request.distances,
-        "selection": sel.to_dict(),
-    }
     if sel.chosen is None:
-        files = {"result.json": _json(base)}
-        return PlanResult(to_jsonable(base), files, sel, None)
+        return _no_plan(sel, request)
     best = sel.chosen
     u = sel.database.uas
     i = u.ids.index(best.uas_id)
@@ -351,12 +341,13 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
         cruise_ms=cruise,
         endurance_s=endurance,
     )
-    ground = req.ground_elevation_m
-    if ground is None:
-        ground = DEFAULT_GROUND_ELEVATION_M
+    ground_info = ground_datum(req.ground_elevation_m, area, lat0, lon0)
+    ground = ground_info["elevation_m"]
+    if ground_info["assumed"]:
         sp.assumptions.append(
-            f"ground elevation not given: the take-off point is taken at {ground:g} m AMSL for the "
-            "intents' WGS-84 altitudes (give --ground-elevation before filing)"
+            f"ground elevation not given: the take-off point is taken at {ground:g} m AMSL, so the "
+            f"intents' WGS-84 altitudes are {ground:g} m + height + geoid height "
+            f"({ground_info['geoid_height_m']:.1f} m here); give --ground-elevation (m AMSL) before filing"
         )
     model = survey_predictor(sp.speed_ms)
     from uasnav.trajectory.features import wind_vector
@@ -402,10 +393,14 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     if pick is None or (pick.uas_id, pick.camera_id) != (best.uas_id, best.camera_id):
         again = select(replace(req, flight_duration_s=max(total_s, 1.0)), **sel_kw, **zone_kw)
     sel = again
+    if sel.chosen is None:
+        # the zones over the flight's window leave nothing to rank (a PROHIBITED zone withholds
+        # every configuration): no flight is planned, and none of its files is offered
+        return _no_plan(sel, request)
     if sel.flight_window is not None:
         sel.flight_window["from"] = "predicted flight time of the survey (upper bounds, turnarounds included)"
     conflicts = _deconflict(flights, _read_intents(list(intents_in), dt.datetime.now(dt.timezone.utc)))
-    result = _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap)
+    result = _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap, ground_info)
     files = _files(sel, sp, flights, result)
     return PlanResult(result, files, sel, sp, flights)
 
@@ -466,7 +461,76 @@ def _deconflict(flights: list[FlightResult], others: list[Any]) -> list[dict[str
     return out
 
 
-def _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap) -> dict[str, Any]:
+def ground_datum(elevation_m: float | None, area: Any, lat_deg: float, lon_deg: float) -> dict[str, Any]:
+    """The ground under the take-off point (``lat_deg``, ``lon_deg``) that every height of the
+    plan stands on, with its datum and where it comes from.
+
+    The survey flies at heights above this point (flat field); an F3548 intent needs WGS-84
+    ellipsoidal altitudes: h_W84 = H_AMSL(ground) + height + N, with N the EGM96 geoid height
+    (:func:`uasnav.geo.geoid.geoid_height`, evaluated at each point of the intent). The ground's
+    AMSL elevation is, in this order: the operator's (``elevation_m``, ``--ground-elevation``);
+    the home altitude of a mission plan given as the area, when its home is within
+    :data:`HOME_AS_TAKEOFF_M` of the take-off point; else :data:`DEFAULT_GROUND_ELEVATION_M`,
+    flagged ``assumed`` (uasnav carries no terrain model: the geoid gives ellipsoid ↔ AMSL,
+    not the ground).
+
+    Returns
+    -------
+    dict
+        ``elevation_m`` (m AMSL), ``datum`` ("AMSL"), ``source``, ``assumed``, ``at`` ([lat, lon]
+        of the take-off point), ``geoid`` (model), ``geoid_height_m`` (N at the take-off point)
+        and ``ellipsoidal_height_m`` (the ground's h_W84 there).
+    """
+    from uasnav.geo import frames
+    from uasnav.geo.geoid import GEOID_MODEL, geoid_height
+
+    assumed = False
+    if elevation_m is not None:
+        ground, source = float(elevation_m), "the operator (--ground-elevation)"
+    else:
+        home = getattr(area, "home", None)
+        d = math.inf
+        if home is not None:
+            e, n, _ = frames.geodetic_to_enu(home[0], home[1], 0.0, lat_deg, lon_deg, 0.0)
+            d = math.hypot(float(e), float(n))
+        if d <= HOME_AS_TAKEOFF_M:
+            ground = float(home[2])
+            source = f"the home position of the plan {area.where} ({d:.0f} m from the take-off point)"
+        else:
+            ground, assumed = DEFAULT_GROUND_ELEVATION_M, True
+            source = "assumed: no ground elevation given and no terrain model"
+    n_m = float(geoid_height(lat_deg, lon_deg))
+    return {
+        "elevation_m": ground,
+        "datum": "AMSL",
+        "source": source,
+        "assumed": assumed,
+        "at": [float(lat_deg), float(lon_deg)],
+        "geoid": GEOID_MODEL,
+        "geoid_height_m": n_m,
+        "ellipsoidal_height_m": ground + n_m,
+    }
+
+
+def _no_plan(sel: Any, request: Any) -> PlanResult:
+    """The answer when no configuration ranks (none meets the requirements, or a zone withholds
+    them all): the selection's verdict, no survey and no flight; ``result.json`` only."""
+    base = {
+        "configuration": None,
+        "operation": None,
+        "survey": None,
+        "flights": [],
+        "eta_s": None,
+        "zones": sel.zones.to_dict() if sel.zones else None,
+        "conflicts": [],
+        "authorisation": sel.authorisation,
+        "distances": request.distances,
+        "selection": sel.to_dict(),
+    }
+    return PlanResult(to_jsonable(base), {"result.json": _json(base)}, sel, None)
+
+
+def _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap, ground) -> dict[str, Any]:
     op = sel.operation
     etas = [f.intent.eta_s for f in flights]
     lo = [f.intent.eta_bounds_s[0] for f in flights]
@@ -509,6 +573,7 @@ def _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap)
             "estimated_time_s": sp.estimated_time_s,
             "assumptions": sp.assumptions,
         },
+        "ground": ground,
         "flights": [f.to_dict() for f in flights],
         "eta_s": {
             "total": float(sum(etas)),
@@ -558,7 +623,7 @@ def _files(sel, sp, flights, result) -> dict[str, bytes]:
             json.dumps(to_json(f.intent.details), indent=1, allow_nan=False) + "\n"
         ).encode()
     summ = summary_dict(sel)
-    summ["plan"] = {k: result[k] for k in ("survey", "flights", "eta_s", "conflicts", "distances")}
+    summ["plan"] = {k: result[k] for k in ("survey", "ground", "flights", "eta_s", "conflicts", "distances")}
     summ["authorisation"] = result["authorisation"]
     files["summary.json"] = _json(summ)
     files["summary.html"] = summary_html(sel, plan=result).encode()

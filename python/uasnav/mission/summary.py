@@ -268,6 +268,22 @@ def summary_fragment(sel: Selection) -> str:
     return "\n".join(parts)
 
 
+def _ground_rows(g: dict[str, Any] | None) -> list[list[str]]:
+    """The take-off ground's elevation, its datum and source, and the geoid height that turns
+    it into the intents' WGS-84 altitudes."""
+    if not g:
+        return []
+    src = f"{g['source']}" + (" — check before filing" if g.get("assumed") else "")
+    return [
+        ["Ground at take-off", f"{g['elevation_m']:.1f} m {g['datum']} ({src})"],
+        [
+            "Geoid height (intents are WGS-84)",
+            f"{g['geoid_height_m']:.2f} m, {g['geoid']}: ground {g['ellipsoidal_height_m']:.1f} m "
+            "above the ellipsoid",
+        ],
+    ]
+
+
 def plan_fragment(result: dict[str, Any]) -> str:
     """The survey part of a ``uasnav plan`` result (``result.json``) as one
     ``<section class="auth-plan">``: the survey, each flight with its predicted time and
@@ -283,6 +299,7 @@ def plan_fragment(result: dict[str, Any]) -> str:
             [
                 ["Height", f"{s['altitude_m']:.1f} m {s['altitude_datum']}"],
                 ["Why this height", s["height_reason"]],
+                *_ground_rows(result.get("ground")),
                 ["Ground resolution", f"{s['gsd_m'] * 100:.2f} cm/px"],
                 ["Overlap front / side", f"{s['overlap']['front']:.0%} / {s['overlap']['side']:.0%}"],
                 [

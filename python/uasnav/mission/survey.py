@@ -53,11 +53,19 @@ MAV_CMD_DO_SET_CAM_TRIGG_DIST = 206
 MIN_RUN_M = 5.0
 #: Default front and side overlaps (photogrammetric mapping of fields).
 DEFAULT_OVERLAP = (0.75, 0.65)
-#: Exposure assumed when the camera database gives none, s (1/1000 s: daylight mapping).
+#: Exposure assumed when the camera database gives none, s. Survey cameras expose
+#: automatically, so no database can give one figure; 1/1000 s is an assumed daylight shutter
+#: speed (not a measured one): the motion-blur limit on speed holds only if the operator keeps
+#: the shutter at least this fast, and the output says so.
 DEFAULT_EXPOSURE_S = 1.0 / 1000.0
-#: Shortest interval between two photos assumed when the database gives none, s (mapping and
-#: multispectral cameras store one capture per second or faster).
+#: Shortest interval between two photos assumed when the database gives none, s: one capture
+#: per second, the rate MicaSense documents for its multispectral cameras (cited with their
+#: ``capture_interval_s`` in the database); an assumption for every other camera.
 DEFAULT_TRIGGER_INTERVAL_S = 1.0
+#: How the output states the defaults.
+DEFAULT_TIMING = (
+    "stated defaults: exposure 1/1000 s (keep the shutter at least this fast), one photo per second"
+)
 #: Motion blur accepted during the exposure, pixels.
 DEFAULT_BLUR_PX = 0.5
 #: Horizontal acceleration assumed for turnarounds and the flight-time estimate, m/s²
@@ -80,7 +88,7 @@ class Camera:
     height_px: float
     exposure_s: float = DEFAULT_EXPOSURE_S
     trigger_interval_s: float = DEFAULT_TRIGGER_INTERVAL_S
-    timing_source: str = "stated defaults (exposure 1/1000 s, one photo per second)"
+    timing_source: str = DEFAULT_TIMING
 
     def __post_init__(self) -> None:
         for name in ("hfov_deg", "width_px", "height_px", "exposure_s", "trigger_interval_s"):
@@ -92,13 +100,33 @@ class Camera:
 
     @classmethod
     def from_table(cls, cameras, j: int) -> Camera:
-        """Camera ``j`` of a :class:`~uasnav.mission.database.CameraTable` (the database gives
-        no exposure or trigger interval: the stated defaults apply)."""
+        """Camera ``j`` of a :class:`~uasnav.mission.database.CameraTable`: its capture interval
+        and exposure where the database gives them (``capture_interval_s``, ``exposure_s``,
+        cited in the entry's source), :data:`DEFAULT_TRIGGER_INTERVAL_S` and
+        :data:`DEFAULT_EXPOSURE_S` otherwise; ``timing_source`` says which."""
+        interval = float(cameras.capture_interval_s[j])
+        exposure = float(cameras.exposure_s[j])
+        have_i, have_e = math.isfinite(interval), math.isfinite(exposure)
+        if have_i or have_e:
+            parts = [
+                f"capture interval {interval:g} s from the database"
+                if have_i
+                else f"capture interval {DEFAULT_TRIGGER_INTERVAL_S:g} s (stated default)",
+                f"exposure {exposure:g} s from the database"
+                if have_e
+                else f"exposure 1/{1.0 / DEFAULT_EXPOSURE_S:g} s (stated default: keep the shutter as fast)",
+            ]
+            source = "; ".join(parts) + f" (database entry {cameras.ids[j]}, cited in its source)"
+        else:
+            source = DEFAULT_TIMING
         return cls(
             name=cameras.label(j),
             hfov_deg=float(cameras.hfov_deg[j]),
             width_px=float(cameras.resolution_w_px[j]),
             height_px=float(cameras.resolution_h_px[j]),
+            exposure_s=exposure if have_e else DEFAULT_EXPOSURE_S,
+            trigger_interval_s=interval if have_i else DEFAULT_TRIGGER_INTERVAL_S,
+            timing_source=source,
         )
 
     def height_for(self, gsd_m: float) -> float:

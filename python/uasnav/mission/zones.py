@@ -155,6 +155,9 @@ class MissionArea:
     #: For a plan's footprint: each positioned item's altitude as (altitude m, frame — an
     #: :class:`~uasnav.io.mission_plan.AltitudeFrame` value —, item index); empty otherwise.
     plan_altitudes: tuple[tuple[float, str, int], ...] = ()
+    #: For a plan's footprint: the plan's home position (lat, lon deg, altitude m AMSL) when the
+    #: plan gives its altitude; None otherwise.
+    home: tuple[float, float, float] | None = None
 
     def centre(self) -> tuple[float, float]:
         """(lon, lat) deg: mean of every vertex (the projection origin)."""
@@ -233,7 +236,13 @@ def area_from_plan(plan: MissionPlan, where: str = "plan", *, buffer_m: float) -
         for k, it in enumerate(plan.items)
         if it.has_position and math.isfinite(it.alt_m) and it.altitude_frame is not AltitudeFrame.NONE
     )
-    return MissionArea((part,), float(buffer_m), where, alts)
+    h = plan.home
+    home = (
+        (float(h.lat_deg), float(h.lon_deg), float(h.alt_amsl_m))
+        if h is not None and all(math.isfinite(x) for x in (h.lat_deg, h.lon_deg, h.alt_amsl_m))
+        else None
+    )
+    return MissionArea((part,), float(buffer_m), where, alts, home)
 
 
 def plan_height(area: MissionArea, *, ground_elevation_m: float | None) -> tuple[float, str] | None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -24,9 +24,11 @@ from uasnav.atomicfile import atomic_write_text
 from uasnav.errors import DataFormatError, InputError
 from uasnav.trajectory.features import N_CELLS, WIND_MAX_MS, Features, cell_index, features
 from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, Elements, discretise, merge_short_legs
-from uasnav.trajectory.lvq import LVQClassifier
 from uasnav.trajectory.samples import ElementSamples
 from uasnav.trajectory.timebounds import TimeBounds
+
+if TYPE_CHECKING:  # the network (and scikit-learn) is imported where a model needs it
+    from uasnav.trajectory.lvq import LVQClassifier
 
 MODEL_FORMAT = "uasnav-trajectory-lvq/1"
 _N_TABLE = 3 * N_CELLS
@@ -240,6 +242,8 @@ class TrajectoryPredictor:
         self.labels_ = populated
         self.label_dv_ = np.bincount(inv, weights=samples.dv_ms) / np.bincount(inv)
         if populated.size >= 2:
+            from uasnav.trajectory.lvq import LVQClassifier
+
             self.lvq_: LVQClassifier | None = LVQClassifier(
                 n_prototypes=max(int(self.n_prototypes), populated.size),
                 algorithm=self.algorithm,
@@ -537,6 +541,8 @@ def _lvq(d: dict[str, Any], labels: np.ndarray) -> LVQClassifier:
         [jc.integer(v, jc.at("lvq.prototype_labels", i), lo=0, hi=c.size - 1) for i, v in enumerate(pl)],
         dtype=np.intp,
     )
+    from uasnav.trajectory.lvq import LVQClassifier
+
     try:
         return LVQClassifier.from_arrays(c, w, lab)
     except InputError as e:
