@@ -50,7 +50,7 @@ SUBCOMMANDS: Mapping[str, tuple[str, str]] = {
     "monitor": (
         "uasnav.cli.monitor",
         "Follow each vehicle on CONNECTION (udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT, "
-        "/dev/ttyX,BAUD) and report its F3548 conformance state changes (Accepted, Activated, "
+        "tcpin:HOST:PORT, /dev/ttyX,BAUD) and report its F3548 conformance state changes (Accepted, Activated, "
         "Nonconforming, Contingent, Ended) and telemetry losses.",
     ),
     "nav": (
@@ -67,7 +67,7 @@ SUBCOMMANDS: Mapping[str, tuple[str, str]] = {
     "replay": (
         "uasnav.cli.replay",
         "Send LOG (.tlog as recorded; .bin/.ulg converted to the MAVLink messages a ground station "
-        "receives) to a UDP address in its recorded timing, scaled by --speed.",
+        "receives) over UDP or TCP in its recorded timing, scaled by --speed.",
     ),
     "report": (
         "uasnav.cli.report",
@@ -80,8 +80,8 @@ SUBCOMMANDS: Mapping[str, tuple[str, str]] = {
     ),
     "serve": (
         "uasnav.cli.serve",
-        "Start the web application: mission selection, trajectory prediction, database pages and "
-        "the JSON API (/api, /openapi.json), fully offline.",
+        "Start the web application: mission selection, trajectory prediction, database pages, the "
+        "live telemetry page (/live) and the JSON API (/api, /openapi.json), fully offline.",
     ),
     "simulate": (
         "uasnav.cli.simulate",
