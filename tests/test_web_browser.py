@@ -104,7 +104,14 @@ def shot(page, name: str) -> None:  # type: ignore[no-untyped-def]
     page.screenshot(path=str(SHOTS / f"{name}.png"), full_page=True)
 
 
+def open_advanced(page) -> None:  # type: ignore[no-untyped-def]
+    """Unfold the form's "Advanced" part (folded by default)."""
+    if page.get_attribute("#advanced", "open") is None:
+        page.click("#advanced-toggle")
+
+
 def fill_thesis(page) -> None:  # type: ignore[no-untyped-def]
+    open_advanced(page)
     for name, value in THESIS_SELECTS.items():
         page.select_option(f"#f-{name}", value)
     for name, value in THESIS.items():
@@ -211,8 +218,21 @@ def test_bad_value_is_shown_beside_its_field(pages, server) -> None:
 
 
 def test_keyboard_only(pages, server) -> None:
-    """Tab reaches every field in order, typing fills them, Enter submits."""
+    """The run button is a few Tab presses away (the short form; "Advanced" folded); Enter on
+    "Advanced" unfolds it and Tab then reaches every field in order, typing fills them, Enter
+    submits, and the focus lands on the results."""
     page = pages.new()
+    page.goto(server.url + "/")
+    core = page.eval_on_selector_all(
+        "#select-form fieldset.core input:not([type=hidden]), #select-form fieldset.core select",
+        "els => els.map(e => e.id)",
+    )
+    presses = 1
+    page.keyboard.press("Tab")  # the skip link
+    while page.evaluate("document.activeElement.type") != "submit" and presses < 40:
+        page.keyboard.press("Tab")
+        presses += 1
+    assert presses <= len(core) + 4, f"{presses} Tab presses to the run button"
     page.goto(server.url + "/")
     order = page.eval_on_selector_all(
         "#select-form input:not([type=hidden]), #select-form select, #select-form button",
@@ -232,6 +252,8 @@ def test_keyboard_only(pages, server) -> None:
             page.keyboard.type("3")
         if active == "f-rain":
             page.keyboard.press("Space")
+        if active == "advanced-toggle":
+            page.keyboard.press("Enter")
         if active in order:
             seen.append(active)
         if active == "submit":
@@ -240,6 +262,7 @@ def test_keyboard_only(pages, server) -> None:
     with page.expect_navigation():
         page.keyboard.press("Enter")
     page.wait_for_selector("#results")
+    assert page.evaluate("document.activeElement.id") == "results"
     assert 0 < page.locator("#ranking tbody tr").count() <= 3
     facts = page.locator(".facts").first.inner_text()
     assert "range 800 m" in facts and "rain" in facts
@@ -339,6 +362,7 @@ def test_not_authorisable_in_the_browser(pages, server, shared_data, tmp_path) -
         page.fill("#f-range", "1500")
         page.set_input_files("#f-zones", str(zones))
         page.set_input_files("#f-area", str(area))
+        open_advanced(page)
         page.uncheck("#f-gnss_autopilot")
         page.click("#select-form button[type=submit]")
         page.wait_for_selector("#results")
@@ -356,3 +380,89 @@ def test_not_authorisable_in_the_browser(pages, server, shared_data, tmp_path) -
         assert page.locator("#rejections tbody tr").count() == n
         shot(page, f"select-withheld-{tag}")
         assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+
+
+#: A 70 × 55 m field (lon, lat) beside Geneva.
+FIELD_RING = [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+
+
+def test_area_upload_map_results_downloads(pages, server, tmp_path) -> None:
+    """Upload an area → the offline map → the results (focused) → every download, at desktop and
+    phone widths; at phone width the ranking's priority columns (mass, cost, operation) are shown
+    with a cue to scroll sideways, and the run button is on screen from the start."""
+    area = tmp_path / "field.geojson"
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [FIELD_RING]}))
+    for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
+        page = pages.new(viewport)
+        page.goto(server.url + "/")
+        box = page.locator("#select-form button[type=submit]").bounding_box()
+        assert box and box["y"] + box["height"] <= viewport["height"], "run button below the fold"
+        page.set_input_files("#f-area", str(area))
+        page.fill("#f-range", "")  # with an area, distances come from the area
+        page.click("#select-form button[type=submit]")
+        page.wait_for_selector("#results")
+        assert page.evaluate("document.activeElement.id") == "results"
+        svg = page.locator("svg.map")
+        assert svg.is_visible()
+        assert page.locator("svg.map path.area").count() == 1
+        assert page.locator("svg.map g.takeoff").count() == 1
+        assert page.locator("svg.map g.north").count() == 1 and page.locator("svg.map g.scale").is_visible()
+        head = page.locator("#ranking thead th")
+        for name in ("Mass (g)", "Cost (USD)", "Operation"):
+            assert head.filter(has_text=name).is_visible(), name
+        if tag == "phone":
+            assert page.locator("#ranking th.opt").first.is_hidden()
+            wide = page.evaluate(
+                "(() => { const b = document.querySelector('#ranking').closest('.scroll');"
+                " return b.scrollWidth > b.clientWidth; })()"
+            )
+            cue = page.locator(".scroll-cue").first
+            assert cue.is_visible() == wide
+        shot(page, f"select-area-{tag}")
+        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+        names = []
+        for link in page.locator(".downloads a[download]").all():
+            with page.expect_download() as d:
+                link.click()
+            assert Path(d.value.path()).stat().st_size > 0
+            names.append(d.value.suggested_filename)
+        assert {"selection.json", "ranking.csv", "authorisation-summary.html"} <= set(names)
+
+
+def test_oversize_upload_is_refused_beside_the_field(pages, server, tmp_path) -> None:
+    big = tmp_path / "big.geojson"
+    with big.open("wb") as f:
+        f.truncate(17 * 2**20)
+    page = pages.new(PHONE)
+    page.goto(server.url + "/")
+    page.fill("#f-wind", "7")
+    page.set_input_files("#f-area", str(big))
+    assert "over the 16 MB limit" in page.locator("#e-area").inner_text()
+    page.click("#select-form button[type=submit]")
+    assert page.locator("#results").count() == 0 and page.input_value("#f-wind") == "7"
+    assert page.evaluate("document.activeElement.id") == "f-area"
+
+
+def test_trajectory_prints_on_one_a4_page(pages, server, tmp_path) -> None:
+    import pymap3d
+
+    from uasnav.trajectory.simulator import phantom4_plans
+
+    ne = phantom4_plans()["B"]
+    lat, lon, _ = pymap3d.ned2geodetic(ne[:, 0], ne[:, 1], 0.0, 47.3977, 8.5456, 50.0)
+    csv = tmp_path / "b.csv"
+    csv.write_text("lat,lon,alt\n" + "".join(f"{a:.9f},{b:.9f},50\n" for a, b in zip(lat, lon, strict=True)))
+    page = pages.new()
+    page.goto(server.url + "/trajectory")
+    page.set_input_files("#t-plan", str(csv))
+    page.fill("#t-required", ",".join(str(10 * i) for i in range(len(ne))))
+    page.click("#trajectory-form button[type=submit]")
+    page.wait_for_selector("#prediction")
+    assert page.evaluate("document.activeElement.id") == "prediction"
+    times = page.locator("#waypoints td[data-time]").all_inner_texts()
+    page.emulate_media(media="print")
+    assert not page.locator("#trajectory-form").is_visible()
+    pdf = pypdf.PdfReader(io.BytesIO(page.pdf(format="A4", print_background=True)))
+    assert len(pdf.pages) == 1
+    printed = pdf.pages[0].extract_text()
+    assert "ETA" in printed and all(t in printed for t in times)  # every waypoint time, none cut

@@ -26,6 +26,74 @@ NOT_FIELDS = frozenset({"source", "output", "output_file", "outfile", "output_pa
 #: Largest uploaded option file (bytes).
 MAX_OPTION_FILE_BYTES = 4 * 2**20
 
+#: The short form an operator fills in; every other field is under "Advanced".
+CORE_FIELDS = (
+    "mission",
+    "area",
+    "resolution",
+    "image_size",
+    "altitude",
+    "imagery",
+    "wind",
+    "range",
+)
+#: Fields that may not be left empty when the form sends them (an absent field takes its
+#: default; an emptied one is a question the operator has not answered). ``range`` is not
+#: needed when an area is uploaded: distances are then measured from the area.
+REQUIRED_FIELDS = (
+    "mission",
+    "range",
+    "resolution",
+    "image_size",
+    "altitude",
+    "imagery",
+    "wind",
+    "jurisdiction",
+)
+
+#: Help in the operator's words (the option table's help speaks the command line's).
+OPERATOR_HELP: dict[str, str] = {
+    "mission": "What the flight is for; it sets the equipment the aircraft must carry.",
+    "range": "How far from take-off the aircraft must fly. With an area uploaded, distances are "
+    "measured from the area instead.",
+    "resolution": "Ground size of one image pixel you need (0.05 m = 5 cm per pixel).",
+    "image_size": "Ground one image must cover, length × width, e.g. 70x70.",
+    "altitude": "Planned height above the ground (the open category allows up to 120 m).",
+    "imagery": "The kind of camera the task needs, or any.",
+    "wind": "Strongest wind expected during the flight.",
+    "rain": "The aircraft must be able to fly in rain.",
+    "speed": "Ground speed the aircraft must hold against the wind; leave empty if none.",
+    "order_by": "What matters most when the configurations are ranked.",
+    "weights": "Your own importance for each parameter, instead of the order above.",
+    "targets": "For each parameter, the value you aim for and the worst you accept (target:limit).",
+    "jurisdiction": "Which rules apply: EASA (Europe) or FAA (United States).",
+    "category": "Leave on default and the category the operation needs is worked out for you.",
+    "gnss_autopilot": "Only aircraft with a GNSS (GPS) autopilot.",
+    "max_distance": "Farthest the pilot will be from the aircraft; empty: worked out from the area "
+    "or the range.",
+    "vlos_distance": "Distance up to which the pilot can still see the aircraft; empty: from each "
+    "aircraft's size.",
+    "observers": "Airspace observers posted along the route, who extend the pilot's sight.",
+    "over_people": "Whether the flight passes over people not involved in it, or over crowds.",
+    "population_density": "People per km² under the flight, or a class: controlled, remote, "
+    "sparsely, lightly (default), suburban, high.",
+    "night": "The flight is at night.",
+    "airspace": "The airspace the flight is in; uncontrolled unless you know otherwise.",
+    "mitigations": "Ground-risk mitigations you can show for the risk assessment, e.g. M1A=low,M2=medium.",
+    "sora_edition": "Edition of the SORA risk assessment to apply.",
+    "residual_arc": "Air-risk class you can claim after strategic mitigations; empty: the initial class.",
+    "area": "The field or route to fly: a GeoJSON or KML file, a QGroundControl plan or a Mission "
+    "Planner waypoints file.",
+    "area_buffer": "Safety margin around the area; empty: none around a field, the flight height "
+    "around a route.",
+    "zones": "Geographical zones from your aviation authority (ED-269 JSON file), to check restrictions.",
+    "ground_elevation": "Height of the ground above sea level, to compare with zone limits given "
+    "above sea level.",
+    "flight_time": "Planned take-off date and time with its time zone, e.g. 2026-05-01T10:00Z.",
+    "flight_duration": "How long the flight lasts; empty: the chosen aircraft's own estimate.",
+    "top": "How many configurations to list.",
+}
+
 
 def is_field(opt: SelectOption) -> bool:
     """Whether ``opt`` is a form field (and an API key)."""
@@ -57,6 +125,20 @@ class FormField:
     @property
     def name(self) -> str:
         return self.option.name
+
+    @property
+    def help(self) -> str:
+        """The field's help in the operator's words (the option's own help otherwise)."""
+        return OPERATOR_HELP.get(self.name, self.option.help)
+
+    @property
+    def core(self) -> bool:
+        """Whether the field is in the short form (else under "Advanced")."""
+        return self.name in CORE_FIELDS
+
+    @property
+    def required(self) -> bool:
+        return self.name in REQUIRED_FIELDS
 
 
 def default_text(opt: SelectOption) -> str:
@@ -124,6 +206,24 @@ def values_from_form(form: Mapping[str, Any], getlist: Any) -> dict[str, Any]:
     return values
 
 
+def empty_required(form: Mapping[str, Any], has_area: bool = False) -> dict[str, str]:
+    """Required fields the form sent empty, each with a message in the operator's words."""
+    errors: dict[str, str] = {}
+    for opt in request_options():
+        if opt.name not in REQUIRED_FIELDS or opt.name not in form:
+            continue
+        if opt.name == "range" and has_area:
+            continue
+        v = form.get(opt.name)
+        if isinstance(v, str) and not v.strip():
+            what = (opt.label or opt.name).lower()
+            unit = f" ({opt.unit})" if opt.unit else ""
+            errors[opt.name] = f"{opt.name}: enter the {what}{unit}" + (
+                ", or upload an area" if opt.name == "range" else ""
+            )
+    return errors
+
+
 def pair_values(text: str | None) -> dict[str, str]:
     """``"range=1,cost=2"`` → {"range": "1", "cost": "2"} for re-filling the sub-fields."""
     out: dict[str, str] = {}
@@ -174,9 +274,13 @@ def file_value(option: str, filename: str, data: bytes) -> Any:
 
 
 __all__ = [
+    "CORE_FIELDS",
     "FILE_KINDS",
     "NOT_FIELDS",
+    "OPERATOR_HELP",
+    "REQUIRED_FIELDS",
     "FormField",
+    "empty_required",
     "field_errors",
     "field_names",
     "file_value",

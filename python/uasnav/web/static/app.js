@@ -3,6 +3,55 @@
   "use strict";
   document.documentElement.classList.add("js");
 
+  // After a run, the answer (or the list of fields to correct) takes the focus, so a keyboard
+  // or screen-reader user lands on it rather than at the top of the form.
+  var landing = document.getElementById("form-error") ||
+    (location.hash ? document.getElementById(location.hash.slice(1)) : null);
+  if (landing && landing.matches("#form-error, #results, #prediction")) {
+    if (!landing.hasAttribute("tabindex")) landing.tabIndex = -1;
+    landing.focus();
+  }
+
+  // Uploads: a file over the server's limit is refused here, beside its field, with the form
+  // kept (the server would refuse the whole request).
+  document.querySelectorAll("form[data-max-upload]").forEach(function (form) {
+    var limit = Number(form.dataset.maxUpload);
+    var check = function (input) {
+      var msg = document.getElementById("e-" + input.name) || document.getElementById("te-" + input.name);
+      var size = 0;
+      Array.prototype.forEach.call(input.files || [], function (f) { size += f.size; });
+      var err = size > limit ? input.name + ": this file is " + (size / 1048576).toFixed(1) +
+        " MB, over the " + Math.round(limit / 1048576) + " MB limit: choose a smaller file" : "";
+      if (msg) msg.textContent = err;
+      input.closest(".field").classList.toggle("invalid", err !== "");
+      if (err) input.setAttribute("aria-invalid", "true"); else input.removeAttribute("aria-invalid");
+      return err === "";
+    };
+    var files = form.querySelectorAll("input[type=file]");
+    files.forEach(function (input) { input.addEventListener("change", function () { check(input); }); });
+    form.addEventListener("submit", function (e) {
+      var bad = null, total = 0;
+      files.forEach(function (input) {
+        if (!check(input) && !bad) bad = input;
+        Array.prototype.forEach.call(input.files || [], function (f) { total += f.size; });
+      });
+      if (!bad && total > limit && files.length) { bad = files[0]; check(bad); }
+      if (bad) { e.preventDefault(); bad.focus(); }
+    });
+  });
+
+  // Wide tables: the "scroll sideways" cue only when the table is wider than its box.
+  var cues = function () {
+    document.querySelectorAll(".scroll").forEach(function (box) {
+      var cue = box.previousElementSibling;
+      if (cue && cue.classList.contains("scroll-cue")) {
+        cue.classList.toggle("shown", box.scrollWidth > box.clientWidth + 1);
+      }
+    });
+  };
+  cues();
+  window.addEventListener("resize", cues);
+
   // Print buttons.
   document.querySelectorAll("[data-print]").forEach(function (b) {
     b.addEventListener("click", function () { window.print(); });

@@ -1,0 +1,121 @@
+"""The selection and trajectory pages through the framework's test client: the short form,
+required fields and oversize uploads answered beside the field, the offline area map, help in
+the operator's words, and the routers the application is built from."""
+
+from __future__ import annotations
+
+import json
+import re
+import warnings
+from pathlib import Path
+
+import pytest
+
+from uasnav.web import create_app, forms
+from uasnav.web.context import MAX_BODY_BYTES
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    from fastapi.testclient import TestClient
+
+BASE = "http://127.0.0.1:8000"
+#: A 70 × 55 m field (lon, lat) beside Geneva.
+RING = [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+AREA = json.dumps({"type": "Polygon", "coordinates": [RING]}).encode()
+
+
+@pytest.fixture(scope="module")
+def client():  # type: ignore[no-untyped-def]
+    return TestClient(create_app(), base_url=BASE, raise_server_exceptions=False)
+
+
+def field_value(html: str, name: str) -> str:
+    m = re.search(rf'id="f-{name}" name="{name}"[^>]*value="([^"]*)"', html, re.S)
+    assert m, name
+    return m.group(1)
+
+
+def test_short_form_then_advanced(client) -> None:
+    html = client.get("/").text
+    core_part, _, advanced = html.partition('<details class="advanced"')
+    for name in forms.CORE_FIELDS:
+        assert f'id="f-{name}"' in core_part, name
+    assert advanced and 'id="f-top"' in advanced and 'id="f-top"' not in core_part
+    # the run button comes before any advanced field is open: nothing but the core to Tab past
+    n_core = len(re.findall(r'<(?:input|select)(?![^>]*type="hidden")', core_part))
+    assert n_core <= 12
+    assert 'class="actions sticky"' in html
+
+
+def test_help_is_in_the_operators_words(client) -> None:
+    html = client.get("/").text
+    helps = re.findall(r'<small class="help"[^>]*>(.*?)</small>', html, re.S)
+    assert len(helps) == len(forms.form_fields({})) or len(helps) > 20
+    for h in helps:
+        assert not re.search(r"--[a-z]", h), h  # no command-line option names
+        assert "http(s) URL" not in h and "path or" not in h, h
+
+
+def test_empty_required_field_is_answered_beside_it(client) -> None:
+    r = client.post("/select", data={"range": "", "resolution": "0.02", "wind": "7"})
+    assert r.status_code == 422
+    assert 'id="e-range" role="alert">range: enter the range (m), or upload an area</span>' in r.text
+    # the form keeps what was typed
+    assert field_value(r.text, "resolution") == "0.02" and field_value(r.text, "wind") == "7"
+    assert 'id="results"' not in r.text
+    # with an area uploaded, no range is needed: distances come from the area
+    r = client.post("/select", data={"range": ""}, files={"area": ("field.geojson", AREA)})
+    assert r.status_code == 200, re.findall(r'class="msg"[^>]*>([^<]+)<', r.text)
+
+
+def test_oversize_upload_is_answered_on_the_page(client) -> None:
+    big = b" " * (MAX_BODY_BYTES + 1)
+    r = client.post("/select", files={"area": ("big.geojson", big)}, data={"range": "800"})
+    assert r.status_code == 413 and r.headers["content-type"].startswith("text/html")
+    assert re.search(r'id="e-area" role="alert">area: the files sent together are over 16 MB', r.text)
+    assert '<form method="post" action="/select#results"' in r.text
+    r = client.post("/trajectory", files={"plan": ("big.plan", big)})
+    assert r.status_code == 413 and 'id="te-plan" role="alert">plan: the files sent together' in r.text
+    # the API keeps its JSON answer
+    r = client.post("/api/trajectory/predict", files={"plan": ("big.plan", big)})
+    assert r.status_code == 413 and r.json()["field"] == "body"
+    # a file under the body limit but over the per-file limit: beside the field, form kept
+    r = client.post(
+        "/select",
+        files={"area": ("a.geojson", b" " * (forms.MAX_OPTION_FILE_BYTES + 1))},
+        data={"range": "800", "wind": "6"},
+    )
+    assert r.status_code == 422 and 'id="e-area" role="alert">area: file over' in r.text
+    assert field_value(r.text, "range") == "800" and field_value(r.text, "wind") == "6"
+
+
+def test_area_upload_draws_the_offline_map(client, shared_data: Path) -> None:
+    doc = json.loads((shared_data / "utm" / "interuss_ed269_geozone_sample.json").read_text())
+    doc["UASZoneList"][0].update(restriction="REQ_AUTHORISATION")
+    r = client.post(
+        "/select",
+        data={"range": "800"},
+        files={"area": ("field.geojson", AREA), "zones": ("zones.json", json.dumps(doc).encode())},
+    )
+    assert r.status_code == 200
+    svg = re.search(r'<svg class="map".*?</svg>', r.text, re.S)
+    assert svg, "no map"
+    s = svg.group(0)
+    assert 'class="area"' in s and 'class="pt takeoff"' in s and 'class="north"' in s
+    assert re.search(r'<g class="scale">.*?<text[^>]*>\d+(\.\d+)? k?m</text>', s, re.S)
+    assert 'class="zone z-auth"' in s  # the zone the field is in, coloured by its restriction
+    # nothing in the map is fetched: no URL but the SVG namespace
+    assert re.findall(r"https?://[^\"' ]+", s) == ["http://www.w3.org/2000/svg"]
+    # the area's polygon is drawn with north up: its northern edge above its southern edge
+    d = re.search(r'class="area" d="M([^"]+)"', s).group(1)
+    ys = [float(p.split(",")[1]) for p in re.findall(r"[\d.]+,[\d.]+", d)]
+    assert max(ys) - min(ys) > 10
+
+
+def test_every_router_answers(client) -> None:
+    """Each page and the API is served by its router at its URL."""
+    for url in ("/", "/trajectory", "/db/uas", "/api", "/api/options", "/api/db/cameras", "/summary.css"):
+        assert client.get(url).status_code == 200, url
+    assert client.get("/db", follow_redirects=False).status_code == 303
+    spec = client.get("/openapi.json").json()["paths"]
+    assert set(spec) == {"/api/select", "/api/options", "/api/db/{name}", "/api/trajectory/predict"}
