@@ -110,7 +110,13 @@ def test_a_schedule_starting_after_take_off_is_hit(doc) -> None:
     (h,) = check_zones(zones, area, height_m=50.0, when=off, until=off + dt.timedelta(seconds=600)).hits
     assert any("flight window" in w for w in h.why)
     # through the selector: the default window is the chosen UAS's mission time estimate
-    base = {"range": 1500, "area": INSIDE, "zones": d, "flight_time": "2026-05-04T09:50Z"}
+    base = {
+        "range": 1500,
+        "max_distance": 1500,
+        "area": INSIDE,
+        "zones": d,
+        "flight_time": "2026-05-04T09:50Z",
+    }
     sel = run_select({**base, "flight_duration": 599})
     assert sel.zones is not None and not sel.zones.hits and sel.flight_window["from"] == "--flight-duration"
     sel = run_select({**base, "flight_time": "2026-05-04T09:56Z"})  # the estimate is about 330 s
@@ -156,7 +162,10 @@ def test_prohibited_zone_makes_the_operation_not_authorisable(doc, tmp_path) -> 
     ("restriction", "word"), [("REQ_AUTHORISATION", "authorisation"), ("CONDITIONAL", "conditions")]
 )
 def test_zone_requirements_are_listed(doc, restriction, word) -> None:
-    sel = run_select({"range": 1500, "area": INSIDE, "zones": _variant(doc, restriction=restriction)})
+    # the pilot 1500 m away: BVLOS, the specific category
+    sel = run_select(
+        {"range": 1500, "max_distance": 1500, "area": INSIDE, "zones": _variant(doc, restriction=restriction)}
+    )
     auth = sel.authorisation
     assert auth["authorisable"] and sel.ranking
     zone_needs = [n for n in auth["requirements"] if n.startswith("zone LSXX")]

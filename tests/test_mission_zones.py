@@ -169,6 +169,8 @@ def test_summary_from_the_cli(tmp_path, sample) -> None:
         "select",
         "--range",
         "1500",
+        "--max-distance",
+        "1500",
         "--area",
         str(area),
         "--zones",

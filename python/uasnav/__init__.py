@@ -19,4 +19,14 @@ try:
 except PackageNotFoundError:  # pragma: no cover - running from a source tree
     from uasnav._core import __version__
 
-__all__ = ["__version__"]
+
+def plan(options=None, /, **kw):  # type: ignore[no-untyped-def]
+    """Plan the survey of a field and everything its authorisation needs: the same structure
+    as ``uasnav plan --json`` (:func:`uasnav.mission.planner.plan`; its ``result`` is
+    ``result.json``, its ``files`` every file the command writes)."""
+    from uasnav.mission.planner import plan as _plan
+
+    return _plan(options, **kw)
+
+
+__all__ = ["__version__", "plan"]

@@ -19,7 +19,7 @@ from uasnav.mission.selection import select
 
 #: Kinds whose bad values are usage errors (exit 2), like the typed options; the other refusals
 #: (a combination the regulations cannot resolve) stay domain errors (exit 1).
-_USAGE_KINDS = ("size", "pairs", "density", "mitigations", "datetime", "file")
+_USAGE_KINDS = ("size", "pairs", "density", "mitigations", "datetime", "file", "wind", "position")
 
 
 def _click_type(opt: SelectOption) -> Any:
@@ -116,6 +116,13 @@ def command(as_json: bool, **options: Any) -> None:
     click.echo(
         f"Mission: {sel.mission_name}  ({jurisdiction}/{category}, max height {sel.regulatory_height_m:g} m)"
     )
+    if request.distances is not None:
+        d = request.distances
+        click.echo(
+            f"Distances: pilot {d['pilot_distance_m']:.0f} m from the farthest point of the area "
+            f"(pilot at {d['pilot_from']}), range {d['range_m']:.0f} m from the take-off point "
+            f"({d['takeoff_from']})"
+        )
     if op is not None:
         click.echo(
             f"Operation: {op.visibility}, {op.max_distance_m:g} m from the pilot (in sight up to "
@@ -165,8 +172,10 @@ def command(as_json: bool, **options: Any) -> None:
         if e.necessary:
             click.echo(f"    * {e.name}: {e.reason}")
     click.echo(f"\nFeasible UAS ({len(sel.feasible_uas)}): " + ", ".join(sel.feasible_uas))
+    rule = "planned height" if req.camera_height == "planned" else "regulatory maximum height"
     click.echo(
-        f"Feasible cameras ({len(sel.feasible_cameras)}, HFOV >= {sel.required_hfov_deg:.1f} deg): "
+        f"Feasible cameras ({len(sel.feasible_cameras)}, HFOV >= {sel.required_hfov_deg:.1f} deg and "
+        f"<= {req.resolution_m:g} m/px at {sel.camera_height_m:g} m, the {rule}): "
         + ", ".join(sel.feasible_cameras)
     )
     click.echo(f"\nRejections ({len(sel.rejections)}):")

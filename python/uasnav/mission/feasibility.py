@@ -14,6 +14,12 @@ import numpy as np
 from uasnav.errors import InputError
 from uasnav.mission.database import CameraTable, UasTable
 
+#: Heights the cameras can be tested at (:attr:`Requirements.camera_height`).
+CAMERA_HEIGHTS = ("planned", "regulatory-max")
+#: Lowest height a survey is planned at, m above ground (clear of trees, buildings and people's
+#: heads on an agricultural field; below it a camera is too narrow for the resolution asked).
+MIN_SURVEY_HEIGHT_M = 10.0
+
 
 @dataclass(frozen=True)
 class Requirements:
@@ -76,6 +82,14 @@ class Requirements:
     flight_duration_s : float or None
         Flight duration (s) for the zones' schedules (take-off + duration); None: the chosen
         UAS's mission time estimate (:func:`mission_time_s`).
+    camera_height : {"planned", "regulatory-max"}
+        Height at which the cameras' field of view and resolution are tested: the planned flight
+        height ``altitude_m`` (what the operator will get), or the highest height the category
+        allows (the thesis' rule, §5.2.3.4).
+    mosaic : bool
+        The target is covered by many photos (a survey, ``uasnav plan``): no single photo has to
+        hold it (no field-of-view test), and the resolution only has to be reachable at or above
+        :data:`MIN_SURVEY_HEIGHT_M` (the survey flies at the height that gives it).
     """
 
     mission: str = "precision-agriculture"
@@ -107,6 +121,8 @@ class Requirements:
     flight_duration_s: float | None = None
     #: Where ``altitude_m`` came from when not ``--altitude`` (a plan flying higher), else None.
     altitude_source: str | None = None
+    camera_height: str = "planned"
+    mosaic: bool = False
 
     def __post_init__(self) -> None:
         checks = {
@@ -139,6 +155,10 @@ class Requirements:
             raise InputError(f"requirement ground_elevation_m={self.ground_elevation_m}: must be finite")
         if not 0 <= self.observers <= 100:
             raise InputError(f"requirement observers={self.observers}: must be in 0..100")
+        if self.camera_height not in CAMERA_HEIGHTS:
+            raise InputError(
+                f"camera_height={self.camera_height!r}: expected one of {', '.join(CAMERA_HEIGHTS)}"
+            )
         if not 0.0 <= self.reserve < 1.0:
             raise InputError(f"reserve={self.reserve}: must be in [0, 1)")
 
@@ -242,7 +262,10 @@ def equipment_tests(u: UasTable, gnss_autopilot: bool, need: list[tuple[str, str
 def camera_tests(c: CameraTable, req: Requirements, height_m: float) -> list[TestResult]:
     """Camera tests: imagery type, HFOV (eq. 60) and ground resolution at ``height_m``.
 
-    ``height_m`` is the maximum height the regulations allow (thesis §5.2.3.4).
+    ``height_m`` is the planned height or the maximum height the regulations allow (thesis
+    §5.2.3.4), as :attr:`Requirements.camera_height` says. For a survey (``req.mosaic``) there
+    is no field-of-view test and the resolution is tested at :data:`MIN_SURVEY_HEIGHT_M`: the
+    survey flies at the height that gives it, as long as that height is not lower.
     """
     n = len(c)
     full = np.full(n, 1.0)
@@ -250,6 +273,12 @@ def camera_tests(c: CameraTable, req: Requirements, height_m: float) -> list[Tes
     if req.imagery is not None:
         ok = np.array([t == req.imagery for t in c.types], dtype=bool)
         out.append(TestResult("imagery", ok, ok.astype(float), full, req.imagery, "=="))
+    if req.mosaic:
+        gsd = ground_resolution_m(c.hfov_deg, c.resolution_w_px, MIN_SURVEY_HEIGHT_M)
+        out.append(
+            TestResult("resolution", gsd <= req.resolution_m, gsd, full * req.resolution_m, "m/px", "<=")
+        )
+        return out
     alpha = required_hfov_deg(req.image_size_m[0], height_m)
     out.append(TestResult("hfov", c.hfov_deg >= alpha, c.hfov_deg, full * alpha, "deg", ">="))
     gsd = ground_resolution_m(c.hfov_deg, c.resolution_w_px, height_m)

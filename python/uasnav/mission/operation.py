@@ -452,7 +452,6 @@ def _range_1_2km(sid: str) -> Limit:
 _DIM_3M = Limit("dimension_m", "<=", 3.0, "dimension {dimension_m:g} m > 3 m")
 _KE_34KJ = Limit("kinetic_energy_j", "<=", 34e3, "kinetic energy {kinetic_energy_kj:.1f} kJ > 34 kJ")
 _SPARSE = Limit("sparse", "==", True, "not a sparsely populated area")
-_NOT_ASSEMBLIES = Limit("over_people", "!=", "assemblies", "over assemblies")
 _LOW_MANNED = Limit(
     "airspace",
     "not in",
@@ -460,6 +459,19 @@ _LOW_MANNED = Limit(
     "airspace {airspace}: not a low probability of encountering manned aircraft",
 )
 _CONTROLLED_GROUND = "needs a controlled ground area under the UA"
+
+
+def _controlled(sid: str) -> Limit:
+    """A controlled ground area has no uninvolved people in it: a flight over uninvolved people
+    (or assemblies) is outside the scenario."""
+    return Limit(
+        "over_people",
+        "==",
+        "none",
+        "over {over_people} people: " + sid + " needs a controlled ground area (no uninvolved people)",
+    )
+
+
 _LOW_MANNED_ALSO = "needs a low probability of encountering manned aircraft"
 
 #: The EU standard scenarios and PDRAs whose scope :func:`eu_scenarios` checks, each row with
@@ -471,7 +483,7 @@ SCENARIOS: tuple[Scenario, ...] = (
             _needs_vlos("STS-01"),
             Limit("eu_class", "==", "C5", "UA class {eu_class_name}, STS-01 needs C5"),
             Limit("height_m", "<=", EU_MAX_HEIGHT_M, "above 120 m"),
-            _NOT_ASSEMBLIES,
+            _controlled("STS-01"),
         ),
         (_CONTROLLED_GROUND,),
         PDRA_SOURCES["STS-01"],
@@ -484,6 +496,7 @@ SCENARIOS: tuple[Scenario, ...] = (
             _range_1_2km("STS-02"),
             _SPARSE,
             Limit("height_m", "<=", EU_MAX_HEIGHT_M, "above 120 m"),
+            _controlled("STS-02"),
         ),
         (_CONTROLLED_GROUND,),
         PDRA_SOURCES["STS-02"],
@@ -508,7 +521,7 @@ SCENARIOS: tuple[Scenario, ...] = (
             _needs_vlos("PDRA-S01"),
             _DIM_3M,
             Limit("height_m", "<", 150.0, "not below 150 m AGL"),
-            Limit("over_people", "!=", "assemblies", "over assemblies (the ground area must be controlled)"),
+            _controlled("PDRA-S01"),
             _LOW_MANNED,
         ),
         ("needs a controlled ground area under the UA (may be in a populated area)", _LOW_MANNED_ALSO),
@@ -524,6 +537,7 @@ SCENARIOS: tuple[Scenario, ...] = (
             _range_1_2km("PDRA-S02"),
             _SPARSE,
             Limit("height_m", "<", 150.0, "not below 150 m AGL"),
+            _controlled("PDRA-S02"),
             _LOW_MANNED,
         ),
         ("needs a controlled ground area entirely in a sparsely populated area", _LOW_MANNED_ALSO),

@@ -23,6 +23,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from uasnav.errors import InputError, UasnavError
 from uasnav.mission.feasibility import Requirements
 from uasnav.mission.operation import OVER_PEOPLE
@@ -65,7 +67,8 @@ class SelectOption:
     ``choice`` (one of ``choices``), ``flag`` (boolean; a ``True`` default is spelt
     ``--name/--no-name`` on the command line), ``size`` (``LENGTHxWIDTH``), ``pairs``
     (``NAME=VALUE,…`` or a mapping), ``density`` (a number of people per km² or a population
-    class name), ``mitigations`` (``M1A=low,M2=medium`` or a mapping), ``datetime`` (ISO 8601
+    class name), ``mitigations`` (``M1A=low,M2=medium`` or a mapping), ``wind`` (``SPEED[@FROM_DEG]``),
+    ``position`` (``LAT,LON`` in degrees), ``datetime`` (ISO 8601
     with a time zone), ``file`` (a document the request carries: the command line reads it from
     a path — or an http(s) URL for zones — the web form uploads it; the parser takes its bytes,
     text, an already parsed JSON object or an :class:`Upload`), ``output`` (a file the command
@@ -150,9 +153,29 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         group="requirements",
     ),
     SelectOption(
+        "camera_height",
+        "choice",
+        "planned",
+        "Height at which the cameras' field of view and resolution are tested: planned (the flight "
+        "altitude) or regulatory-max (the highest the category allows, the thesis' rule).",
+        choices=("planned", "regulatory-max"),
+        label="Camera tested at",
+        group="payload",
+    ),
+    SelectOption(
         "imagery", "text", "multispectral", "Camera type, or 'any'.", label="Imagery type", group="payload"
     ),
-    SelectOption("wind", "real", 5.0, "Wind speed (m/s).", "m/s", 0.0, label="Wind", group="weather"),
+    SelectOption(
+        "wind",
+        "wind",
+        5.0,
+        "Wind speed (m/s), optionally with the direction it blows from: SPEED[@FROM_DEG], e.g. 5@270.",
+        "m/s",
+        0.0,
+        maximum=100.0,
+        label="Wind",
+        group="weather",
+    ),
     SelectOption(
         "rain", "flag", False, "The flight must be possible in rain.", label="Rain", group="weather"
     ),
@@ -312,6 +335,23 @@ SELECT_OPTIONS: tuple[SelectOption, ...] = (
         group="operation",
     ),
     SelectOption(
+        "takeoff",
+        "position",
+        None,
+        "Take-off point LAT,LON (deg); default the plan's first point or the area's centroid.",
+        label="Take-off point",
+        group="operation",
+    ),
+    SelectOption(
+        "pilot",
+        "position",
+        None,
+        "Remote pilot's position LAT,LON (deg); default the take-off point. With an area, the "
+        "pilot distance is the farthest point of the area from here.",
+        label="Pilot position",
+        group="operation",
+    ),
+    SelectOption(
         "area_buffer",
         "real",
         None,
@@ -406,6 +446,12 @@ class SelectRequest:
     zones: tuple[Zone, ...] | None = None
     zones_source: str = "zones"
     when: dt.datetime | None = None
+    #: Direction the wind blows from (deg from north), when given as SPEED@FROM_DEG.
+    wind_from_deg: float | None = None
+    #: Take-off and pilot positions (lat, lon deg) used for the distances, and how they were set.
+    takeoff: tuple[float, float] | None = None
+    pilot: tuple[float, float] | None = None
+    distances: dict[str, Any] | None = None
 
 
 def request_options() -> tuple[SelectOption, ...]:
@@ -512,6 +558,85 @@ def read_file_option(name: str, source: str) -> Upload:
     if os.path.isdir(source):
         raise InputError(f"{source}: is a directory, not a file")
     return Upload(source, read_file_limited(source, MAX_BYTES, source))
+
+
+def parse_wind(value: Any) -> tuple[float, float | None]:
+    """``5``, ``"5"`` or ``"5@270"`` → (speed m/s, from-direction deg or None); speed in
+    [0, 100] m/s, direction finite (taken modulo 360)."""
+    if isinstance(value, bool):
+        raise OptionError("wind", f"wind: expected SPEED[@FROM_DEG], got {value!r}")
+    if isinstance(value, int | float):
+        speed_text, direction_text = repr(value), None
+    elif isinstance(value, str):
+        speed_text, sep, d = value.strip().partition("@")
+        direction_text = d if sep else None
+    else:
+        raise OptionError("wind", f"wind: expected SPEED[@FROM_DEG], got {value!r}")
+    try:
+        speed = float(speed_text)
+        direction = None if direction_text is None else float(direction_text)
+    except ValueError:
+        raise OptionError(
+            "wind", f"wind: expected SPEED[@FROM_DEG] (m/s @ degrees the wind blows from), got {value!r}"
+        ) from None
+    if not (math.isfinite(speed) and 0.0 <= speed <= 100.0):
+        raise OptionError("wind", f"wind: speed must be in [0, 100] m/s, got {value!r}")
+    if direction is not None and not math.isfinite(direction):
+        raise OptionError("wind", f"wind: direction must be a finite number of degrees, got {value!r}")
+    return speed, None if direction is None else direction % 360.0
+
+
+def parse_position(name: str, value: Any) -> tuple[float, float]:
+    """``"LAT,LON"`` (or a pair of numbers) → (lat, lon) deg, within ±90 / ±180."""
+    parts: Any = value.split(",") if isinstance(value, str) else value
+    try:
+        if not isinstance(parts, list | tuple) or len(parts) != 2 or any(isinstance(p, bool) for p in parts):
+            raise ValueError
+        lat, lon = float(parts[0]), float(parts[1])
+    except (TypeError, ValueError):
+        raise OptionError(name, f"{name}: expected LAT,LON in degrees, got {value!r}") from None
+    if not (math.isfinite(lat) and math.isfinite(lon) and abs(lat) <= 90.0 and abs(lon) <= 180.0):
+        raise OptionError(name, f"{name}: LAT,LON must be within ±90°, ±180°, got {value!r}")
+    return lat, lon
+
+
+def area_distances(
+    area: MissionArea, takeoff: tuple[float, float] | None, pilot: tuple[float, float] | None
+) -> dict[str, Any]:
+    """Take-off point (default the plan's first point, else the area's centroid), pilot position
+    (default the take-off point) and the largest distances (m) from each to the area: the
+    pilot distance of the operation and the range the UA flies from the take-off point."""
+    from uasnav.geo import frames
+
+    lon0, lat0 = area.centre()
+    g = area.local(lon0, lat0)
+    how_t = "--takeoff"
+    if takeoff is None:
+        first = next((data[0] for kind, data in area.parts if kind in ("line", "point")), None)
+        if area.plan_altitudes and first is not None:
+            takeoff, how_t = (float(first[1]), float(first[0])), "the plan's first point"
+        else:
+            c = g.centroid
+            la, lo, _ = frames.enu_to_geodetic(c.x, c.y, 0.0, lat0, lon0, 0.0)
+            takeoff, how_t = (float(la), float(lo)), "the area's centroid"
+    how_p = "--pilot"
+    if pilot is None:
+        pilot, how_p = takeoff, "the take-off point"
+    hull = g.convex_hull
+    coords = np.asarray(hull.exterior.coords if hull.geom_type == "Polygon" else hull.coords, dtype=float)
+
+    def farthest(p: tuple[float, float]) -> float:
+        e, n, _ = frames.geodetic_to_enu(p[0], p[1], 0.0, lat0, lon0, 0.0)
+        return float(np.hypot(coords[:, 0] - float(e), coords[:, 1] - float(n)).max())
+
+    return {
+        "takeoff": list(takeoff),
+        "takeoff_from": how_t,
+        "pilot": list(pilot),
+        "pilot_from": how_p,
+        "pilot_distance_m": max(farthest(pilot), 1.0),
+        "range_m": max(farthest(takeoff), 1.0),
+    }
 
 
 def _real(opt: SelectOption, value: Any) -> float:
@@ -723,6 +848,9 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
             when = parse_when(str(v["flight_time"]))
         except InputError as e:
             raise OptionError("flight_time", str(e)) from None
+    wind_ms, wind_from = parse_wind(v["wind"])
+    takeoff = parse_position("takeoff", v["takeoff"]) if v["takeoff"] is not None else None
+    pilot = parse_position("pilot", v["pilot"]) if v["pilot"] is not None else None
     req = Requirements(
         mission=v["mission"],
         range_m=v["range"],
@@ -730,7 +858,7 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
         image_size_m=size,
         altitude_m=v["altitude"],
         imagery=None if v["imagery"] == "any" else v["imagery"],
-        wind_ms=v["wind"],
+        wind_ms=wind_ms,
         rain=v["rain"],
         speed_ms=v["speed"],
         jurisdiction=v["jurisdiction"],
@@ -749,6 +877,7 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
         observers=v["observers"],
         residual_arc=v["residual_arc"],
         flight_duration_s=v["flight_duration"],
+        camera_height=v["camera_height"],
     )
     area = zones = None
     zones_where = "zones"
@@ -758,6 +887,10 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
         content, where = _file_bytes("area", v["area"])
         buffer = v["area_buffer"]
         try:
+            if where.lower().endswith(".kml") and not isinstance(content, Mapping):
+                from uasnav.mission.zones import kml_area_geojson
+
+                content = kml_area_geojson(content, where)
             if is_plan_document(where, content):
                 # A plan's footprint: the route widened by the buffer, by default the flight
                 # height (the 1:1 ground-risk-buffer rule, EASA AMC1 Art. 11 Annex A A.5.2.4).
@@ -786,6 +919,27 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
                 area = parse_area(content, where, buffer_m=buffer)
         except UasnavError as e:
             raise OptionError("area", f"area: {e}") from None
+    distances = None
+    if area is not None and (area.plan_altitudes or all(kind == "poly" for kind, _ in area.parts)):
+        # The pilot distance is where the UA goes from the pilot, not the mission range; the
+        # range is the farthest the UA flies from the take-off point.
+        from dataclasses import replace
+
+        distances = area_distances(area, takeoff, pilot)
+        changes: dict[str, Any] = {}
+        if v["max_distance"] is None:
+            changes["max_distance_m"] = distances["pilot_distance_m"]
+        if values.get("range") in (None, ""):
+            changes["range_m"] = distances["range_m"]
+        if changes:
+            req = replace(req, **changes)
+        takeoff, pilot = tuple(distances["takeoff"]), tuple(distances["pilot"])
+    elif takeoff is not None or pilot is not None:
+        raise OptionError(
+            "pilot" if pilot is not None else "takeoff",
+            f"{'pilot' if pilot is not None else 'takeoff'}: a position needs a polygon area or a plan "
+            "(--area) to measure the distances from",
+        )
     if v["zones"] is not None:
         from uasnav.io.ed269 import parse_zones, zones_from_json
 
@@ -797,7 +951,20 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
                 zones = parse_zones(content.encode() if isinstance(content, str) else content, zones_where)
         except UasnavError as e:
             raise OptionError("zones", f"zones: {e}") from None
-    return SelectRequest(req, weights, targets, v["top"], area, zones, zones_where, when)
+    return SelectRequest(
+        req,
+        weights,
+        targets,
+        v["top"],
+        area,
+        zones,
+        zones_where,
+        when,
+        wind_from_deg=wind_from,
+        takeoff=takeoff,  # type: ignore[arg-type]
+        pilot=pilot,  # type: ignore[arg-type]
+        distances=distances,
+    )
 
 
 def run_select(

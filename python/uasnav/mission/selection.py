@@ -90,9 +90,9 @@ class RankedPair:
     category: str | None = None
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Selection:
-    """Everything the output interface of Figure 70 shows."""
+    """Everything the output interface of Figure 70 shows (built from keywords)."""
 
     requirements: Requirements
     mission_name: str
@@ -125,38 +125,62 @@ class Selection:
     #: Every operation the candidate UAS imply (one per VLOS/EVLOS/BVLOS present), least
     #: demanding first, each with its best configuration; ``operation`` is the chosen one's.
     operations: list[OperationChoice] = field(default_factory=list)
+    #: Height (m above ground) the cameras' field of view and resolution were tested at, and
+    #: the rule that chose it (``planned`` or ``regulatory-max``, :attr:`Requirements.camera_height`).
+    camera_height_m: float | None = None
 
     @property
     def authorisation(self) -> dict:
         """The verdict an operator files against: ``authorisable`` (False when a PROHIBITED zone
-        is entered or nothing is feasible), the ``blocking`` reasons and the ``requirements``
+        is entered or nothing is feasible), the ``blocking`` reasons, the ``requirements``
         (the category's authorisation, STS/PDRA or FAA waivers that apply, zone authorisations
-        and conditions)."""
+        and conditions) and ``route``: the category that authorises it, falling back open →
+        STS → PDRA → SORA → certified (EASA); "not authorisable" only when none can."""
         op, req = self.operation, self.requirements
         blocking = [r.message for r in self.rejections if r.test == "zone-prohibited"]
         needs: list[str] = []
+        route = None
         if op is not None and req.jurisdiction == "easa":
             if op.category == "open":
                 sub = self.chosen.open_subcategory if self.chosen else None
                 where = f"open category {sub}" if sub else "open category"
                 needs.append(f"{where}: no operational authorisation ({op.legal_basis})")
+                route = where
             elif op.category == "specific":
-                sail = (
-                    f", SORA {self.sora.edition} SAIL {self.sora.sail}"
-                    if self.sora and self.sora.sail
-                    else ""
-                )
-                needs.append(
-                    f"operational authorisation from the competent authority ((EU) 2019/947 Art. 12{sail})"
-                )
-                for x in self.scenarios:
-                    if x.applies:
-                        how = "declaration" if x.id.startswith("STS") else "authorisation"
-                        needs.append(f"or {how} under {x.id} ({x.source})")
+                sts = [x for x in self.scenarios if x.applies and x.id.startswith("STS")]
+                pdra = [x for x in self.scenarios if x.applies and x.id.startswith("PDRA")]
+                if self.sora is not None and self.sora.certified and not sts and not pdra:
+                    route = "certified category"
+                    needs.append(
+                        "certified category ((EU) 2019/947 Art. 6): the SORA puts this operation "
+                        "beyond the specific category — a certified UAS, a licensed remote pilot and "
+                        "an operator certificate"
+                    )
+                else:
+                    for x in sts:
+                        needs.append(f"declaration under {x.id} ({x.source})")
+                    for x in pdra:
+                        needs.append(f"operational authorisation under {x.id} ({x.source})")
+                    sail = (
+                        f", SORA {self.sora.edition} SAIL {self.sora.sail}"
+                        if self.sora and self.sora.sail
+                        else ""
+                    )
+                    needs.append(
+                        ("or " if sts or pdra else "")
+                        + "operational authorisation from the competent authority "
+                        + f"((EU) 2019/947 Art. 12{sail})"
+                    )
+                    route = (
+                        f"specific category, {sts[0].id} declaration"
+                        if sts
+                        else f"specific category, {pdra[0].id}"
+                        if pdra
+                        else "specific category, SORA"
+                        + (f" SAIL {self.sora.sail}" if self.sora and self.sora.sail else "")
+                    )
         else:
             needs += [f"{x.id}: {'; '.join(x.reasons)} ({x.source})" for x in self.scenarios if x.applies]
-        if self.sora is not None and self.sora.certified:
-            blocking.append("outside the SORA: certified category")
         for h in self.zones.hits if self.zones else ():
             if h.restriction in ("REQ_AUTHORISATION", "CONDITIONAL"):
                 what = (
@@ -172,17 +196,53 @@ class Selection:
         if blocking:
             verdict = "not authorisable: " + "; ".join(blocking)
         elif not self.ranking:
-            verdict = "no feasible configuration"
+            verdict = self.unmet
+        elif route == "certified category":
+            verdict = "authorisable only in the certified category"
         elif len(needs) > 1 or (needs and not needs[0].startswith("open category")):
-            verdict = "authorisable with the requirements listed"
+            verdict = "authorisable with the requirements listed" + (f" ({route})" if route else "")
         else:
             verdict = "no authorisation needed (open category)" if needs else "authorisable"
         return {
             "authorisable": not blocking and bool(self.ranking),
             "verdict": verdict,
+            "route": route,
             "blocking": blocking,
             "requirements": needs,
         }
+
+    @property
+    def unmet(self) -> str:
+        """What no configuration meets, said as what it is ("no camera meets the resolution
+        …") rather than as a flight that cannot be flown."""
+        tests_of: dict[str, set[str]] = {"uas": set(), "camera": set(), "pair": set(), "mission": set()}
+        for r in self.rejections:
+            tests_of.setdefault(r.kind, set()).add(r.test)
+        parts = []
+        if len(self.database.cameras) and not self.camera_ok.any():
+            best = {}
+            for r in self.rejections:
+                if r.kind == "camera" and r.test == "resolution":
+                    best["resolution"] = min(best.get("resolution", float("inf")), r.value)
+            why = sorted(tests_of["camera"])
+            if "resolution" in best and np.isfinite(best["resolution"]):
+                why = [
+                    w
+                    if w != "resolution"
+                    else f"resolution (best {best['resolution']:.3g} m/px against "
+                    f"{self.requirements.resolution_m:g} m/px asked"
+                    + (f" at {self.camera_height_m:g} m" if self.camera_height_m else "")
+                    + ")"
+                    for w in why
+                ]
+            parts.append("no camera in the database meets " + ", ".join(why))
+        if len(self.database.uas) and not self.uas_ok.any():
+            parts.append("no UAS in the database meets " + ", ".join(sorted(tests_of["uas"])))
+        if not parts and tests_of["mission"]:
+            parts.append("the mission fails " + ", ".join(sorted(tests_of["mission"])))
+        if not parts:
+            parts.append("no UAS/camera pair meets " + (", ".join(sorted(tests_of["pair"])) or "the tests"))
+        return "; ".join(parts)
 
     @property
     def chosen(self) -> RankedPair | None:
@@ -239,6 +299,16 @@ class Selection:
                 "legal_basis": self.operation.legal_basis if self.operation else None,
             },
             "required_hfov_deg": self.required_hfov_deg,
+            "camera_height": {
+                "rule": r.camera_height,
+                "height_m": self.camera_height_m,
+                "explained": (
+                    "field of view and resolution tested at the planned height (--altitude)"
+                    if r.camera_height == "planned"
+                    else "field of view and resolution tested at the highest height the category "
+                    "allows (thesis §5.2.3.4)"
+                ),
+            },
             "feasible_uas": self.feasible_uas,
             "feasible_cameras": self.feasible_cameras,
             "rejections": [x.__dict__ for x in self.rejections],
@@ -340,6 +410,28 @@ def _operations_per_uas(u, req: Requirements, regs: Regulations) -> list[tuple[O
         )
         out.append((derive_operation(req, vlos_default=(float(per[k]), src)), members))
     return sorted(out, key=lambda x: _burden(x[0]))
+
+
+#: Farthest pilot–UA distance a direct radio C2 link of a small UAS covers with radio line of
+#: sight (m): manufacturers' direct links reach 5–15 km unobstructed; beyond this distance the
+#: C2 link is a network (cellular) or SATCOM link.
+DIRECT_C2_RANGE_M = 5000.0
+
+
+def c2_name(item_id: str, name: str, distance_m: float) -> str:
+    """The beyond-sight C2 link named by the range it must cover (``distance_m`` from the
+    pilot): a network or SATCOM link only beyond :data:`DIRECT_C2_RANGE_M`."""
+    if item_id != "blos-c2":
+        return name
+    if distance_m <= DIRECT_C2_RANGE_M:
+        return (
+            f"BLOS C2 data link covering {distance_m:.0f} m from the pilot: a direct radio link with radio "
+            "line of sight over the whole area (raised antenna), or a communication network link"
+        )
+    return (
+        f"BLOS C2 data link covering {distance_m:.0f} m from the pilot: communication network or SATCOM "
+        "(beyond direct radio range)"
+    )
 
 
 def _reject(
@@ -475,8 +567,11 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
         st = mx.status_for(e.id, feats, op.facts)
         if st.status != INCOMPATIBLE:
             equipment.append(
-                EquipmentNeed(e.id, e.name, e.group, st.status == NECESSARY, st.reason, e.onboard, e.retrofit)
-            )
+                EquipmentNeed(
+                    e.id, c2_name(e.id, e.name, op.max_distance_m), e.group, st.status == NECESSARY,
+                    st.reason, e.onboard, e.retrofit,
+                )
+            )  # fmt: skip
     category = op.category
     cat = regs.category(req.jurisdiction, category)
     h_reg = regs.max_height_m(req.jurisdiction, category)
@@ -523,9 +618,12 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
             f"{req.jurisdiction}/{category}: VLOS required ({cat.source}); "
             f"{op.max_distance_m:g} m from the pilot, within the {op.vlos_distance_m:g} m kept in sight"
         )
-    # eq. 60 at the highest height the regulations allow (thesis §5.2.3.4); if the category sets
-    # no height limit the required altitude is used instead.
-    h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
+    # eq. 60 at the planned height, or at the highest height the regulations allow (the
+    # thesis' rule, §5.2.3.4; the required altitude when the category sets no limit)
+    if req.camera_height == "regulatory-max":
+        h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
+    else:
+        h_cam = req.altitude_m
     uas_ok, rej = _reject(
         uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids, members
     )
@@ -621,8 +719,10 @@ def _ranked(br: _Branch, req, regs, u, c, i: int, j: int) -> RankedPair:
         float(scores.resolution[0, j]),
         m,
         float(scores.cost_usd[i, j]),
+        # an open subcategory only on a row flown in the open category (a BVLOS or specific
+        # operation has none, whatever the mass)
         regs.open_subcategory(m, u.eu_class[i], over_people=op.over_people, urban=op.urban)
-        if "easa" in regs.jurisdictions
+        if req.jurisdiction == "easa" and op.category == "open" and "easa" in regs.jurisdictions
         else None,
         _sora_of(op, req, u, i, m).sail if req.jurisdiction == "easa" and op.category == "specific" else None,
         op.visibility,
@@ -787,26 +887,27 @@ def select(
                     )
                 )
     return Selection(
-        req,
-        mission.name,
-        dict(mission.features),
-        equipment,
-        main.h_reg,
-        required_hfov_deg(req.image_size_m[0], main.h_cam),
-        main.vlos_required,
-        uas_ok,
-        cam_ok,
-        pair_ok,
-        rejections,
-        ranking,
-        scores,
-        db,
-        notes,
-        op,
-        sora,
-        zone_check,
-        scenarios,
-        withheld,
-        window,
-        operations,
+        requirements=req,
+        mission_name=mission.name,
+        features=dict(mission.features),
+        equipment=equipment,
+        regulatory_height_m=main.h_reg,
+        required_hfov_deg=required_hfov_deg(req.image_size_m[0], main.h_cam),
+        vlos_required=main.vlos_required,
+        uas_ok=uas_ok,
+        camera_ok=cam_ok,
+        pair_ok=pair_ok,
+        rejections=rejections,
+        ranking=ranking,
+        scores=scores,
+        database=db,
+        notes=notes,
+        operation=op,
+        sora=sora,
+        zones=zone_check,
+        scenarios=scenarios,
+        withheld=withheld,
+        flight_window=window,
+        operations=operations,
+        camera_height_m=float(main.h_cam),
     )

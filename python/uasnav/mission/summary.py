@@ -268,14 +268,80 @@ def summary_fragment(sel: Selection) -> str:
     return "\n".join(parts)
 
 
-def summary_html(sel: Selection) -> str:
+def plan_fragment(result: dict[str, Any]) -> str:
+    """The survey part of a ``uasnav plan`` result (``result.json``) as one
+    ``<section class="auth-plan">``: the survey, each flight with its predicted time and
+    bounds, the zones' window and the strategic conflicts."""
+    e = html.escape
+    s = result.get("survey")
+    if not s:
+        return ""
+    parts = ["<section class='auth-plan'><h3>Survey</h3>"]
+    parts.append(
+        _table(
+            ["Quantity", "Value"],
+            [
+                ["Height", f"{s['altitude_m']:.1f} m {s['altitude_datum']}"],
+                ["Why this height", s["height_reason"]],
+                ["Ground resolution", f"{s['gsd_m'] * 100:.2f} cm/px"],
+                ["Overlap front / side", f"{s['overlap']['front']:.0%} / {s['overlap']['side']:.0%}"],
+                [
+                    "Line spacing / trigger distance",
+                    f"{s['line_spacing_m']:.1f} m / {s['trigger_distance_m']:.1f} m",
+                ],
+                ["Speed", f"{s['speed_ms']:.1f} m/s ({s['speed_reason']})"],
+                ["Lines / photos / flights", f"{s['lines']} / {s['photos']} / {s['flights']}"],
+                ["Photographed length", f"{s['length_m']:.0f} m"],
+            ],
+        )
+    )
+    rows = [
+        [
+            f["name"],
+            f["start"],
+            f"{f['eta_s']:.0f}",
+            f"{f['eta_bounds_s'][0]:.0f}–{f['eta_bounds_s'][1]:.0f}",
+            f["photos"],
+            f["volumes"],
+        ]
+        for f in result.get("flights", [])
+    ]
+    parts.append("<h3>Flights</h3>")
+    parts.append(
+        _table(["Flight", "Take-off", "Time s", "Bounds s", "Photos", "Volumes"], rows, (2, 3, 4, 5))
+    )
+    conflicts = result.get("conflicts") or []
+    parts.append("<h3>Strategic deconfliction</h3>")
+    if conflicts:
+        parts.append(
+            _table(
+                ["Flight", "Intent", "Overlap", "Resolution"],
+                [
+                    [c["flight"], c["intent"], f"{c['overlap_start']} – {c['overlap_end']}", c["resolution"]]
+                    for c in conflicts
+                ],
+            )
+        )
+    else:
+        parts.append("<p>No conflict with the intents given.</p>")
+    if s.get("assumptions"):
+        parts.append(
+            "<h3>Assumptions</h3><ul>" + "".join(f"<li>{e(a)}</li>" for a in s["assumptions"]) + "</ul>"
+        )
+    parts.append("</section>")
+    return "\n".join(parts)
+
+
+def summary_html(sel: Selection, plan: dict[str, Any] | None = None) -> str:
     """The summary as one self-contained HTML page: :func:`summary_fragment` with its
-    stylesheet (print included) inline."""
+    stylesheet (print included) inline; with ``plan`` (a ``uasnav plan`` result) its survey,
+    flights and conflicts (:func:`plan_fragment`) follow."""
     title = html.escape(f"Authorisation summary — {sel.mission_name}")
     return (
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
         f"<title>{title}</title><style>{SUMMARY_CSS}{_PAGE_CSS}</style></head><body>\n"
         + summary_fragment(sel)
+        + (plan_fragment(plan) if plan else "")
         + "\n</body></html>"
     )
 

@@ -445,3 +445,40 @@ __all__ = [
     "parse_when",
     "read_area",
 ]
+
+
+def kml_area_geojson(data: bytes | str, where: str = "area.kml") -> dict[str, Any]:
+    """A KML area (its ``Polygon`` placemarks; else a ``LineString`` or ``Point``) as the GeoJSON
+    object :func:`parse_area` reads. Parsed by the hardened KML reader of
+    :mod:`uasnav.io.plan_formats.kml` (no DTD, no entities, no network)."""
+    from uasnav.io.plan_formats import kml
+
+    if isinstance(data, bytes):
+        if len(data) > MAX_BYTES:
+            raise DataFormatError(f"area file larger than {MAX_BYTES} bytes", path=where)
+        try:
+            data = data.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            raise DataFormatError("not a UTF-8 text file", path=where) from None
+    root = kml._parse(data, where)
+    geoms: list[dict[str, Any]] = []
+    for poly in kml._find(root, "Polygon"):
+        rings = []
+        for tag in ("outerBoundaryIs", "innerBoundaryIs"):
+            for b in kml._find(poly, tag):
+                for c in kml._find(b, "coordinates"):
+                    rings.append([[x, y] for x, y, _ in kml._coords(c, where)])
+        if rings:
+            geoms.append({"type": "Polygon", "coordinates": rings})
+    if not geoms:
+        for ls in kml._find(root, "LineString"):
+            for c in kml._find(ls, "coordinates"):
+                geoms.append(
+                    {"type": "LineString", "coordinates": [[x, y] for x, y, _ in kml._coords(c, where)]}
+                )
+    if not geoms:
+        raise DataFormatError("no Polygon or LineString in the KML area", path=where)
+    return {
+        "type": "FeatureCollection",
+        "features": [{"type": "Feature", "geometry": g, "properties": {}} for g in geoms],
+    }

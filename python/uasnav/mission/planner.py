@@ -1,0 +1,597 @@
+"""From a field to a filed authorisation: one request through every part (``uasnav plan``).
+
+Pipeline: the selection ranks UAS + camera for this area (:func:`uasnav.mission.selection.select`,
+pilot distance from the area and the pilot's position) → a survey plan for the chosen pair
+(:mod:`uasnav.mission.survey`: height, lines, triggers, speed, flights) → each flight's time
+predicted with its calibrated bounds (:func:`uasnav.trajectory.route3d.predict_route` through
+:func:`uasnav.utm.intent.build_intent`) → one ASTM F3548 operational intent per flight → the
+ED-269 zones over the flight window the prediction gives, and strategic deconfliction against
+the given intents (with the departure delay that clears each conflict) → the authorisation
+summary.
+
+:func:`plan` returns a :class:`PlanResult`: ``result`` is the ``result.json`` document and
+``files`` every file ``uasnav plan --out DIR`` writes (name → bytes), written all or nothing
+by :func:`write_outputs`.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import functools
+import json
+import math
+import os
+import threading
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from uasnav.errors import InputError
+from uasnav.jsonable import to_jsonable
+from uasnav.mission.request import OptionError, Upload, parse_select_options
+from uasnav.mission.survey import Camera, SurveyPlan, flight_plan, plan_survey
+
+#: Time between two flights of a survey (land, change the battery, take off), s.
+DEFAULT_TURNAROUND_S = 600.0
+#: Coverage of the time bounds of the intents.
+COVERAGE = 0.95
+#: Simulated 3D runs the built-in predictor's time bounds are calibrated on (≥ 19 for 95 %).
+CALIBRATION_RUNS = 40
+#: Ground elevation taken when none is given, m AMSL (stated in the output).
+DEFAULT_GROUND_ELEVATION_M = 0.0
+#: Files written per flight (``{k:02d}`` is the flight number).
+FLIGHT_FILES = ("flight-{k:02d}.plan", "flight-{k:02d}.waypoints", "flight-{k:02d}.intent.json")
+
+#: Options of ``uasnav plan`` besides the selector's (:data:`SELECT_OPTIONS`): name → help.
+PLAN_OPTIONS: dict[str, str] = {
+    "overlap": "Front and side overlap of the photos, FRONT,SIDE in % or fractions (default 75,65).",
+    "intents": "Operational intents of other operators to deconflict with (F3548 JSON or InterUSS "
+    "flight-intent YAML).",
+    "start": "Take-off time of the first flight, ISO 8601 with a zone (2026-05-01T10:00Z).",
+    "turnaround": "Time between two flights (landing, battery change, take-off), s.",
+}
+
+
+@dataclass
+class FlightResult:
+    """One flight of the survey: its plan, prediction and intent."""
+
+    number: int
+    plan: Any  # MissionPlan
+    intent: Any  # IntentBuild
+    start: dt.datetime
+    photos: int
+    lines: int
+    estimated_s: float
+
+    @property
+    def name(self) -> str:
+        return f"flight-{self.number:02d}"
+
+    def to_dict(self) -> dict[str, Any]:
+        b = self.intent
+        return {
+            "name": self.name,
+            "start": b.start.isoformat(),
+            "eta_s": b.eta_s,
+            "eta_bounds_s": list(b.eta_bounds_s),
+            "end_latest": (b.start + dt.timedelta(seconds=b.eta_bounds_s[1])).isoformat(),
+            "photos": self.photos,
+            "lines": self.lines,
+            "volumes": len(b.details.volumes),
+            "files": [f.format(k=self.number) for f in FLIGHT_FILES],
+        }
+
+
+@dataclass
+class PlanResult:
+    """What :func:`plan` returns: ``result`` (the ``result.json`` document), ``files`` (name →
+    bytes, every file of the output directory), the selection, the survey and the flights."""
+
+    result: dict[str, Any]
+    files: dict[str, bytes]
+    selection: Any
+    survey: SurveyPlan | None
+    flights: list[FlightResult] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``result.json`` document."""
+        return self.result
+
+    def __getitem__(self, key: str) -> Any:
+        return self.result[key]
+
+    def keys(self):
+        return self.result.keys()
+
+
+_LOCK = threading.Lock()
+
+
+#: Speeds (m/s) the shipped survey models are calibrated at (``data/survey_models.json``).
+MODEL_SPEEDS = (3.0, 5.0, 7.0, 9.0, 11.0, 13.0, 15.0)
+#: The shipped survey models: the built-in kinematic predictor with its time bounds calibrated
+#: at each of :data:`MODEL_SPEEDS` (regenerate with ``scripts/make_survey_models.py``).
+MODELS_FILE = Path(__file__).parent / "data" / "survey_models.json"
+
+
+def build_predictor(speed_ms: float, runs: int = CALIBRATION_RUNS) -> Any:
+    """The built-in survey predictor at ``speed_ms``: the kinematic point mass (the default
+    method) fitted on the thesis' two Phantom-4 trajectories simulated in calm air and in a
+    5 m/s wind, its time bounds calibrated (split-conformal) on ``runs`` simulated 3D runs
+    (take-off, sloped legs, holds, landing) flown at ``speed_ms``. Deterministic."""
+    import warnings
+
+    from uasnav.trajectory.calibration import calibrate, simulated_route_runs
+    from uasnav.trajectory.models import make_predictor
+    from uasnav.trajectory.samples import ElementSamples, measure_elements
+    from uasnav.trajectory.simulator import MultirotorParams, WindModel, phantom4_plans, simulate_flight
+
+    parts = []
+    for k, plan_ne in enumerate(phantom4_plans().values()):
+        for w, (speed, from_deg) in enumerate(((0.0, 0.0), (5.0, 200.0))):
+            tel = simulate_flight(
+                plan_ne,
+                params=MultirotorParams(cruise_ms=speed_ms),
+                wind=WindModel(speed_ms=speed, from_deg=from_deg),
+                seed=10 * k + w,
+            )
+            _, s = measure_elements(
+                tel.plan_ne, tel.t, tel.pos_ne, tel.vel_ne, tel.wind_ne, tel.cruise_ms, flight=2 * k + w
+            )
+            parts.append(s)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=UserWarning)
+        model = make_predictor("kinematic").fit(ElementSamples.concat(parts))
+    cal = simulated_route_runs(model, runs, seed=0, cruise_ms=speed_ms)
+    model.time_bounds_ = calibrate(cal, source=f"{runs} simulated 3D runs at {speed_ms:g} m/s, seed 0")
+    return model
+
+
+@functools.lru_cache(maxsize=1)
+def _shipped() -> dict[str, Any]:
+    from uasnav import jsoncheck as jc
+
+    with jc.reraise_in(str(MODELS_FILE)):
+        return jc.obj(jc.parse(MODELS_FILE.read_text(), "invalid JSON"), "")
+
+
+@functools.lru_cache(maxsize=16)
+def _predictor_at(speed_key: float) -> Any:
+    from uasnav.trajectory.models import model_from_dict
+
+    if MODELS_FILE.exists():
+        models = _shipped()["models"]
+        nearest = min(models, key=lambda k: abs(float(k) - speed_key))
+        return model_from_dict(models[nearest], source=f"{MODELS_FILE.name}[{nearest}]")
+    return build_predictor(speed_key)
+
+
+def survey_predictor(speed_ms: float) -> Any:
+    """The trajectory model a survey flown at ``speed_ms`` is timed with: the shipped model
+    calibrated at the nearest of :data:`MODEL_SPEEDS` (:func:`build_predictor`)."""
+    with _LOCK:
+        return _predictor_at(round(float(speed_ms), 1))
+
+
+def parse_overlap(value: Any) -> tuple[float, float]:
+    """``"75,65"`` (percent), ``"0.75,0.65"`` or a pair → (front, side) fractions in [0, 0.95]."""
+    if value is None or value == "":
+        from uasnav.mission.survey import DEFAULT_OVERLAP
+
+        return DEFAULT_OVERLAP
+    parts: Any = value.split(",") if isinstance(value, str) else value
+    try:
+        if not isinstance(parts, list | tuple) or len(parts) != 2:
+            raise ValueError
+        f, s = float(parts[0]), float(parts[1])
+    except (TypeError, ValueError):
+        raise OptionError("overlap", f"overlap: expected FRONT,SIDE (e.g. 75,65), got {value!r}") from None
+    if f > 1.0 or s > 1.0:
+        f, s = f / 100.0, s / 100.0
+    if not (math.isfinite(f) and math.isfinite(s) and 0.0 <= f <= 0.95 and 0.0 <= s <= 0.95):
+        raise OptionError("overlap", f"overlap: each must be within 0–95 %, got {value!r}")
+    return f, s
+
+
+def _read_intents(items: Sequence[Any], now: dt.datetime) -> list[Any]:
+    """Intents of other operators: paths, or :class:`Upload` documents (JSON or YAML)."""
+    from uasnav import jsoncheck as jc
+    from uasnav.io.interuss import read_flight_intents, resolve_flight_intents
+    from uasnav.io.operational_intent import check_times, parse_intents, read_intents
+
+    found = []
+    for it in items:
+        if isinstance(it, Upload):
+            name = it.name
+            if name.lower().endswith((".yaml", ".yml")):
+                import yaml
+
+                try:
+                    data = yaml.safe_load(it.data.decode("utf-8"))
+                except (yaml.YAMLError, UnicodeDecodeError) as e:
+                    raise InputError(f"{name}: not a flight-intent YAML document ({e})") from None
+                found += resolve_flight_intents(data, name, now)
+            else:
+                with jc.reraise_in(name):
+                    d = jc.parse(
+                        it.data.decode("utf-8", "replace"), "not an operational intent: not valid JSON"
+                    )
+                found += parse_intents(d, name, os.path.splitext(os.path.basename(name))[0])
+        else:
+            p = os.fspath(it)
+            found += read_flight_intents(p, now) if p.lower().endswith((".yaml", ".yml")) else read_intents(p)
+    for x in found:
+        check_times(x, now)
+    return found
+
+
+def _camera(sel: Any, j: int) -> Camera:
+    c = sel.database.cameras
+    return Camera(
+        name=c.label(j),
+        hfov_deg=float(c.hfov_deg[j]),
+        width_px=float(c.resolution_w_px[j]),
+        height_px=float(c.resolution_h_px[j]),
+    )
+
+
+def _field_polygon(area: Any, lat0: float, lon0: float) -> Any:
+    """The field to photograph in the local east/north frame about the take-off point: the
+    area's polygons (a plan's route: its convex hull)."""
+    g = area.local(lon0, lat0)
+    if g.geom_type not in ("Polygon", "MultiPolygon") or g.area <= 0:
+        g = g.convex_hull
+    if g.geom_type == "MultiPolygon":
+        g = g.convex_hull
+    if g.geom_type != "Polygon" or g.area <= 0:
+        raise InputError(f"{area.where}: the survey area needs a surface (a polygon, or a plan with an area)")
+    return g
+
+
+def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
+    """Plan a survey of an area and everything its authorisation needs (see module).
+
+    Parameters
+    ----------
+    options, **kw
+        Options by snake_case name: every selector option (:data:`SELECT_OPTIONS`; ``area`` is
+        required: GeoJSON, KML or a mission plan, as a path, its text/bytes, a parsed object or
+        an :class:`~uasnav.mission.request.Upload`) plus ``overlap`` (``"75,65"``), ``intents``
+        (paths or uploads), ``start`` (ISO 8601, or a datetime; default: the next full hour)
+        and ``turnaround`` (s between flights). ``altitude`` is an upper bound on the survey
+        height (the resolution sets it otherwise).
+
+    Returns
+    -------
+    PlanResult
+
+    Raises
+    ------
+    OptionError
+        A bad option (``.option`` names it).
+    InputError
+        Nothing can fly it, or an input file is unreadable.
+    """
+    values: dict[str, Any] = {**(options or {}), **kw}
+    overlap = parse_overlap(values.pop("overlap", None))
+    intents_in = values.pop("intents", None) or ()
+    if isinstance(intents_in, str | os.PathLike | Upload):
+        intents_in = (intents_in,)
+    start_v = values.pop("start", None)
+    turnaround = values.pop("turnaround", None)
+    turnaround = DEFAULT_TURNAROUND_S if turnaround in (None, "") else float(turnaround)
+    if not (math.isfinite(turnaround) and turnaround >= 0):
+        raise OptionError(
+            "turnaround", f"turnaround: must be a finite number of seconds >= 0, got {turnaround!r}"
+        )
+    if values.get("area") is None:
+        raise OptionError("area", "area: give the field to survey (GeoJSON, KML or a plan)")
+    altitude_given = values.get("altitude") not in (None, "")
+    for name in ("area", "zones"):
+        v = values.get(name)
+        if isinstance(v, os.PathLike) or (isinstance(v, str) and not v.lstrip().startswith(("{", "<"))):
+            from uasnav.mission.request import read_file_option
+
+            values[name] = read_file_option(name, os.fspath(v))
+    if start_v is None or start_v == "":
+        start_v = values.get("flight_time")
+    if isinstance(start_v, dt.datetime):
+        if start_v.tzinfo is None:
+            raise OptionError("start", "start: the take-off time needs a time zone")
+        start = start_v.astimezone(dt.timezone.utc)
+    elif start_v is None or start_v == "":
+        now = dt.datetime.now(dt.timezone.utc)
+        start = (now + dt.timedelta(hours=1)).replace(minute=0, second=0, microsecond=0)
+    else:
+        from uasnav.mission.zones import parse_when
+
+        try:
+            start = parse_when(str(start_v))
+        except InputError as e:
+            raise OptionError("start", f"start: {e}") from None
+    values["flight_time"] = start.isoformat()
+    request = parse_select_options({k: v for k, v in values.items() if k != "altitude" or v is not None})
+    req = request.requirements
+    from uasnav.mission.regulations import load_regulations
+    from uasnav.mission.selection import select
+
+    regs = load_regulations()
+    # A survey is a mosaic: the resolution is reached by flying at the height that gives it;
+    # the height checked by the regulations is the operator's ceiling or the legal maximum.
+    legal = _legal_height(regs, req)
+    req = replace(req, mosaic=True, altitude_m=req.altitude_m if altitude_given else legal)
+    assert request.area is not None and request.takeoff is not None and request.pilot is not None
+    area = request.area
+    lat0, lon0 = request.takeoff
+    sel_kw = dict(targets=request.targets, weights=request.weights, top=request.top, regulations=regs)
+    sel = select(req, **sel_kw)
+    base = {
+        "configuration": None,
+        "operation": None,
+        "survey": None,
+        "flights": [],
+        "eta_s": None,
+        "zones": None,
+        "conflicts": [],
+        "authorisation": sel.authorisation,
+        "distances": request.distances,
+        "selection": sel.to_dict(),
+    }
+    if sel.chosen is None:
+        files = {"result.json": _json(base)}
+        return PlanResult(to_jsonable(base), files, sel, None)
+    best = sel.chosen
+    u = sel.database.uas
+    i = u.ids.index(best.uas_id)
+    j = sel.database.cameras.ids.index(best.camera_id)
+    camera = _camera(sel, j)
+    cruise = req.cruise_fraction * float(u.max_speed_ms[i])
+    endurance = float(u.endurance_min[i]) * 60.0 * (1.0 - req.reserve)
+    field_en = _field_polygon(area, lat0, lon0)
+    sp = plan_survey(
+        field_en,
+        camera,
+        resolution_m=req.resolution_m,
+        origin=(lat0, lon0),
+        altitude_m=req.altitude_m if altitude_given else None,
+        legal_max_m=legal,
+        overlap=overlap,
+        cruise_ms=cruise,
+        endurance_s=endurance,
+    )
+    ground = req.ground_elevation_m
+    if ground is None:
+        ground = DEFAULT_GROUND_ELEVATION_M
+        sp.assumptions.append(
+            f"ground elevation not given: the take-off point is taken at {ground:g} m AMSL for the "
+            "intents' WGS-84 altitudes (give --ground-elevation before filing)"
+        )
+    model = survey_predictor(sp.speed_ms)
+    from uasnav.trajectory.features import wind_vector
+    from uasnav.utm.intent import build_intent
+
+    wind_from = request.wind_from_deg
+    if wind_from is None:
+        wind_from = 0.0
+        sp.assumptions.append("wind direction not given: taken from the north (the time bounds cover it)")
+    wind = wind_vector(req.wind_ms, wind_from)
+    flights: list[FlightResult] = []
+    t = start
+    for k in range(len(sp.flights)):
+        mp = flight_plan(sp, k, home_amsl_m=ground, name="survey")
+        b = build_intent(mp, model, wind, t, coverage=COVERAGE, priority=0)
+        flights.append(
+            FlightResult(
+                k + 1,
+                mp,
+                b,
+                t,
+                sum(ln.photos for ln in sp.flights[k]),
+                len(sp.flights[k]),
+                sp.estimated_time_s[k],
+            )
+        )
+        t = t + dt.timedelta(seconds=b.eta_bounds_s[1] + turnaround)
+    end_latest = t - dt.timedelta(seconds=turnaround)
+    total_s = (end_latest - start).total_seconds()
+    # the zones over the predicted window (take-off of the first flight to the latest end of the last)
+    if request.zones is not None:
+        sel = select(
+            replace(req, flight_duration_s=max(total_s, 1.0)),
+            **sel_kw,
+            area=area,
+            zones=request.zones,
+            zones_source=request.zones_source,
+            when=start,
+        )
+        if sel.flight_window is not None:
+            sel.flight_window["from"] = (
+                "predicted flight time of the survey (upper bounds, turnarounds included)"
+            )
+    conflicts = _deconflict(flights, _read_intents(list(intents_in), dt.datetime.now(dt.timezone.utc)))
+    result = _result(sel, sp, flights, conflicts, request, start, total_s, overlap)
+    files = _files(sel, sp, flights, result)
+    return PlanResult(result, files, sel, sp, flights)
+
+
+def _legal_height(regs: Any, req: Any) -> float:
+    """Highest height (m above ground) the applicable category allows (open if unset)."""
+    from uasnav.mission.regulations import DEFAULT_CATEGORY
+
+    cat = req.category or DEFAULT_CATEGORY.get(req.jurisdiction)
+    try:
+        h = float(regs.max_height_m(req.jurisdiction, cat))
+    except Exception:
+        h = math.inf
+    return h if math.isfinite(h) else 120.0
+
+
+def _deconflict(flights: list[FlightResult], others: list[Any]) -> list[dict[str, Any]]:
+    """Conflicts of each survey flight with the given intents, and the delay of our flight
+    that clears it (None: none within a day)."""
+    if not others or not flights:
+        return []
+    from uasnav.io.operational_intent import NamedIntent
+    from uasnav.utm.deconflict import deconflict, earliest_delays
+    from uasnav.utm.volumes import volume_arrays
+
+    ours = [NamedIntent(f.name, f.intent.details, f.name) for f in flights]
+    names = {x.name for x in ours}
+    clash = [x for x in others if x.name in names]
+    if clash:
+        raise InputError(
+            f"an intent given with --intents is named {clash[0].name!r}, like a flight of this plan"
+        )
+    allv = ours + list(others)
+    res = deconflict(allv)
+    v = volume_arrays(allv)
+    out = []
+    mine = [k for k, x in enumerate(allv) if x.name in names]
+    delays = dict(zip(mine, earliest_delays(v, mine), strict=True))
+    for c in res.conflicts:
+        if not (set(c.intents) & names):
+            continue
+        own = c.intents[0] if c.intents[0] in names else c.intents[1]
+        other = c.intents[1] if own == c.intents[0] else c.intents[0]
+        d = float(delays[[x.name for x in allv].index(own)])
+        out.append(
+            {
+                "flight": own,
+                "intent": other,
+                "overlap_start": c.overlap[0].isoformat(),
+                "overlap_end": c.overlap[1].isoformat(),
+                "volumes": [list(p) for p in c.volumes],
+                "delay_s": None if math.isnan(d) else d,
+                "resolution": (
+                    f"delay {own} by {d:.0f} s" if not math.isnan(d) else "no delay within a day clears it"
+                ),
+            }
+        )
+    return out
+
+
+def _result(sel, sp, flights, conflicts, request, start, total_s, overlap) -> dict[str, Any]:
+    best = sel.chosen
+    op = sel.operation
+    etas = [f.intent.eta_s for f in flights]
+    lo = [f.intent.eta_bounds_s[0] for f in flights]
+    hi = [f.intent.eta_bounds_s[1] for f in flights]
+    auth = sel.authorisation
+    if conflicts:
+        auth = dict(auth)
+        auth["requirements"] = list(auth["requirements"]) + [
+            f"strategic conflict of {c['flight']} with {c['intent']}: {c['resolution']}" for c in conflicts
+        ]
+    d = {
+        "configuration": {
+            "uas_id": best.uas_id,
+            "uas": best.uas,
+            "camera_id": best.camera_id,
+            "camera": best.camera,
+            "score": best.score,
+            "mass_g": best.mass_g,
+            "cost_usd": best.cost_usd,
+        },
+        "operation": op.to_dict() if op else None,
+        "distances": request.distances,
+        "survey": {
+            "altitude_m": sp.altitude_m,
+            "altitude_datum": "above the take-off point (flat field)",
+            "height_reason": sp.height_reason,
+            "gsd_m": sp.gsd_m,
+            "footprint_m": list(sp.footprint_m),
+            "overlap": {"front": overlap[0], "side": overlap[1]},
+            "line_spacing_m": sp.spacing_m,
+            "trigger_distance_m": sp.trigger_m,
+            "speed_ms": sp.speed_ms,
+            "speed_reason": sp.speed_reason,
+            "heading_deg": sp.heading_deg,
+            "photos": sp.photos,
+            "lines": len(sp.lines),
+            "length_m": sp.length_m,
+            "flights": len(sp.flights),
+            "endurance_s": sp.endurance_s,
+            "estimated_time_s": sp.estimated_time_s,
+            "assumptions": sp.assumptions,
+        },
+        "flights": [f.to_dict() for f in flights],
+        "eta_s": {
+            "total": float(sum(etas)),
+            "lower": float(sum(lo)),
+            "upper": float(sum(hi)),
+            "coverage": COVERAGE,
+            "per_flight": [
+                {"eta_s": e, "lower": a, "upper": b} for e, a, b in zip(etas, lo, hi, strict=True)
+            ],
+            "window": {
+                "start": start.isoformat(),
+                "end": (start + dt.timedelta(seconds=total_s)).isoformat(),
+                "duration_s": total_s,
+            },
+        },
+        "zones": sel.zones.to_dict() if sel.zones else None,
+        "flight_window": sel.flight_window,
+        "conflicts": conflicts,
+        "authorisation": auth,
+        "sora": sel.sora.to_dict() if sel.sora else None,
+        "scenarios": [x.__dict__ | {"reasons": list(x.reasons)} for x in sel.scenarios],
+        "notes": list(sel.notes),
+        "files": ["summary.html", "summary.json", "result.json"]
+        + [n.format(k=f.number) for f in flights for n in FLIGHT_FILES],
+    }
+    return to_jsonable(d)
+
+
+def _json(d: Any) -> bytes:
+    return (json.dumps(to_jsonable(d), indent=2, ensure_ascii=False, allow_nan=False) + "\n").encode()
+
+
+def _files(sel, sp, flights, result) -> dict[str, bytes]:
+    from uasnav.io.operational_intent import to_json
+    from uasnav.io.plan_formats.qgc import qgc_plan_dict
+    from uasnav.io.plan_formats.wpl import wpl_text
+    from uasnav.mission.summary import summary_dict, summary_html
+
+    files: dict[str, bytes] = {}
+    for f in flights:
+        k = f.number
+        files[f"flight-{k:02d}.plan"] = (
+            json.dumps(qgc_plan_dict(f.plan), indent=4, allow_nan=False) + "\n"
+        ).encode()
+        files[f"flight-{k:02d}.waypoints"] = wpl_text(f.plan).encode()
+        files[f"flight-{k:02d}.intent.json"] = (
+            json.dumps(to_json(f.intent.details), indent=1, allow_nan=False) + "\n"
+        ).encode()
+    summ = summary_dict(sel)
+    summ["plan"] = {k: result[k] for k in ("survey", "flights", "eta_s", "conflicts", "distances")}
+    summ["authorisation"] = result["authorisation"]
+    files["summary.json"] = _json(summ)
+    files["summary.html"] = summary_html(sel, plan=result).encode()
+    files["result.json"] = _json(result)
+    return files
+
+
+def write_outputs(result: PlanResult, out_dir: str | os.PathLike[str]) -> list[str]:
+    """Write every file of ``result`` into ``out_dir`` (created if missing), all or nothing."""
+    from uasnav.atomicfile import output_set
+
+    d = Path(out_dir)
+    if d.exists() and not d.is_dir():
+        raise InputError(f"{d}: exists and is not a directory")
+    with output_set() as out:
+        for name, data in result.files.items():
+            out.write_bytes(d / name, data)
+    return [str(d / n) for n in result.files]
+
+
+__all__ = [
+    "PLAN_OPTIONS",
+    "FlightResult",
+    "PlanResult",
+    "parse_overlap",
+    "plan",
+    "survey_predictor",
+    "write_outputs",
+]
