@@ -119,3 +119,32 @@ def test_every_router_answers(client) -> None:
     assert client.get("/db", follow_redirects=False).status_code == 303
     spec = client.get("/openapi.json").json()["paths"]
     assert set(spec) == {"/api/select", "/api/options", "/api/db/{name}", "/api/trajectory/predict"}
+
+
+def test_area_upload_runs_the_plan(client) -> None:
+    """With an area, the page shows the survey plan ``uasnav.plan`` makes for the same values,
+    draws its lines on the map and offers every file the plan writes."""
+    import base64
+
+    import uasnav
+    from uasnav.mission.request import Upload
+
+    r = client.post(
+        "/select", data={"range": "", "overlap": "70,60"}, files={"area": ("field.geojson", AREA)}
+    )
+    assert r.status_code == 200
+    links = dict(
+        re.findall(
+            r'<a class="button" href="data:[^;]+;charset=utf-8;base64,([^"]+)" download="([^"]+)"', r.text
+        )
+    )
+    got = {name: base64.b64decode(b64) for b64, name in links.items()}
+    want = uasnav.plan(area=Upload("field.geojson", AREA), overlap="70,60")
+    assert set(want.files) <= set(got)
+    assert {"flight-01.plan", "flight-01.waypoints", "flight-01.intent.json", "result.json"} <= set(got)
+    page_result = json.loads(got["result.json"])
+    assert page_result["survey"] == json.loads(json.dumps(want.result["survey"]))
+    assert page_result["configuration"] == want.result["configuration"]
+    n_lines = want.result["survey"]["lines"]
+    assert r.text.count('<polyline class="survey"') == n_lines
+    assert f'<b class="n">{want.result["survey"]["photos"]}</b> photos' in r.text

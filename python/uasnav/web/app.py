@@ -26,6 +26,7 @@ from fastapi.staticfiles import StaticFiles
 from fastapi.templating import Jinja2Templates
 
 from uasnav import __version__
+from uasnav.mission.planner import plan
 from uasnav.mission.request import parse_select_options, run_select
 from uasnav.mission.scoring import PARAMETERS
 from uasnav.web import forms
@@ -94,6 +95,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
         # looked up at call time, so the selector this module names is the one that runs
         run_select=lambda *a, **k: run_select(*a, **k),
         parse_select_options=lambda v: parse_select_options(v),
+        run_plan=lambda *a, **k: plan(*a, **k),
     )
     _add_error_handlers(app, templates)
 

@@ -75,6 +75,8 @@ class WebContext:
     choices: dict[str, tuple[tuple[str, str], ...]]
     run_select: Callable[..., Any]
     parse_select_options: Callable[[Mapping[str, Any]], Any]
+    #: ``uasnav.plan``: the survey of an uploaded area, its flights, intents and files.
+    run_plan: Callable[..., Any] | None = None
 
     def selection(self, values: Mapping[str, Any], files: Mapping[str, Any] | None = None) -> Any:
         """The selector on the server's documents; a bad value is an :class:`ApiError` 422

@@ -92,6 +92,10 @@ OPERATOR_HELP: dict[str, str] = {
     "flight_time": "Planned take-off date and time with its time zone, e.g. 2026-05-01T10:00Z.",
     "flight_duration": "How long the flight lasts; empty: the chosen aircraft's own estimate.",
     "top": "How many configurations to list.",
+    "takeoff": "Where the aircraft takes off, latitude,longitude in degrees; empty: the first point "
+    "of an uploaded plan, else the middle of the area.",
+    "pilot": "Where you stand, latitude,longitude in degrees; empty: at the take-off point. The "
+    "distance to the area's farthest point is measured from here.",
 }
 
 
@@ -139,6 +143,34 @@ class FormField:
     @property
     def required(self) -> bool:
         return self.name in REQUIRED_FIELDS
+
+
+#: The survey plan's options that are not selector options (``uasnav plan`` adds them): shown
+#: under "Advanced", used when an area is uploaded. Name → (label, unit, help, widget).
+PLAN_FIELDS: dict[str, tuple[str, str, str, str]] = {
+    "overlap": (
+        "Photo overlap",
+        "%",
+        "Front and side overlap of neighbouring photos, e.g. 75,65 (the default).",
+        "text",
+    ),
+    "intents": (
+        "Other operators' flights",
+        "",
+        "Their operational intents (F3548 JSON or flight-intent YAML), to check for conflicts.",
+        "file",
+    ),
+}
+
+
+def plan_values(form: Mapping[str, Any]) -> dict[str, str]:
+    """The plan's own text fields as typed (blank ones left out: they take defaults)."""
+    out = {}
+    for name, (_, _, _, w) in PLAN_FIELDS.items():
+        v = form.get(name)
+        if w != "file" and isinstance(v, str) and v.strip():
+            out[name] = v.strip()
+    return out
 
 
 def default_text(opt: SelectOption) -> str:
@@ -278,6 +310,7 @@ __all__ = [
     "FILE_KINDS",
     "NOT_FIELDS",
     "OPERATOR_HELP",
+    "PLAN_FIELDS",
     "REQUIRED_FIELDS",
     "FormField",
     "empty_required",
@@ -287,6 +320,7 @@ __all__ = [
     "form_fields",
     "is_field",
     "pair_values",
+    "plan_values",
     "values_from_form",
     "widget",
 ]

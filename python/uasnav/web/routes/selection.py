@@ -5,12 +5,15 @@ from __future__ import annotations
 import json
 from typing import Annotated, Any
 
+import numpy as np
 from fastapi import APIRouter, Depends, Request
 from fastapi.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
 from markupsafe import Markup
+from starlette.concurrency import run_in_threadpool
 from starlette.datastructures import UploadFile
 
 from uasnav.errors import UasnavError
+from uasnav.geo import frames
 from uasnav.jsonable import to_jsonable
 from uasnav.mission import request as select_request
 from uasnav.mission import summary
@@ -58,7 +61,9 @@ def selection_page(
         "request": request,
         "core": core,
         "groups": grouped(advanced),
-        "advanced_open": any(f.name in errors for f in advanced),
+        "advanced_open": any(f.name in errors for f in advanced)
+        or any(n in errors for n in forms.PLAN_FIELDS),
+        "plan_fields": forms.PLAN_FIELDS,
         "area_map": result.get("area_map") if result else None,
         "max_upload": MAX_BODY_BYTES,
         "values": values,
@@ -105,17 +110,48 @@ def run_view(ctx: WebContext, values: dict[str, Any], files: dict[str, Any]) -> 
         "margin": selection_view.margin,
         "necessary": NECESSARY,
         "area_map": map_of(req),
+        "req": req,
     }
 
 
-def map_of(req: Any) -> Markup | None:
-    """The offline map of the request's area (and zones), or None without an area."""
+#: Media types of the files a plan writes, by suffix.
+_MIME = {".json": "application/json", ".plan": "application/json", ".html": "text/html"}
+
+
+def plan_view(pr: Any) -> dict[str, Any]:
+    """The survey-plan part of the page: ``result.json`` and a download of every file."""
+    downloads = [
+        (name, data_uri(_MIME.get(name[name.rfind(".") :], "text/plain"), data.decode("utf-8")))
+        for name, data in pr.files.items()
+    ]
+    return {"result": pr.result, "downloads": downloads, "error": None}
+
+
+def map_of(req: Any, pr: Any = None) -> Markup | None:
+    """The offline map of the request's area and zones, with the survey lines and the take-off
+    and pilot points when a plan was made; None without an area."""
     area = getattr(req, "area", None)
     if area is None:
         return None
-    lon, lat = area.centre()
-    layers = area_map.MapLayers(area, getattr(req, "zones", None) or (), points={"take-off": (lat, lon)})
-    return area_map.area_map(layers)
+    zones = getattr(req, "zones", None) or ()
+    lines: list[list[tuple[float, float]]] = []
+    dist = getattr(req, "distances", None) or {}
+    if pr is not None and pr.survey is not None:
+        lat0, lon0 = pr.survey.origin
+        for ln in pr.survey.lines:
+            en = np.asarray([ln.run_in_en, ln.start_en, ln.end_en, ln.run_out_en], dtype=float)
+            la, lo, _ = frames.enu_to_geodetic(en[:, 0], en[:, 1], 0.0, lat0, lon0, 0.0)
+            lines.append(list(zip(np.atleast_1d(la).tolist(), np.atleast_1d(lo).tolist(), strict=True)))
+        dist = pr.result.get("distances") or dist
+    points: dict[str, tuple[float, float]] = {}
+    if dist.get("takeoff"):
+        points["take-off"] = (float(dist["takeoff"][0]), float(dist["takeoff"][1]))
+        if dist.get("pilot") and list(dist["pilot"]) != list(dist["takeoff"]):
+            points["pilot"] = (float(dist["pilot"][0]), float(dist["pilot"][1]))
+    else:
+        lon, lat = area.centre()
+        points["take-off"] = (lat, lon)
+    return area_map.area_map(area_map.MapLayers(area, zones, lines, points))
 
 
 @router.get("/summary.css")
@@ -138,22 +174,48 @@ async def select_form(request: Request, ctx: Ctx) -> Response:
     errors = {**forms.field_errors(values), **forms.empty_required(form, has_area)}
     result = None
     files: dict[str, Any] = {}
-    for opt in forms.form_fields(ctx.choices):
-        up = form.get(opt.name)
-        if opt.widget == "file" and isinstance(up, UploadFile) and up.filename:
+    file_names = [f.name for f in forms.form_fields(ctx.choices) if f.widget == "file"]
+    file_names += [n for n, spec in forms.PLAN_FIELDS.items() if spec[3] == "file"]
+    for name in file_names:
+        up = form.get(name)
+        if isinstance(up, UploadFile) and up.filename:
             data = await up.read(forms.MAX_OPTION_FILE_BYTES + 1)
             try:
-                files[opt.name] = forms.file_value(opt.name, up.filename, data)
+                files[name] = forms.file_value(name, up.filename, data)
             except OptionError as e:
                 errors[e.option] = str(e)
+    extra = forms.plan_values(form)
+    values.update(extra)
     if not errors:
+        intents = files.pop("intents", None)
         try:
-            result = run_view(ctx, values, files)
+            result = run_view(ctx, {k: v for k, v in values.items() if k not in extra}, files)
+            if "area" in files and ctx.run_plan is not None:
+                result.update(await plan_part(ctx, values, files, intents, result["req"]))
         except (OptionError, ApiError) as e:
             errors[field_of(e) or "form"] = getattr(e, "message", str(e))
+            result = None
         except UasnavError as e:
             errors["form"] = str(e)
+            result = None
     return selection_page(request, ctx, values, errors, result, 422 if errors else 200)
+
+
+async def plan_part(
+    ctx: WebContext, values: dict[str, Any], files: dict[str, Any], intents: Any, req: Any
+) -> dict[str, Any]:
+    """The survey plan of the uploaded area (``uasnav plan`` on the form's values) and its map;
+    a plan nothing can fly is said in the plan's part, the selection above it still shown."""
+    opts = {**values, **files}
+    if intents is not None:
+        opts["intents"] = (intents,)
+    try:
+        pr = await run_in_threadpool(ctx.run_plan, opts)
+    except OptionError:
+        raise
+    except (UasnavError, ValueError) as e:
+        return {"plan": {"result": None, "downloads": [], "error": str(e)}}
+    return {"plan": plan_view(pr), "area_map": map_of(req, pr)}
 
 
 @router.get("/select/export.{fmt}")
