@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 from typing import Annotated, Any
 
 import numpy as np
@@ -21,6 +22,7 @@ from uasnav.mission.matrices import NECESSARY
 from uasnav.mission.request import OPTION_GROUPS, OptionError
 from uasnav.web import area_map, forms, selection_view
 from uasnav.web.context import (
+    GENERIC_500,
     MAX_BODY_BYTES,
     MAX_FIELDS,
     MAX_FILES,
@@ -33,6 +35,7 @@ from uasnav.web.context import (
     web_context,
 )
 
+log = logging.getLogger("uasnav.web")
 router = APIRouter(include_in_schema=False)
 Ctx = Annotated[WebContext, Depends(web_context)]
 
@@ -215,6 +218,10 @@ async def plan_part(
         raise
     except (UasnavError, ValueError) as e:
         return {"plan": {"result": None, "downloads": [], "error": str(e)}}
+    except Exception:
+        # the selection above stands on its own: a planner failure costs the plan, not the page
+        log.exception("survey plan failed")
+        return {"plan": {"result": None, "downloads": [], "error": GENERIC_500}}
     return {"plan": plan_view(pr), "area_map": map_of(req, pr)}
 
 
