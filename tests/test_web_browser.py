@@ -401,13 +401,24 @@ def test_area_upload_map_results_downloads(pages, server, tmp_path) -> None:
         assert box and box["y"] + box["height"] <= viewport["height"], "run button below the fold"
         page.set_input_files("#f-area", str(area))
         page.fill("#f-range", "")  # with an area, distances come from the area
-        page.click("#select-form button[type=submit]")
+        if tag == "phone":  # keyboard only: Tab to the run button, Enter
+            page.focus("#f-range")
+            for _ in range(30):
+                if page.evaluate("document.activeElement.type") == "submit":
+                    break
+                page.keyboard.press("Tab")
+            with page.expect_navigation():
+                page.keyboard.press("Enter")
+        else:
+            page.click("#select-form button[type=submit]")
         page.wait_for_selector("#results")
         assert page.evaluate("document.activeElement.id") == "results"
         svg = page.locator("svg.map")
         assert svg.is_visible()
         assert page.locator("svg.map path.area").count() == 1
         assert page.locator("svg.map g.takeoff").count() == 1
+        assert page.locator("svg.map polyline.survey").count() >= 1
+        assert page.locator("#flights tbody tr").count() >= 1
         assert page.locator("svg.map g.north").count() == 1 and page.locator("svg.map g.scale").is_visible()
         head = page.locator("#ranking thead th")
         for name in ("Mass (g)", "Cost (USD)", "Operation"):
@@ -425,10 +436,23 @@ def test_area_upload_map_results_downloads(pages, server, tmp_path) -> None:
         names = []
         for link in page.locator(".downloads a[download]").all():
             with page.expect_download() as d:
-                link.click()
-            assert Path(d.value.path()).stat().st_size > 0
+                if tag == "phone":  # keyboard only
+                    link.focus()
+                    page.keyboard.press("Enter")
+                else:
+                    link.click()
+            got = tmp_path / f"{tag}-{d.value.suggested_filename}"
+            d.value.save_as(got)
+            assert got.stat().st_size > 0
             names.append(d.value.suggested_filename)
         assert {"selection.json", "ranking.csv", "authorisation-summary.html"} <= set(names)
+        # every file the plan writes, and the flight plan reads back
+        want = {"flight-01.plan", "flight-01.waypoints", "flight-01.intent.json", "summary.html"}
+        assert want | {"summary.json", "result.json"} <= set(names)
+        route, _ = plan_route(read_plan(tmp_path / f"{tag}-flight-01.plan"))
+        assert len(route) >= 2
+        result = json.loads((tmp_path / f"{tag}-result.json").read_text())
+        assert result["survey"]["lines"] == page.locator("svg.map polyline.survey").count()
 
 
 def test_oversize_upload_is_refused_beside_the_field(pages, server, tmp_path) -> None:
