@@ -148,3 +148,12 @@ def test_area_upload_runs_the_plan(client) -> None:
     n_lines = want.result["survey"]["lines"]
     assert r.text.count('<polyline class="survey"') == n_lines
     assert f'<b class="n">{want.result["survey"]["photos"]}</b> photos' in r.text
+
+
+def test_answers_name_fields_not_command_line_options(client) -> None:
+    r = client.post("/select", data={"range": "", "altitude": "50"}, files={"area": ("field.geojson", AREA)})
+    assert r.status_code == 200 and 'id="plan"' in r.text
+    plan = re.search(r'<section class="plan".*?</section>', r.text, re.S).group(0)
+    plan = re.sub(r'href="data:[^"]*"', "", plan)
+    notes = " ".join(re.findall(r'<p class="note">(.*?)</p>', r.text, re.S))
+    assert "“Altitude”" in plan and not re.search(r"--[a-z]", plan + notes)

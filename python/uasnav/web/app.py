@@ -40,6 +40,7 @@ from uasnav.web.context import (
     choices_of,
     load_documents,
     num,
+    plain,
 )
 from uasnav.web.page_errors import OversizePages, PageRenderer
 from uasnav.web.routes import api, api_page, database, selection, trajectory
@@ -87,6 +88,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
     templates.env.globals.update(version=__version__, sources=docs.sources, parameters=PARAMETERS)
     templates.env.filters["num"] = num
     templates.env.filters["auto"] = auto_num
+    templates.env.filters["plain"] = plain
     app.state.docs = docs
     app.state.web = WebContext(
         docs=docs,

@@ -9,6 +9,7 @@ The selector itself reaches the routes through the context too (``run_select``,
 from __future__ import annotations
 
 import base64
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -159,6 +160,20 @@ def choices_of(docs: Documents) -> dict[str, tuple[tuple[str, str], ...]]:
         ),
         "category": tuple(cats.items()),
     }
+
+
+_OPTION_NAME = re.compile(r"--([a-z][a-z0-9-]*)")
+
+
+def plain(text: Any) -> str:
+    """``text`` with command-line option names (``--altitude``) replaced by the form's field
+    labels ("Altitude"), for answers shared with the command line."""
+    labels = {o.flag: o.label for o in select_request.SELECT_OPTIONS if o.label}
+
+    def label(m: re.Match[str]) -> str:
+        return f"“{labels[m.group(0)]}”" if m.group(0) in labels else m.group(0)
+
+    return _OPTION_NAME.sub(label, str(text))
 
 
 def auto_num(x: Any) -> str:
