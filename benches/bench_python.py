@@ -373,6 +373,43 @@ def bench_mission(n_uas: int, n_cam: int, repeat: int) -> None:
     )
 
 
+def bench_plan(repeat: int) -> None:
+    """``uasnav.plan`` of the thesis field (70 m × 70 m at 0.05 m/px) and of a 400 m × 300 m
+    field at 0.02 m/px: first call (imports and model load) and warm calls."""
+    import time
+
+    from uasnav.geo import frames
+
+    def rect(w: float, h: float) -> dict:
+        e = np.array([10, 10 + w, 10 + w, 10, 10])
+        n = np.array([10, 10, 10 + h, 10 + h, 10])
+        la, lo, _ = frames.enu_to_geodetic(e, n, 0.0, 45.0, 9.0, 0.0)
+        return {
+            "type": "Polygon",
+            "coordinates": [[[float(x), float(y)] for x, y in zip(lo, la, strict=True)]],
+        }
+
+    t0 = time.perf_counter()
+    import uasnav
+
+    def thesis() -> object:
+        return uasnav.plan(area=rect(70, 70), takeoff="45,9", resolution=0.05, start="2027-05-01T10:00Z")
+
+    thesis()
+    first = time.perf_counter() - t0
+    t_thesis = median_time(thesis, repeat)
+    t_large = median_time(
+        lambda: uasnav.plan(
+            area=rect(400, 300), takeoff="45,9", resolution=0.02, imagery="rgb", start="2027-05-01T10:00Z"
+        ),
+        repeat,
+    )
+    print(
+        f"plan thesis field: first call (imports + model) {first:6.2f} s | warm {t_thesis * 1e3:7.1f} ms | "
+        f"400x300 m at 0.02 m/px warm {t_large * 1e3:7.1f} ms"
+    )
+
+
 def bench_utm(n_intents: int, n_sub: int, repeat: int) -> None:
     """Issue 17: all conflicts among seeded synthetic intents (city 30 km, a day, 10–50 volumes
     each) from arrays in memory: the Rust space-time index (build + exact 4D tests) vs a shapely
@@ -613,6 +650,7 @@ CASES: dict[str, Callable[[bool], None]] = {
     "io": lambda quick: bench_io(10**4 if quick else 10**5, 1 if quick else 3),
     "csv_pyarrow": lambda quick: bench_csv_pyarrow(300.0 if quick else 3600.0, 3 if quick else 5),
     "mission": lambda quick: bench_mission(10**3 if quick else 10**4, 10**3, 3 if quick else 5),
+    "plan": lambda quick: bench_plan(3 if quick else 5),
     "utm": lambda quick: bench_utm(10**4 if quick else 10**5, 500 if quick else 3000, 3),
     "fleet": lambda quick: bench_fleet(
         3 if quick else 5, 2 if quick else 8, 40.0 if quick else 120.0, 1 if quick else 3

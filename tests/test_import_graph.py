@@ -77,7 +77,8 @@ def _imports(path: Path, modules: set[str]) -> set[str]:
 
 def _graph() -> dict[str, set[str]]:
     files = sorted(PKG_DIR.rglob("*.py"))
-    modules = {_module_name(f) for f in files}
+    # the compiled extension is a module of its own (described by its stub), not the package face
+    modules = {_module_name(f) for f in files} | {_module_name(f) for f in PKG_DIR.glob("_core.pyi")}
     return {_module_name(f): _imports(f, modules) for f in files}
 
 

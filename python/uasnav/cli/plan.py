@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from uasnav.cli._common import OutputPath, Real, echo_json
+from uasnav.cli._common import Real, echo_json
 from uasnav.cli.select import _USAGE_KINDS, _options
 from uasnav.mission.planner import PLAN_OPTIONS
 from uasnav.mission.request import SELECT_OPTIONS, OptionError, read_file_option
@@ -28,7 +28,11 @@ from uasnav.mission.request import SELECT_OPTIONS, OptionError, read_file_option
     "--turnaround", type=Real(0.0, 86400.0), default=600.0, show_default=True, help=PLAN_OPTIONS["turnaround"]
 )
 @click.option(
-    "--out", "out", required=True, type=OutputPath(), help="Directory to write the plan's files into."
+    "--out",
+    "out",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Directory to write the plan's files into (created if missing).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print result.json.")
 def command(

@@ -35,6 +35,8 @@ def _click_type(opt: SelectOption) -> Any:
         return click.Choice(opt.choices or ())
     if opt.kind == "output":
         return OutputPath()
+    if opt.kind in ("wind", "position"):
+        return click.STRING  # SPEED[@FROM_DEG], LAT,LON: checked by the request parser
     return None
 
 
@@ -193,6 +195,12 @@ def command(as_json: bool, **options: Any) -> None:
             f"  {rank_no:>2} {pair.uas:<30} {pair.camera:<26} {pair.score:6.2f} {pair.mass_g:7.0f}"
             f" {pair.cost_usd:7.0f}  {pair.open_subcategory or '-':<4}  {pair.visibility}/{pair.category}"
         )
+    if sel.ranking:
+        from uasnav.mission.scoring import explain
+
+        click.echo("  scores:")
+        for line in explain(sel.targets or request.targets, w):
+            click.echo(f"    {line}")
     if not sel.ranking and sel.withheld:
         click.echo("  (none flyable: the area enters a PROHIBITED zone)")
         click.echo("\nWithheld — would rank only if the zone authority exempted the flight:")

@@ -196,10 +196,12 @@ def parse_overlap(value: Any) -> tuple[float, float]:
 
 
 def _read_intents(items: Sequence[Any], now: dt.datetime) -> list[Any]:
-    """Intents of other operators: paths, or :class:`Upload` documents (JSON or YAML)."""
+    """Intents of other operators: paths, or :class:`Upload` documents (JSON, or InterUSS
+    flight-intent YAML whose times are resolved at ``now``). Volumes that ended before the
+    survey are not refused: they cannot conflict with it."""
     from uasnav import jsoncheck as jc
     from uasnav.io.interuss import read_flight_intents, resolve_flight_intents
-    from uasnav.io.operational_intent import check_times, parse_intents, read_intents
+    from uasnav.io.operational_intent import parse_intents, read_intents
 
     found = []
     for it in items:
@@ -222,8 +224,6 @@ def _read_intents(items: Sequence[Any], now: dt.datetime) -> list[Any]:
         else:
             p = os.fspath(it)
             found += read_flight_intents(p, now) if p.lower().endswith((".yaml", ".yml")) else read_intents(p)
-    for x in found:
-        check_times(x, now)
     return found
 
 

@@ -153,3 +153,24 @@ def rank(total: np.ndarray, k: int) -> list[tuple[int, int]]:
     # Ties are broken by the flat index so that rankings are reproducible.
     idx = idx[np.lexsort((idx, flat[idx]))]
     return [divmod(int(i), total.shape[1]) for i in idx[:k]]
+
+
+def explain(targets: Targets, weights: Weights) -> list[str]:
+    """What the ranking's scores mean, one line per parameter: a value at or better than the
+    target scores 0 (so configurations inside the target tie on that parameter, e.g. a $1 699
+    and a $1 999 aircraft both under a $4 000 cost target), one at the limit scores 1, linear
+    in between (Table 23, eq. 61); the total is the weighted sum, lower is better."""
+    rows = (
+        ("range", targets.range_m, "m", "longer is better", weights.range),
+        ("weight", targets.weight_g, "g", "lighter is better", weights.weight),
+        ("cost", targets.cost_usd, "USD", "cheaper is better", weights.cost),
+        ("resolution", targets.resolution_deg, "deg/px", "finer is better", weights.resolution),
+    )
+    out = []
+    for name, (target, limit), unit, sense, w in rows:
+        out.append(
+            f"{name} (weight {w:g}, {sense}): {target:g} {unit} or better scores 0 — every configuration "
+            f"within the target ties on {name} —, {limit:g} {unit} scores 1, linear in between"
+        )
+    out.append("total = weighted sum of the four scores (eq. 61); lower is better")
+    return out

@@ -33,7 +33,7 @@ from uasnav.mission.operation import (
     vlos_distance_of,
 )
 from uasnav.mission.regulations import Regulations, load_regulations
-from uasnav.mission.scoring import ScoreMatrix, Targets, Weights, rank, score_matrix
+from uasnav.mission.scoring import ScoreMatrix, Targets, Weights, explain, rank, score_matrix
 from uasnav.mission.sora import SoraResult, assess
 
 if TYPE_CHECKING:
@@ -128,6 +128,8 @@ class Selection:
     #: Height (m above ground) the cameras' field of view and resolution were tested at, and
     #: the rule that chose it (``planned`` or ``regulatory-max``, :attr:`Requirements.camera_height`).
     camera_height_m: float | None = None
+    #: The scoring's targets and limits (Table 23), for the explanation shown with the ranking.
+    targets: Targets | None = None
 
     @property
     def authorisation(self) -> dict:
@@ -314,6 +316,11 @@ class Selection:
             "rejections": [x.__dict__ for x in self.rejections],
             "ranking": [c.__dict__ for c in self.ranking],
             "weights": self.scores.weights.__dict__,
+            "scoring": {
+                "weights": self.scores.weights.__dict__,
+                "targets": (self.targets or Targets()).__dict__,
+                "explained": explain(self.targets or Targets(), self.scores.weights),
+            },
             "notes": self.notes,
             "operation": self.operation.to_dict() if self.operation else None,
             "sora": self.sora.to_dict() if self.sora else None,
@@ -910,4 +917,5 @@ def select(
         flight_window=window,
         operations=operations,
         camera_height_m=float(main.h_cam),
+        targets=targets,
     )
