@@ -124,6 +124,11 @@ class WebContext:
         return to_jsonable(self.selection(values, files).to_dict())
 
 
+async def read_form(request: Request) -> Any:
+    """The request's form (urlencoded or multipart) within the server's part limits."""
+    return await request.form(max_files=MAX_FILES, max_fields=MAX_FIELDS, max_part_size=MAX_PART_BYTES)
+
+
 def web_context(request: Request) -> WebContext:
     """FastAPI dependency: the application's :class:`WebContext`."""
     return request.app.state.web  # type: ignore[no-any-return]

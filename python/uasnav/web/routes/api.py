@@ -12,12 +12,10 @@ from uasnav.jsonable import to_jsonable
 from uasnav.mission import request as select_request
 from uasnav.web import forms, prediction, tables
 from uasnav.web.context import (
-    MAX_FIELDS,
-    MAX_FILES,
     MAX_JSON_BYTES,
-    MAX_PART_BYTES,
     ApiError,
     WebContext,
+    read_form,
     web_context,
 )
 from uasnav.web.routes.database import table_of
@@ -186,7 +184,7 @@ def api_db(ctx: Ctx, name: str, q: str = "", sort: str = "", desc: bool = False)
 async def api_predict(request: Request) -> Response:
     if not request.headers.get("content-type", "").startswith("multipart/form-data"):
         raise ApiError(415, "content-type", "content-type: expected multipart/form-data with a plan file")
-    form = await request.form(max_files=MAX_FILES, max_fields=MAX_FIELDS, max_part_size=MAX_PART_BYTES)
+    form = await read_form(request)
     fmt = form.get("format") or "json"
     if fmt not in ("json", "csv", "geojson"):
         raise ApiError(422, "format", f"format: {fmt!r} is not json, csv or geojson")

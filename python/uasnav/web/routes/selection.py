@@ -24,14 +24,12 @@ from uasnav.web import area_map, forms, selection_view
 from uasnav.web.context import (
     GENERIC_500,
     MAX_BODY_BYTES,
-    MAX_FIELDS,
-    MAX_FILES,
-    MAX_PART_BYTES,
     ApiError,
     WebContext,
     data_uri,
     download,
     field_of,
+    read_form,
     web_context,
 )
 
@@ -170,7 +168,7 @@ def index(request: Request, ctx: Ctx) -> Response:
 
 @router.post("/select", response_class=HTMLResponse)
 async def select_form(request: Request, ctx: Ctx) -> Response:
-    form = await request.form(max_files=MAX_FILES, max_fields=MAX_FIELDS, max_part_size=MAX_PART_BYTES)
+    form = await read_form(request)
     values = forms.values_from_form(form, form.getlist)
     up_area = form.get("area")
     has_area = isinstance(up_area, UploadFile) and bool(up_area.filename)

@@ -12,7 +12,7 @@ from starlette.datastructures import UploadFile
 
 from uasnav.errors import UasnavError
 from uasnav.web import prediction
-from uasnav.web.context import MAX_BODY_BYTES, MAX_FIELDS, MAX_FILES, MAX_PART_BYTES, WebContext, web_context
+from uasnav.web.context import MAX_BODY_BYTES, WebContext, read_form, web_context
 
 router = APIRouter(include_in_schema=False)
 Ctx = Annotated[WebContext, Depends(web_context)]
@@ -104,7 +104,7 @@ def trajectory_form(request: Request, ctx: Ctx) -> Response:
 
 @router.post("/trajectory", response_class=HTMLResponse)
 async def trajectory_post(request: Request, ctx: Ctx) -> Response:
-    form = await request.form(max_files=MAX_FILES, max_fields=MAX_FIELDS, max_part_size=MAX_PART_BYTES)
+    form = await read_form(request)
     values = {k: v for k, v in form.items() if isinstance(v, str)}
     try:
         result = await predict_from_form(form)
