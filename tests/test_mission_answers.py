@@ -107,3 +107,14 @@ def test_select_wind_takes_a_direction_and_json_says_the_camera_height(tmp_path)
     assert d["requirements"]["wind_ms"] == 6.0 and d["camera_height"]["rule"] == "regulatory-max"
     bad = CliRunner().invoke(main, ["select", "--wind", "6@north"])
     assert bad.exit_code == 2 and "wind" in bad.output
+
+
+def test_select_window_is_the_survey_of_the_area_not_the_range(shared_data) -> None:
+    # a 500 m × 500 m mapping field: the zones' window is the survey's time, minutes not seconds
+    zones = (shared_data / "utm" / "interuss_ed269_geozone_sample.json").read_text()
+    sel = run_select(
+        {"area": rect(10, 10, 500), "zones": zones, "flight_time": "2027-05-03T10:00Z", "resolution": 0.03}
+    )
+    w = sel.flight_window
+    assert w is not None and "survey of the area" in w["from"]
+    assert w["duration_s"] > 600

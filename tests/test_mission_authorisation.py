@@ -119,9 +119,13 @@ def test_a_schedule_starting_after_take_off_is_hit(doc) -> None:
     }
     sel = run_select({**base, "flight_duration": 599})
     assert sel.zones is not None and not sel.zones.hits and sel.flight_window["from"] == "--flight-duration"
-    sel = run_select({**base, "flight_time": "2026-05-04T09:56Z"})  # the estimate is about 330 s
-    assert sel.flight_window is not None and "mission time estimate" in sel.flight_window["from"]
-    assert sel.flight_window["duration_s"] > 240 and [x.identifier for x in sel.zones.hits] == ["LSXX"]
+    # the default window: the survey of the area (about 150 s for this field), not the range's
+    # out-and-back estimate
+    sel = run_select({**base, "flight_time": "2026-05-04T09:58Z"})
+    assert sel.flight_window is not None and "survey of the area" in sel.flight_window["from"]
+    assert sel.flight_window["duration_s"] > 120 and [x.identifier for x in sel.zones.hits] == ["LSXX"]
+    early = run_select({**base, "flight_time": "2026-05-04T09:56Z"})
+    assert early.flight_window["duration_s"] < 240 and not early.zones.hits
     with pytest.raises(ValueError, match="before"):
         SCHEDULES[0].active_during(off, off - dt.timedelta(seconds=1))
 

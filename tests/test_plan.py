@@ -246,3 +246,10 @@ def test_cli_plan_writes_outputs_and_prints_result_json(tmp_path) -> None:
     )
     assert bad.exit_code == 2 and "wind" in bad.output
     assert not (tmp_path / "o").exists()
+
+
+def test_a_resolution_no_camera_reaches_is_said_as_such() -> None:
+    res = uasnav.plan(area=rect(10, 10, 70, 70), resolution=0.0005, start=START)
+    assert res["survey"] is None and not res["authorisation"]["authorisable"]
+    assert res["authorisation"]["verdict"].startswith("no camera in the database meets resolution")
+    assert set(res.files) == {"result.json"}

@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from uasnav.cli._common import Real, echo_json
+from uasnav.cli._common import OutputPath, Real, echo_json
 from uasnav.cli.select import _USAGE_KINDS, _options
 from uasnav.mission.planner import PLAN_OPTIONS
 from uasnav.mission.request import SELECT_OPTIONS, OptionError, read_file_option
@@ -31,7 +31,7 @@ from uasnav.mission.request import SELECT_OPTIONS, OptionError, read_file_option
     "--out",
     "out",
     required=True,
-    type=click.Path(file_okay=False),
+    type=OutputPath(dir_okay=True, file_okay=False),
     help="Directory to write the plan's files into (created if missing).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print result.json.")

@@ -227,16 +227,6 @@ def _read_intents(items: Sequence[Any], now: dt.datetime) -> list[Any]:
     return found
 
 
-def _camera(sel: Any, j: int) -> Camera:
-    c = sel.database.cameras
-    return Camera(
-        name=c.label(j),
-        hfov_deg=float(c.hfov_deg[j]),
-        width_px=float(c.resolution_w_px[j]),
-        height_px=float(c.resolution_h_px[j]),
-    )
-
-
 def _field_polygon(area: Any, lat0: float, lon0: float) -> Any:
     """The field to photograph in the local east/north frame about the take-off point: the
     area's polygons (a plan's route: its convex hull)."""
@@ -346,7 +336,7 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     u = sel.database.uas
     i = u.ids.index(best.uas_id)
     j = sel.database.cameras.ids.index(best.camera_id)
-    camera = _camera(sel, j)
+    camera = Camera.from_table(sel.database.cameras, j)
     cruise = req.cruise_fraction * float(u.max_speed_ms[i])
     endurance = float(u.endurance_min[i]) * 60.0 * (1.0 - req.reserve)
     field_en = _field_polygon(area, lat0, lon0)
@@ -396,22 +386,26 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
         t = t + dt.timedelta(seconds=b.eta_bounds_s[1] + turnaround)
     end_latest = t - dt.timedelta(seconds=turnaround)
     total_s = (end_latest - start).total_seconds()
-    # the zones over the predicted window (take-off of the first flight to the latest end of the last)
-    if request.zones is not None:
-        sel = select(
-            replace(req, flight_duration_s=max(total_s, 1.0)),
-            **sel_kw,
-            area=area,
-            zones=request.zones,
-            zones_source=request.zones_source,
-            when=start,
-        )
-        if sel.flight_window is not None:
-            sel.flight_window["from"] = (
-                "predicted flight time of the survey (upper bounds, turnarounds included)"
-            )
+    # The answer at the height the survey flies (operation, SORA, zones' vertical band) and over
+    # the predicted window (take-off of the first flight to the latest end of the last); kept
+    # only if the same configuration still ranks first, else the first pass's heights stand.
+    zone_kw: dict[str, Any] = (
+        dict(area=area, zones=request.zones, zones_source=request.zones_source, when=start)
+        if request.zones is not None
+        else {}
+    )
+    flown = replace(
+        req, altitude_m=math.ceil(sp.altitude_m * 10.0) / 10.0, flight_duration_s=max(total_s, 1.0)
+    )
+    again = select(flown, **sel_kw, **zone_kw)
+    pick = again.chosen or (again.withheld[0] if again.withheld else None)
+    if pick is None or (pick.uas_id, pick.camera_id) != (best.uas_id, best.camera_id):
+        again = select(replace(req, flight_duration_s=max(total_s, 1.0)), **sel_kw, **zone_kw)
+    sel = again
+    if sel.flight_window is not None:
+        sel.flight_window["from"] = "predicted flight time of the survey (upper bounds, turnarounds included)"
     conflicts = _deconflict(flights, _read_intents(list(intents_in), dt.datetime.now(dt.timezone.utc)))
-    result = _result(sel, sp, flights, conflicts, request, start, total_s, overlap)
+    result = _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap)
     files = _files(sel, sp, flights, result)
     return PlanResult(result, files, sel, sp, flights)
 
@@ -472,8 +466,7 @@ def _deconflict(flights: list[FlightResult], others: list[Any]) -> list[dict[str
     return out
 
 
-def _result(sel, sp, flights, conflicts, request, start, total_s, overlap) -> dict[str, Any]:
-    best = sel.chosen
+def _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap) -> dict[str, Any]:
     op = sel.operation
     etas = [f.intent.eta_s for f in flights]
     lo = [f.intent.eta_bounds_s[0] for f in flights]

@@ -10,6 +10,7 @@ import numpy as np
 
 from uasnav.mission.database import Database, load_database
 from uasnav.mission.feasibility import (
+    MIN_SURVEY_HEIGHT_M,
     Rejection,
     Requirements,
     TestResult,
@@ -222,6 +223,14 @@ class Selection:
             tests_of.setdefault(r.kind, set()).add(r.test)
         parts = []
         if len(self.database.cameras) and not self.camera_ok.any():
+            # the tests that alone keep some camera out (a camera failing only them), else all
+            fails: dict[str, set[str]] = {}
+            for r in self.rejections:
+                if r.kind == "camera":
+                    fails.setdefault(r.item, set()).add(r.test)
+            binding = {next(iter(t)) for t in fails.values() if len(t) == 1}
+            if binding:
+                tests_of["camera"] = binding
             best = {}
             for r in self.rejections:
                 if r.kind == "camera" and r.test == "resolution":
@@ -305,7 +314,10 @@ class Selection:
                 "rule": r.camera_height,
                 "height_m": self.camera_height_m,
                 "explained": (
-                    "field of view and resolution tested at the planned height (--altitude)"
+                    "a survey: no field-of-view test; the resolution is reachable at or above "
+                    f"{MIN_SURVEY_HEIGHT_M:g} m (the survey flies at the height that gives it)"
+                    if r.mosaic
+                    else "field of view and resolution tested at the planned height (--altitude)"
                     if r.camera_height == "planned"
                     else "field of view and resolution tested at the highest height the category "
                     "allows (thesis §5.2.3.4)"
@@ -341,12 +353,56 @@ def equipment_tests(u, req: Requirements, equipment: list[EquipmentNeed]) -> lis
     return _equipment_tests(u, req.gnss_autopilot, need)
 
 
-def _flight_duration(u, req: Requirements, ranking: list[RankedPair]) -> tuple[float, str]:
+def _survey_duration(db: Database, req: Requirements, best: RankedPair, area) -> tuple[float, str] | None:
+    """(duration s, how) of a survey of the polygon ``area`` by ``best`` at the resolution, from
+    the take-off point at the area's centroid: the survey planner's flight-time estimate of
+    every flight plus the turnarounds between them; None if no survey can be laid out."""
+    from uasnav.errors import UasnavError
+    from uasnav.mission.survey import Camera, plan_survey
+
+    u, c = db.uas, db.cameras
+    i, j = u.ids.index(best.uas_id), c.ids.index(best.camera_id)
+    lon0, lat0 = area.centre()
+    g = area.local(lon0, lat0)
+    if g.geom_type != "Polygon":
+        g = g.convex_hull
+    try:
+        sp = plan_survey(
+            g,
+            Camera.from_table(c, j),
+            resolution_m=req.resolution_m,
+            origin=(lat0, lon0),
+            takeoff_en=(g.centroid.x, g.centroid.y),
+            altitude_m=req.altitude_m,
+            cruise_ms=req.cruise_fraction * float(u.max_speed_ms[i]),
+            endurance_s=float(u.endurance_min[i]) * 60.0 * (1.0 - req.reserve),
+        )
+    except UasnavError:
+        return None
+    n = len(sp.flights)
+    total = sum(sp.estimated_time_s) + SURVEY_TURNAROUND_S * (n - 1)
+    return float(total), (
+        f"survey of the area by {best.uas} + {best.camera}: {len(sp.lines)} lines, {n} flight(s) "
+        f"at {sp.speed_ms:.1f} m/s (conservative estimate; `uasnav plan` predicts it with bounds)"
+    )
+
+
+#: Time between two flights of a survey (landing, battery change, take-off), s.
+SURVEY_TURNAROUND_S = 600.0
+
+
+def _flight_duration(
+    u, req: Requirements, ranking: list[RankedPair], area=None, db: Database | None = None
+) -> tuple[float, str]:
     """(duration s, how it was obtained) of the flight: ``req.flight_duration_s`` when given,
     else the mission time (out and back over the range against the wind at the cruise airspeed,
     :func:`mission_time_s`) of the best-ranked UAS, else the longest finite one in the database."""
     if req.flight_duration_s is not None:
         return float(req.flight_duration_s), "--flight-duration"
+    if ranking and area is not None and db is not None and any(k == "poly" for k, _ in area.parts):
+        got = _survey_duration(db, req, ranking[0], area)
+        if got is not None:
+            return got
     t = mission_time_s(req.range_m, req.cruise_fraction * u.max_speed_ms, req.wind_ms)
     if ranking:
         i = u.ids.index(ranking[0].uas_id)
@@ -627,7 +683,9 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
         )
     # eq. 60 at the planned height, or at the highest height the regulations allow (the
     # thesis' rule, §5.2.3.4; the required altitude when the category sets no limit)
-    if req.camera_height == "regulatory-max":
+    if req.mosaic:  # a survey: the resolution is tested at the lowest survey height
+        h_cam = MIN_SURVEY_HEIGHT_M
+    elif req.camera_height == "regulatory-max":
         h_cam = h_reg if np.isfinite(h_reg) else req.altitude_m
     else:
         h_cam = req.altitude_m
@@ -853,7 +911,7 @@ def select(
 
         until = None
         if when is not None:
-            duration, how = _flight_duration(u, req, ranking)
+            duration, how = _flight_duration(u, req, ranking, area, db)
             until = when + _dt.timedelta(seconds=duration)
             window = {
                 "start": when.isoformat(),

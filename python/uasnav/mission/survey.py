@@ -90,6 +90,17 @@ class Camera:
         if self.hfov_deg >= 180:
             raise InputError(f"camera {self.name}: hfov_deg must be < 180, got {self.hfov_deg!r}")
 
+    @classmethod
+    def from_table(cls, cameras, j: int) -> Camera:
+        """Camera ``j`` of a :class:`~uasnav.mission.database.CameraTable` (the database gives
+        no exposure or trigger interval: the stated defaults apply)."""
+        return cls(
+            name=cameras.label(j),
+            hfov_deg=float(cameras.hfov_deg[j]),
+            width_px=float(cameras.resolution_w_px[j]),
+            height_px=float(cameras.resolution_h_px[j]),
+        )
+
     def height_for(self, gsd_m: float) -> float:
         """Height (m) at which one pixel covers ``gsd_m`` on the ground."""
         return gsd_m * self.width_px / (2.0 * math.tan(math.radians(self.hfov_deg) / 2.0))
