@@ -77,3 +77,12 @@ def test_report_quick(tmp_path):
     assert data["sections"]["allan"]["nist_max_rel_diff"] < 1e-5
     r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--only", "nope"])
     assert r.exit_code == 1 and "unknown report section" in r.output
+
+
+def test_report_fleet_section_through_the_cli(tmp_path):
+    # The fleet experiment writes a simulated fleet to a scratch folder and reads it back in the
+    # same run: the command's own output staging must not hide those files from it.
+    r = CliRunner().invoke(main, ["report", "--out", str(tmp_path), "--quick", "--only", "fleet"])
+    assert r.exit_code == 0, r.output
+    data = json.loads((tmp_path / "report.json").read_text())
+    assert "fleet" in data["sections"]

@@ -19,10 +19,13 @@ tests/test_cli_options.py.
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import resource
+import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import click
 import pytest
@@ -269,3 +272,156 @@ def test_every_command_keeps_the_contract(path, cmd, data, tmp_path_factory):
         _check_contract(argv, inputs, root, before)
     finally:
         os.chdir(cwd)
+
+
+# --- YAML intents, corrupt binary logs, the Python API ----------------------------------------
+
+_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+#: Time budget of one example of the byte-mutation and YAML fuzzers (s): a reader that
+#: resynchronises without bound, or a YAML bomb that expands, overruns it and fails the test.
+_EXAMPLE_BUDGET_S = 30.0
+
+_YAML_ATOMS = ["intents:", "full:", "delta:", "source: a", "mutation:", "basic_information:", "area:",
+               "- outline_circle: {center: {lat: 47, lng: 8}, radius: {value: 100, units: M}}",
+               "altitude_lower: {value: 0, reference: W84, units: M}", "start_time:", "duration: 5m",
+               "offset_from: {starting_from: {time_during_test: StartOfTestRun}, offset: -1s}",
+               "&a [x, x, x, x, x, x, x, x]", "*a", "[*a, *a, *a, *a, *a, *a, *a, *a]", "[[[[[[[[", "{",
+               "!!python/object:os.system", "? complex", "- - - -", "1e999", "~", "'", '"\\x00"']  # fmt: skip
+
+
+@st.composite
+def _yaml_text(draw: st.DrawFn) -> str:
+    lines = []
+    for _ in range(draw(st.integers(1, 30))):
+        indent = " " * draw(st.integers(0, 8))
+        key = draw(st.sampled_from(["", "a: ", "b: ", "c: &c ", "d: *c ", "- "]))
+        lines.append(indent + key + draw(st.sampled_from(_YAML_ATOMS)))
+    if draw(st.booleans()):  # a billion-laughs tower of some height
+        h = draw(st.integers(1, 9))
+        lines = (
+            ["l0: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
+            + [f"l{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 10)}]" for i in range(1, h)]
+            + [f"intents: {{x: {{full: *l{h - 1}}}}}"]
+            + lines
+        )
+    return "\n".join(lines) + "\n"
+
+
+@settings(suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture], deadline=None)
+@given(text=_yaml_text())
+def test_yaml_intents_keep_the_contract(text, tmp_path_factory):
+    root = tmp_path_factory.mktemp("yaml")
+    (root / "i.yaml").write_text(text, encoding="utf-8")
+    before = _snapshot(root)
+    cwd = os.getcwd()
+    os.chdir(root)
+    try:
+        t0 = time.monotonic()
+        _check_contract(
+            ["utm", "deconflict", "i.yaml", "--now", "2026-01-01T00:00:00Z"], ["i.yaml"], root, before
+        )
+        assert time.monotonic() - t0 < _EXAMPLE_BUDGET_S
+    finally:
+        os.chdir(cwd)
+
+
+_LOGS = {
+    ".tlog": (_DATA / "flights" / "phoenix_mission1_arducopter.tlog", 200_000),
+    ".bin": (_DATA / "logs" / "ardupilot_log171.bin", 300_000),
+    ".ulg": (_DATA / "logs" / "px4_sample_log_small.ulg", 300_000),
+}
+
+
+@st.composite
+def _mutated_log(draw: st.DrawFn) -> tuple[str, bytes]:
+    ext = draw(st.sampled_from(sorted(_LOGS)), label="format")
+    src, keep = _LOGS[ext]
+    with open(src, "rb") as fh:
+        data = bytearray(fh.read(keep))
+    rng_seed = draw(st.integers(0, 2**32 - 1), label="seed")
+    import random
+
+    rng = random.Random(rng_seed)
+    for _ in range(draw(st.sampled_from([0, 1, 10, 1000, 10_000]), label="flips")):
+        i = rng.randrange(len(data))
+        data[i] ^= 1 << rng.randrange(8)
+    cut = draw(st.sampled_from([len(data), len(data) // 2, 17, 0]), label="truncate at")
+    return ext, bytes(data[:cut])
+
+
+@pytest.mark.parametrize("command", [["allan"], ["zupt"], ["nav", "--json"]], ids=["allan", "zupt", "nav"])
+@settings(
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+    deadline=None,
+    max_examples=6,
+)
+@given(log=_mutated_log())
+def test_corrupt_binary_logs_keep_the_contract(command, log, tmp_path_factory):
+    ext, blob = log
+    root = tmp_path_factory.mktemp("bytes")
+    (root / f"log{ext}").write_bytes(blob)
+    before = _snapshot(root)
+    cwd = os.getcwd()
+    os.chdir(root)
+    try:
+        t0 = time.monotonic()
+        _check_contract([*command, f"log{ext}"], [f"log{ext}"], root, before)
+        took = time.monotonic() - t0
+        event(f"{command[0]} {ext}: {'<1' if took < 1 else '<5' if took < 5 else '>=5'} s")
+        assert took < _EXAMPLE_BUDGET_S, f"{command} on a mutated {ext}: {took:.1f} s"
+    finally:
+        os.chdir(cwd)
+
+
+_API_NUMBERS = st.sampled_from(
+    [0.0, -0.0, -1.0, 1.0, 1e-300, 5e-324, 1e308, -1e308, math.inf, -math.inf, math.nan, 100.0]
+)
+
+
+def _api_calls() -> list[tuple[str, Any]]:
+    """Public API functions, each with a strategy of hostile arguments."""
+    import numpy as np
+
+    from uasnav import allan, limits, units
+
+    arrays = st.sampled_from(
+        [
+            np.zeros(0),
+            np.full(10, np.nan),
+            np.ones((5, 3)),
+            np.arange(1000.0),
+            np.full(4, 1.79e308),
+            np.ones((2, 2, 2)),
+        ]
+    )
+    return [
+        ("allan.oadev", st.builds(lambda d, r, t: lambda: allan.oadev(d, r, t), arrays, _API_NUMBERS,
+                                 st.sampled_from(["octave", "all", "bogus", [0.0], [-1.0], [1e308]]))),
+        ("units.parse_quantity", st.builds(lambda t: lambda: units.parse_quantity(t, "m"), st.sampled_from(
+            ["1e999 m", "nan m", "-inf km", "1 s", "", "m", "1e308 km"]))),
+        ("limits.parse_size", st.builds(lambda t: lambda: limits.parse_size(t), st.sampled_from(
+            ["abc", "-1", "1e999", "nan", "inf", "", "1Q", "2G"]))),
+        ("limits.check_work", st.builds(lambda n: lambda: limits.check_work(n, "probe"), _API_NUMBERS)),
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize("name,calls", _api_calls(), ids=[n for n, _ in _api_calls()])
+@settings(suppress_health_check=[HealthCheck.too_slow], deadline=None, max_examples=15)
+@given(data=st.data())
+def test_public_api_functions_answer_or_raise_input_errors(name, calls, data):
+    """A public function given hostile values returns finite numbers or raises a uasnav error
+    (an ``InputError`` is also a ``ValueError``): never a bare numpy/Python exception, never inf
+    or NaN presented as a result."""
+    import numpy as np
+
+    from uasnav.errors import UasnavError
+
+    call = data.draw(calls)
+    try:
+        out = call()
+    except UasnavError:
+        return
+    for v in out if isinstance(out, tuple) else (out,):
+        for field in (getattr(v, "adev", None), v if isinstance(v, float | int) else None):
+            if field is not None:
+                assert np.all(np.isfinite(np.asarray(field, dtype=float))), f"{name}: {out!r}"

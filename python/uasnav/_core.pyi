@@ -10,7 +10,7 @@ an integer is expected stays a ``TypeError``. No call lets a Rust panic cross in
 """
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,6 +19,7 @@ from uasnav.ins.core import FilterConfig
 
 __version__: str
 __all__ = [
+    "InsStream",
     "__version__",
     "allan_cluster_size_for_tau",
     "allan_cluster_sizes",
@@ -323,3 +324,34 @@ def ins_run(
     keeps nav-core's default); a missing attribute or a wrong type is an ``InputError`` naming
     the field.
     """
+
+@final
+class InsStream:
+    """The GNSS/INS filter stepped one batch of received messages per call (nav-core's
+    ``InsStream``: causal; levels on the first ``levelling_samples`` IMU samples, starts at the
+    latest fix within 1 s, then applies each fix at the first IMU sample at or after its time).
+    ``config`` as for :func:`ins_run`."""
+
+    def __new__(cls, *, config: FilterConfig, levelling_samples: int = 100) -> InsStream: ...
+    def step(
+        self,
+        imu_t: NDArray[np.float64],
+        gyro: NDArray[np.float64],
+        accel: NDArray[np.float64],
+        gnss_t: NDArray[np.float64],
+        gnss_llh: NDArray[np.float64],
+        gnss_vel: NDArray[np.float64],
+        gnss_acc: NDArray[np.float64],
+        gnss_before: NDArray[np.uint64],
+    ) -> dict[str, NDArray[Any]]:
+        """Process one batch in arrival order (GIL released): IMU times (s), gyro (n, 3) rad/s,
+        accel (n, 3) m/s²; fixes as for :func:`ins_run`, fix ``j`` having arrived after
+        ``gnss_before[j]`` of the batch's IMU samples. Returns, per processed IMU sample, ``t``,
+        ``llh``, ``vel``, ``attitude``, ``protection`` (HPL, VPL m), ``gyro_bias``,
+        ``accel_bias``, ``fixes_used``, ``fixes_excluded``."""
+    @property
+    def running(self) -> bool:
+        """Whether the filter runs (levelling done, initialised on a fix)."""
+    def counts(self) -> dict[str, Any]:
+        """Running counts: imu_samples, imu_refused, imu_gaps, fixes_used, fixes_excluded,
+        fixes_dropped, gnss_resets, course_reset."""

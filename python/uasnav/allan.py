@@ -31,6 +31,7 @@ from scipy import stats
 
 from uasnav import _core
 from uasnav.errors import InputError, NumericalError
+from uasnav.limits import check_work
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -289,6 +290,12 @@ def oadev(
             f"rate: {rate:g} Hz is beyond any sensor's sample rate (at most {_MAX_RATE_HZ:g} Hz)"
         )
     ms = cluster_sizes(n, rate, taus)
+    # one pass over the n phase samples of each column per cluster size (≈ 4 operations each)
+    check_work(
+        4.0 * n * mat.shape[1] * len(ms),
+        f"Allan deviation of {n} samples × {mat.shape[1]} axes at {len(ms)} cluster sizes",
+        option='taus ("octave" or "decade" instead of "all")',
+    )
     # A constant column (a noise-free or quantisation-limited axis) has σ(τ) = 0 exactly; summed
     # into the phase, its value would leave float rounding (~1e-25) instead: zero it (a copy).
     # Column extremes in two reductions, no n-sized temporaries (this runs on 10⁷-sample logs);

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from uasnav import _core
 from uasnav.errors import InputError
+from uasnav.limits import check_count
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -172,7 +173,8 @@ def drift(
     if arr.shape == (3,):
         if duration is None or not (np.isfinite(duration) and duration > 0):
             raise InputError("duration: required (> 0) for a constant rate vector")
-        n = round(duration / dt)
+        # the constant vector becomes n rows, θ(t) and t: refused before any allocation
+        n = check_count(round(duration / dt), 6 * 8, f"attitude drift over {duration:g} s", option="duration")
         arr = np.broadcast_to(arr, (n, 3))
     r = _rows("rates", arr, 3)
     if r.shape[0] == 0:

@@ -39,6 +39,15 @@ class FetchError(InputError):
     """A URL that could not be fetched; the message names the URL and the reason on one line."""
 
 
+def new_request(url: str, headers: dict[str, str]) -> urllib.request.Request:
+    """``urllib.request.Request(url, headers=…)``; a malformed URL (``http://[::1``) is a
+    :class:`FetchError` naming it instead of urllib's bare ``ValueError``."""
+    try:
+        return urllib.request.Request(url, headers=headers)
+    except ValueError as e:
+        raise FetchError(f"{url}: not a valid URL ({e})") from None
+
+
 class Deadline:
     """A total deadline for one fetch: at expiry every connection it watches is shut down.
 
@@ -161,7 +170,7 @@ def download(
     """
     if not is_url(url):
         raise FetchError(f"{url!r}: only http:// and https:// URLs are fetched")
-    req = urllib.request.Request(url, headers={"User-Agent": user_agent, "Accept": accept})
+    req = new_request(url, {"User-Agent": user_agent, "Accept": accept})
     deadline = Deadline(timeout_s)
     late = f"{url}: cannot fetch (no complete answer within the timeout of {timeout_s:g} s)"
     got = 0

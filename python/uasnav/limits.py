@@ -12,10 +12,12 @@ Limits (environment variables, read at each check so a test or a shell can chang
 ``UASNAV_MAX_MEMORY``
     Bytes one operation may allocate, with an optional suffix ``K``, ``M``, ``G``, ``T``
     (powers of 1024; ``KB``/``KiB`` … are accepted too), e.g. ``UASNAV_MAX_MEMORY=16G``.
-    Default: 4 GiB, or half the physical memory if that is less.
+    Default: 4 GiB, or half the physical memory if that is less. A set value must be a positive
+    byte count: ``abc``, ``-1``, ``0``, ``nan``, ``inf`` or an empty value are refused.
 ``UASNAV_MAX_WORK``
     Elementary operations one computation may take (about 10⁹ per second on one core), e.g.
-    ``UASNAV_MAX_WORK=1e13``. Default 2·10¹¹ (minutes, not days).
+    ``UASNAV_MAX_WORK=1e13``. Default 2·10¹¹ (minutes, not days). A set value must be a
+    positive finite number.
 
 >>> parse_size("2G"), parse_size("512 MiB"), parse_size("1e6")
 (2147483648, 536870912, 1000000)
@@ -86,24 +88,47 @@ def _physical_memory() -> int | None:
 def max_memory() -> int:
     """The memory limit in bytes: ``$UASNAV_MAX_MEMORY`` or the default (4 GiB, at most half the RAM)."""
     env = os.environ.get(ENV_MEMORY)
-    if env is not None and env.strip():
-        return parse_size(env, ENV_MEMORY)
+    if env is not None:
+        value = parse_size(env, ENV_MEMORY) if env.strip() else 0
+        if value <= 0:
+            raise InputError(f"{ENV_MEMORY}: expected a positive byte count such as 16G, got {env!r}")
+        return value
     ram = _physical_memory()
     return min(DEFAULT_MAX_MEMORY, ram // 2) if ram else DEFAULT_MAX_MEMORY
 
 
-def max_work() -> float:
-    """The work limit (elementary operations): ``$UASNAV_MAX_WORK`` or 2·10¹¹."""
-    env = os.environ.get(ENV_WORK)
-    if env is None or not env.strip():
-        return DEFAULT_MAX_WORK
+def env_positive(name: str, default: float, what: str) -> float:
+    """The positive finite number in the environment variable ``name``, or ``default`` if it
+    is unset; a set but invalid value (``abc``, ``-1``, ``0``, ``nan``, ``inf``, empty) is an
+    :class:`InputError` naming the variable, ``what`` it expects and the value."""
+    env = os.environ.get(name)
+    if env is None:
+        return default
     try:
         value = float(env)
     except ValueError:
         value = math.nan
     if not (math.isfinite(value) and value > 0):
-        raise InputError(f"{ENV_WORK}: expected a positive number of operations such as 1e12, got {env!r}")
+        raise InputError(f"{name}: expected a positive number of {what}, got {env!r}")
     return value
+
+
+def max_work() -> float:
+    """The work limit (elementary operations): ``$UASNAV_MAX_WORK`` or 2·10¹¹."""
+    return env_positive(ENV_WORK, DEFAULT_MAX_WORK, "operations such as 1e12")
+
+
+def check_environment() -> None:
+    """Refuse, up front, a set but invalid ``UASNAV_MAX_MEMORY`` / ``UASNAV_MAX_WORK`` (``abc``,
+    ``-1``, ``0``, ``nan``, ``inf``, empty): a limit that is silently ignored is no limit.
+
+    Raises
+    ------
+    InputError
+        Naming the variable and its value.
+    """
+    max_memory()
+    max_work()
 
 
 def _hint(option: str | None) -> str:
@@ -188,11 +213,40 @@ def read_limited(
     return b"".join(parts)
 
 
+def check_input_file(path: str | os.PathLike, what: str | None = None) -> None:
+    """Refuse, before opening it, an input that would block a reader: a FIFO or a socket.
+
+    ``open()`` of a FIFO waits for a writer, forever if none comes; a socket cannot be opened.
+    Regular files, directories and character devices (``/dev/zero``: reads are bounded by
+    :func:`read_limited`) pass; a missing path is left to the reader's own message.
+
+    Raises
+    ------
+    InputError
+        Naming ``what`` (default: the path) and the kind of file.
+    """
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return
+    kind = "a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else None
+    if kind is not None:
+        name = what if what is not None else os.fspath(path)
+        raise InputError(
+            f"{name}: {kind}, not a file; refusing to read it (a reader would wait for a writer)"
+        )
+
+
 def read_file_limited(
     path: str | os.PathLike, limit: int, where: str | None = None, *, option: str | None = None
 ) -> bytes:
-    """Read a file (or device, FIFO) with :func:`read_limited`; OSError → :class:`InputError`."""
+    """Read a file (or device) with :func:`read_limited`; OSError → :class:`InputError`.
+
+    A FIFO or socket is refused before opening (:func:`check_input_file`)."""
     name = where if where is not None else str(path)
+    check_input_file(path, name)
     try:
         with open(path, "rb") as fh:
             return read_limited(fh, limit, name, option=option)
@@ -206,8 +260,11 @@ __all__ = [
     "ENV_MEMORY",
     "ENV_WORK",
     "check_count",
+    "check_environment",
+    "check_input_file",
     "check_memory",
     "check_work",
+    "env_positive",
     "format_size",
     "max_memory",
     "max_work",

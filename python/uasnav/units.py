@@ -213,7 +213,8 @@ def parse_quantity(text: str, to: str, *, what: str | None = None) -> float:
     Raises
     ------
     InputError
-        ``text`` is not a string holding a number followed by a unit.
+        ``text`` is not a string holding a number followed by a unit, or its value in ``to``
+        is not finite.
     UnitError
         The unit is unknown or of another dimension than ``to`` (an :class:`InputError`).
 
@@ -231,9 +232,13 @@ def parse_quantity(text: str, to: str, *, what: str | None = None) -> float:
     if m is None or not m.group(2):
         raise InputError(f"{where}expected '<number><unit>', e.g. '15deg/h', got {text!r}")
     try:
-        return float(convert(float(m.group(1)), m.group(2), to))
+        with np.errstate(over="ignore"):  # an overflow is refused just below, by value
+            value = float(convert(float(m.group(1)), m.group(2), to))
     except UnitError as e:
         raise UnitError(f"{where}{text!r}: {e}") from None
+    if not math.isfinite(value):  # "1e999 m", "1e308 km": beyond the float range
+        raise InputError(f"{where}{text!r} is not a finite quantity (beyond the float range in {to})")
+    return value
 
 
 def known_units() -> list[str]:

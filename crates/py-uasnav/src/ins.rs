@@ -1,5 +1,9 @@
-//! Binding of `nav_core::ins`: one call runs a whole flight (GIL released).
-use nav_core::ins::{InsBatchInput, InsBatchOutput, InsConfig, InsFilter, MagnetometerAiding};
+//! Binding of `nav_core::ins`: one call runs a whole flight, or `InsStream` steps a live
+//! stream one batch of messages per call (GIL released in both).
+use nav_core::ins::{
+    GnssFix, InsBatchInput, InsBatchOutput, InsConfig, InsFilter, InsStream, MagnetometerAiding,
+    StreamSolution,
+};
 use nav_core::zupt::{DerivativeTable, NoDerivative};
 use numpy::ndarray::Array1;
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
@@ -308,7 +312,148 @@ fn ins_run<'py>(
     Ok(dict)
 }
 
+/// `nav_core::ins::InsStream`: the filter stepped one batch of received messages per call.
+#[pyclass(name = "InsStream", module = "uasnav._core")]
+struct PyInsStream {
+    inner: InsStream<f64>,
+}
+
+#[pymethods]
+impl PyInsStream {
+    #[new]
+    #[pyo3(signature = (*, config, levelling_samples=100))]
+    fn new(
+        py: Python<'_>,
+        #[pyo3(from_py_with = config_arg)] config: InsConfig<f64>,
+        #[pyo3(from_py_with = levelling_arg)] levelling_samples: usize,
+    ) -> PyResult<Self> {
+        let inner = InsStream::new(config, levelling_samples).py_err(py)?;
+        Ok(Self { inner })
+    }
+
+    /// Processes one batch in arrival order: fix `j` arrived after `gnss_before[j]` of the
+    /// batch's IMU samples. Returns the solutions after each processed IMU sample.
+    #[pyo3(signature = (imu_t, gyro, accel, gnss_t, gnss_llh, gnss_vel, gnss_acc, gnss_before))]
+    #[allow(clippy::too_many_arguments)]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        imu_t: PyReadonlyArray1<'py, f64>,
+        gyro: PyReadonlyArray2<'py, f64>,
+        accel: PyReadonlyArray2<'py, f64>,
+        gnss_t: PyReadonlyArray1<'py, f64>,
+        gnss_llh: PyReadonlyArray2<'py, f64>,
+        gnss_vel: PyReadonlyArray2<'py, f64>,
+        gnss_acc: PyReadonlyArray2<'py, f64>,
+        gnss_before: PyReadonlyArray1<'py, u64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let it = slice1(py, "imu_t", &imu_t)?;
+        let g = rows::<3>(py, "gyro", &gyro)?;
+        let a = rows::<3>(py, "accel", &accel)?;
+        let gt = slice1(py, "gnss_t", &gnss_t)?;
+        let gl = rows::<3>(py, "gnss_llh", &gnss_llh)?;
+        let gv = rows::<3>(py, "gnss_vel", &gnss_vel)?;
+        let ga = rows::<3>(py, "gnss_acc", &gnss_acc)?;
+        let gb = gnss_before.as_slice().map_err(|_| {
+            input_error(py, "gnss_before: expected a contiguous uint64 array".into())
+        })?;
+        let n = it.len();
+        if g.len() != n || a.len() != n {
+            return Err(input_error(
+                py,
+                format!(
+                    "gyro/accel: expected {n} rows like imu_t, got {} and {}",
+                    g.len(),
+                    a.len()
+                ),
+            ));
+        }
+        let m = gt.len();
+        if gl.len() != m || gv.len() != m || ga.len() != m || gb.len() != m {
+            return Err(input_error(
+                py,
+                format!("gnss_llh/gnss_vel/gnss_acc/gnss_before: expected {m} rows like gnss_t"),
+            ));
+        }
+        if gb.windows(2).any(|w| matches!(w, [x, y] if y < x)) || gb.iter().any(|&b| b as usize > n)
+        {
+            return Err(input_error(
+                py,
+                format!("gnss_before: expected non-decreasing counts within 0..={n}"),
+            ));
+        }
+        let inner = &mut self.inner;
+        let out = py.detach(|| -> Result<Vec<StreamSolution<f64>>, nav_core::NavError> {
+            let mut out = Vec::with_capacity(n);
+            let mut fixes = gt.iter().zip(gl).zip(gv).zip(ga).zip(gb).peekable();
+            let mut imu = it.iter().zip(g).zip(a);
+            for k in 0..=n {
+                while let Some(((((t, l), v), acc), _)) =
+                    fixes.next_if(|(_, b)| usize::try_from(**b).is_ok_and(|b| b == k))
+                {
+                    inner.push_gnss(GnssFix {
+                        t_s: *t,
+                        llh: *l,
+                        vel_m_s: *v,
+                        acc: *acc,
+                    })?;
+                }
+                if let Some(((t, gy), ac)) = imu.next() {
+                    if let Some(sol) = inner.push_imu(*t, *gy, *ac)? {
+                        out.push(sol);
+                    }
+                }
+            }
+            Ok(out)
+        });
+        let sols = out.py_err(py)?;
+        let dict = PyDict::new(py);
+        let col =
+            |f: &dyn Fn(&StreamSolution<f64>) -> f64| sols.iter().map(f).collect::<Vec<f64>>();
+        dict.set_item("t", Array1::from_vec(col(&|s| s.t_s)).into_pyarray(py))?;
+        let llh: Vec<[f64; 3]> = sols.iter().map(|s| s.llh).collect();
+        let vel: Vec<[f64; 3]> = sols.iter().map(|s| s.vel_m_s).collect();
+        let att: Vec<[f64; 4]> = sols.iter().map(|s| s.attitude).collect();
+        let pl: Vec<[f64; 2]> = sols.iter().map(|s| s.protection_m).collect();
+        let bg: Vec<[f64; 3]> = sols.iter().map(|s| s.gyro_bias_rad_s).collect();
+        let ba: Vec<[f64; 3]> = sols.iter().map(|s| s.accel_bias_m_s2).collect();
+        dict.set_item("gyro_bias", to2(&bg).into_pyarray(py))?;
+        dict.set_item("accel_bias", to2(&ba).into_pyarray(py))?;
+        dict.set_item("llh", to2(&llh).into_pyarray(py))?;
+        dict.set_item("vel", to2(&vel).into_pyarray(py))?;
+        dict.set_item("attitude", to2(&att).into_pyarray(py))?;
+        dict.set_item("protection", to2(&pl).into_pyarray(py))?;
+        let used: Vec<u8> = sols.iter().map(|s| s.fixes_used).collect();
+        let excl: Vec<u8> = sols.iter().map(|s| s.fixes_excluded).collect();
+        dict.set_item("fixes_used", Array1::from_vec(used).into_pyarray(py))?;
+        dict.set_item("fixes_excluded", Array1::from_vec(excl).into_pyarray(py))?;
+        Ok(dict)
+    }
+
+    /// Whether the filter runs (levelling done and initialised on a fix).
+    #[getter]
+    fn running(&self) -> bool {
+        self.inner.is_running()
+    }
+
+    /// Running counts as a dict.
+    fn counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = self.inner.counts();
+        let d = PyDict::new(py);
+        d.set_item("imu_samples", c.imu_samples)?;
+        d.set_item("imu_refused", c.imu_refused)?;
+        d.set_item("imu_gaps", c.imu_gaps)?;
+        d.set_item("fixes_used", c.fixes_used)?;
+        d.set_item("fixes_excluded", c.fixes_excluded)?;
+        d.set_item("fixes_dropped", c.fixes_dropped)?;
+        d.set_item("gnss_resets", c.gnss_resets)?;
+        d.set_item("course_reset", c.course_reset)?;
+        Ok(d)
+    }
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ins_run, m)?)?;
+    m.add_class::<PyInsStream>()?;
     Ok(())
 }

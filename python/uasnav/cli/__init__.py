@@ -12,6 +12,7 @@ option value outside its domain), as click does. An unexpected exception (a bug)
 
 from __future__ import annotations
 
+import functools
 import importlib
 import os
 import pkgutil
@@ -23,6 +24,7 @@ import click
 
 from uasnav import __version__
 from uasnav.errors import UasnavError
+from uasnav.limits import check_environment, check_input_file
 
 #: Longest error line printed (characters); longer messages are cut in the middle.
 _MAX_MESSAGE = 2000
@@ -67,6 +69,11 @@ def _is_debug() -> bool:
     return os.environ.get(DEBUG_ENV, "").strip() not in ("", "0")
 
 
+def _show_held(caught: list[warnings.WarningMessage]) -> None:
+    for text in dict.fromkeys(_one_line(str(w.message)) for w in caught):
+        click.echo(f"warning: {text}", err=True)
+
+
 class _Group(click.Group):
     """Turns every error into one ``error: …`` line on stderr and exit code 1: uasnav's domain
     errors and OS errors as they are, anything else as an internal error to report (with the
@@ -75,15 +82,33 @@ class _Group(click.Group):
     def invoke(self, ctx: click.Context) -> Any:
         # A warning (ours, e.g. CorruptDataWarning, or a library's that we let through on
         # purpose) is one ``warning: …`` line, like errors: never a file path and source line.
+        # Warnings are held until the command ends: shown after a success, folded into the one
+        # ``error:`` line of a failure.
         warnings.showwarning = _show_warning
+        held: list[str] = []
         try:
-            return super().invoke(ctx)
+            with warnings.catch_warnings(record=True) as caught:
+                try:
+                    result = super().invoke(ctx)
+                except click.exceptions.Exit:
+                    _show_held(caught)
+                    raise
+                except BaseException:
+                    held = list(dict.fromkeys(_one_line(str(w.message)) for w in caught))
+                    raise
+            _show_held(caught)
+            return result
         except _PASS_THROUGH:
             raise
         except UasnavError as e:
             message = str(e)
         except OSError as e:
             message = _os_error_message(e)
+        except OverflowError as e:
+            # only numbers the user gave reach the float/int/date range: an input error
+            message = f"a value is outside the representable range ({e}); check the options and inputs"
+        except RecursionError:
+            message = "input nested too deeply to process"
         except MemoryError:
             message = "out of memory (the input or the options ask for more than this machine has)"
         except (KeyboardInterrupt, SystemExit, GeneratorExit):
@@ -95,6 +120,8 @@ class _Group(click.Group):
                 f"internal error: {type(e).__name__}: {e} - please report it "
                 f"(run again with {DEBUG_ENV}=1 for the traceback)"
             )
+        if held:
+            message = f"{message} (warnings: {'; '.join(held)})"
         click.echo(f"error: {_one_line(message)}", err=True)
         ctx.exit(1)
 
@@ -113,6 +140,56 @@ def main() -> None:
     """
 
 
+def _input_paths(cmd: click.Command) -> list[str]:
+    """Names of ``cmd``'s parameters that are files to read (``click.Path``, not an output)."""
+    from uasnav.cli._common import OutputPath
+
+    return [
+        p.name
+        for p in cmd.params
+        if p.name
+        and isinstance(p.type, click.Path)
+        and not isinstance(p.type, OutputPath)
+        and not (p.name.startswith("out") or "output" in p.name)
+    ]
+
+
+def _guarded(cmd: click.Command, staged: bool = True) -> None:
+    """Wrap ``cmd`` (and its subcommands) so that, before the command opens anything, the
+    resource limits of the environment are valid (:func:`uasnav.limits.check_environment`) and
+    every input path is checked by :func:`uasnav.limits.check_input_file`: one check for every
+    subcommand, so a FIFO never blocks a reader. ``--help`` needs neither. The files the
+    command writes form one :func:`uasnav.atomicfile.output_set`: all written, or none —
+    except under a command marked ``incremental_outputs`` (the fleet's datasets, committed log
+    by log and read back by the same run, keep their own manifest)."""
+    staged = staged and not getattr(cmd, "incremental_outputs", False)
+    if isinstance(cmd, click.Group):
+        for sub in cmd.commands.values():
+            _guarded(sub, staged)
+    names = _input_paths(cmd)
+    callback = cmd.callback
+    if callback is None or isinstance(cmd, click.Group):
+        return  # a group's callback runs before its subcommand's, which is guarded itself
+
+    def checked(*args: Any, **kwargs: Any) -> Any:
+        from uasnav.atomicfile import output_set
+
+        check_environment()
+        for name in names:
+            value = kwargs.get(name)
+            for v in value if isinstance(value, list | tuple) else [value]:
+                if isinstance(v, str | os.PathLike):
+                    check_input_file(v)
+        # every file the command writes is committed together when it succeeds: a failure
+        # (a bad second output, an error after the first file) leaves every output as it was
+        if not staged:
+            return callback(*args, **kwargs)
+        with output_set():
+            return callback(*args, **kwargs)
+
+    cmd.callback = functools.update_wrapper(checked, callback)
+
+
 def _register() -> None:
     for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
         if info.name.startswith("_"):
@@ -120,6 +197,7 @@ def _register() -> None:
         mod = importlib.import_module(f"{__name__}.{info.name}")
         cmd = getattr(mod, "command", None)
         if isinstance(cmd, click.Command):
+            _guarded(cmd)
             main.add_command(cmd)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import os
 import warnings
 from collections.abc import Iterator
 from typing import Any
@@ -109,6 +110,9 @@ class OutputPath(click.Path):
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         if isinstance(value, str) and not value.strip():
             self.fail("an empty file name", param, ctx)
+        if isinstance(value, str) and not self.dir_okay and value.endswith(("/", os.sep)):
+            # "m.json/" names a directory: writing "m.json" instead would be a silent surprise
+            self.fail(f"{value!r} ends with a path separator: it names a directory, not a file", param, ctx)
         return super().convert(value, param, ctx)
 
 

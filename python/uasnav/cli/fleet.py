@@ -24,6 +24,11 @@ def command() -> None:
     """
 
 
+# A run commits each log's table as it finishes and reads its dataset back at the end (scores,
+# report): its outputs are not one staged set (the manifest makes a run resumable instead).
+command.incremental_outputs = True  # type: ignore[attr-defined]
+
+
 def _check_scheduler(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
     if value is not None and "://" not in value:
         raise click.BadParameter(f"expected an address like tcp://HOST:8786, got {value!r}")
@@ -67,6 +72,10 @@ def _run_options(f: Any) -> Any:
             "--memory-limit", callback=_check_memory_limit, metavar="SIZE",
             help="Memory limit of each local worker process (e.g. 2G; default auto: memory ÷ workers).",
         ),
+        click.option(
+            "--log-timeout", type=POSITIVE, default=600.0, show_default=True, metavar="SECONDS",
+            help="Deadline of one log (its download, then its analysis); a log past it is an error row.",
+        ),
         click.option("--resume", is_flag=True, help="Continue a run in --out: only logs not yet finished."),
         click.option("--json", "as_json", is_flag=True, help="Print the run summary as JSON."),
     ]  # fmt: skip
@@ -99,7 +108,7 @@ def _progress() -> Any:
 
 def _execute(analysis: Any, sources: tuple[str, ...], out: str, scheduler: str | None,
              scheduler_file: str | None, workers: int | None, resume: bool,
-             memory_limit: str | int | None = None) -> Any:  # fmt: skip
+             memory_limit: str | int | None = None, log_timeout: float | None = None) -> Any:  # fmt: skip
     from uasnav.fleet.runner import run
 
     _check_out(out, ".parquet")
@@ -112,6 +121,7 @@ def _execute(analysis: Any, sources: tuple[str, ...], out: str, scheduler: str |
     return run(
         analysis, list(sources), out, scheduler=scheduler, scheduler_file=scheduler_file,
         workers=workers, resume=resume, progress=_progress(), memory_limit=memory_limit or "auto",
+        **({} if log_timeout is None else {"fetch_timeout_s": log_timeout, "log_timeout_s": log_timeout}),
     )  # fmt: skip
 
 
@@ -151,11 +161,14 @@ def _print(summary: Any, as_json: bool) -> None:
 
 @command.command("scan")
 @_run_options
-def scan(sources, out, scheduler, scheduler_file, workers, resume, memory_limit, as_json):  # type: ignore[no-untyped-def]
+def scan(sources, out, scheduler, scheduler_file, workers, resume, memory_limit, log_timeout, as_json):  # type: ignore[no-untyped-def]
     """Inventory: one row per log (format, vehicle, start, duration, IMUs, GNSS, mission, hash)."""
     from uasnav.fleet.scan import SCAN
 
-    _print(_execute(SCAN, sources, out, scheduler, scheduler_file, workers, resume, memory_limit), as_json)
+    _print(
+        _execute(SCAN, sources, out, scheduler, scheduler_file, workers, resume, memory_limit, log_timeout),
+        as_json,
+    )
 
 
 @command.command("imu-health")
@@ -163,13 +176,17 @@ def scan(sources, out, scheduler, scheduler_file, workers, resume, memory_limit,
 @click.option(
     "--report", "report_path", type=OutputPath(), help="Write an HTML page (FLEET.html) of the fleet."
 )
-def imu_health(sources, out, scheduler, scheduler_file, workers, resume, memory_limit, as_json, report_path):  # type: ignore[no-untyped-def]
+def imu_health(
+    sources, out, scheduler, scheduler_file, workers, resume, memory_limit, log_timeout, as_json, report_path
+):  # type: ignore[no-untyped-def]
     """Per log and IMU: noise terms, turn-on bias, temperature slope, vibration, clipping, anomaly score."""
     from uasnav.fleet.imu_health import IMU_HEALTH
 
     if report_path is not None:
         _check_out(report_path, ".html", "--report")
-    summary = _execute(IMU_HEALTH, sources, out, scheduler, scheduler_file, workers, resume, memory_limit)
+    summary = _execute(
+        IMU_HEALTH, sources, out, scheduler, scheduler_file, workers, resume, memory_limit, log_timeout
+    )
     if report_path is not None:
         from uasnav.fleet.html import write_health_report
 
@@ -190,24 +207,41 @@ def imu_health(sources, out, scheduler, scheduler_file, workers, resume, memory_
     help="Largest telemetry gap in an element (s).",
 )
 def elements(
-    sources, out, scheduler, scheduler_file, workers, resume, memory_limit, as_json, segment, speed, max_gap
+    sources,
+    out,
+    scheduler,
+    scheduler_file,
+    workers,
+    resume,
+    memory_limit,
+    log_timeout,
+    as_json,
+    segment,
+    speed,
+    max_gap,
 ):  # type: ignore[no-untyped-def]
     """Trajectory elements (features, measured times) of every log that flew a mission."""
     from uasnav.fleet.elements import elements_analysis
 
     analysis = elements_analysis(segment, speed, max_gap)
     _print(
-        _execute(analysis, sources, out, scheduler, scheduler_file, workers, resume, memory_limit), as_json
+        _execute(
+            analysis, sources, out, scheduler, scheduler_file, workers, resume, memory_limit, log_timeout
+        ),
+        as_json,
     )
 
 
 @command.command("nav")
 @_run_options
-def nav(sources, out, scheduler, scheduler_file, workers, resume, memory_limit, as_json):  # type: ignore[no-untyped-def]
+def nav(sources, out, scheduler, scheduler_file, workers, resume, memory_limit, log_timeout, as_json):  # type: ignore[no-untyped-def]
     """GNSS/INS replay of every log with IMU and GNSS: RMS against its reference, outage drift."""
     from uasnav.fleet.nav import NAV
 
-    _print(_execute(NAV, sources, out, scheduler, scheduler_file, workers, resume, memory_limit), as_json)
+    _print(
+        _execute(NAV, sources, out, scheduler, scheduler_file, workers, resume, memory_limit, log_timeout),
+        as_json,
+    )
 
 
 @command.command("simulate")

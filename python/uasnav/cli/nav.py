@@ -43,7 +43,23 @@ def _durations(text: str | None) -> list[float]:
 
 
 @click.command("nav")
-@click.argument("log", type=click.Path(exists=False))
+@click.argument("log", type=click.Path(exists=False), required=False)
+@click.option(
+    "--live",
+    "live",
+    metavar="CONNECTION",
+    help="Run causally on a live MAVLink stream (udpin:HOST:PORT, tcp:HOST:PORT, /dev/ttyX,BAUD) "
+    "instead of LOG, writing --out as it goes and a status line per second.",
+)
+@click.option(
+    "--causal",
+    is_flag=True,
+    help="Run LOG's MAVLink messages (a .tlog as recorded, .bin/.ulg as uasnav replay sends them) "
+    "through the causal filter of --live.",
+)
+@click.option(
+    "--idle-exit", type=POSITIVE, help="With --live: stop after this many seconds without a message."
+)
 @click.option(
     "--gnss",
     "gnss_path",
@@ -104,7 +120,10 @@ def _durations(text: str | None) -> list[float]:
 )
 @click.option("--plot", "plot_path", type=OutputPath(), help="Write a PNG of the track.")
 def command(
-    log: str,
+    log: str | None,
+    live: str | None,
+    causal: bool,
+    idle_exit: float | None,
     gnss_path: str | None,
     imu_sel: str | None,
     model_path: str | None,
@@ -128,6 +147,18 @@ def command(
     Logged IMU streams (DataFlash, ULog, ROS) use the logged-IMU noise preset; a CSV log uses
     the consumer-MEMS defaults.
     """
+    if live is not None or causal:
+        if live is not None and (causal or log is not None):
+            raise click.UsageError("--live reads CONNECTION: give no LOG and no --causal")
+        if causal and log is None:
+            raise click.UsageError("--causal needs LOG")
+        if live is not None:
+            run_live(live, out_path, hal, val, idle_exit)
+        else:
+            run_causal(str(log), out_path, hal, val)
+        return
+    if log is None:
+        raise click.UsageError("missing LOG (or --live CONNECTION)")
     from uasnav import ins
     from uasnav.atomicfile import output_set
     from uasnav.errors import InputError
@@ -290,3 +321,133 @@ def _plot(result: Any, flight: Any, path: str) -> None:
     with atomic_open(path, "wb") as fh:
         fig.savefig(fh, format="png", dpi=100)
     plt.close(fig)
+
+
+def _nav_config(hal: float | None, val: float | None) -> Any:
+    from uasnav.ins.core import InsConfig
+
+    return InsConfig.for_logged_imu(hal_m=hal, val_m=val)
+
+
+class _TrackWriter:
+    """TRACK.csv written as the solution comes (staged beside the target, flushed every second,
+    renamed into place on a clean exit) and a one-line status per second on stderr."""
+
+    def __init__(self, fh: Any, hal: float | None, val: float | None, status: bool) -> None:
+        import time
+
+        from uasnav.io.track import TRACK_COLUMNS
+
+        self.fh, self.hal, self.val, self.status = fh, hal, val, status
+        self.rows = 0
+        self.last = None
+        self._next = time.monotonic() + 1.0
+        if fh is not None:
+            fh.write(",".join(TRACK_COLUMNS) + "\n")
+
+    def add(self, batch: Any, nav: Any) -> None:
+        import time
+
+        from uasnav.live.nav import format_rows, track_rows
+
+        rows = track_rows(batch)
+        if rows.shape[0]:
+            self.rows += rows.shape[0]
+            self.last = rows[-1]
+            if self.fh is not None:
+                self.fh.write(format_rows(rows))
+        now = time.monotonic()
+        if now >= self._next:
+            self._next = now + 1.0
+            if self.fh is not None:
+                self.fh.flush()
+            if self.status:
+                click.echo(self.line(nav), err=True)
+
+    def line(self, nav: Any) -> str:
+        c = nav.counts()
+        if self.last is None:
+            return f"levelling: {nav.imu_messages} IMU samples, {nav.gnss_messages} fixes received"
+        r = self.last
+        hpl, vpl = r[16], r[17]
+        alerts = []
+        if self.hal is not None and hpl > self.hal:
+            alerts.append("HPL>HAL")
+        if self.val is not None and vpl > self.val:
+            alerts.append("VPL>VAL")
+        return (
+            f"t {r[0]:.2f} s  {r[1]:.7f} {r[2]:.7f} {r[3]:.1f} m  v {math.hypot(r[4], r[5]):.1f} m/s  "
+            f"HPL {hpl:.1f} m VPL {vpl:.1f} m  fixes {c['fixes_used']} used {c['fixes_excluded']} excluded  "
+            f"IMU {c['imu_samples']} ({c['imu_refused']} refused, {c['imu_gaps']} gaps)"
+            + (f"  ALERT {' '.join(alerts)}" if alerts else "")
+        )
+
+
+def _run(feed: Any, out_path: str | None, hal: float | None, val: float | None, status: bool) -> None:
+    import contextlib
+
+    from uasnav.atomicfile import atomic_open
+    from uasnav.live.nav import LiveNav
+
+    nav = LiveNav(_nav_config(hal, val))
+    with atomic_open(out_path, "w") if out_path else contextlib.nullcontext() as fh:
+        w = _TrackWriter(fh, hal, val, status)
+        feed(nav, w)
+        w.add(nav.flush(), nav)
+    c = nav.counts()
+    click.echo(
+        f"{w.rows} solutions from {nav.imu_messages} IMU samples "
+        f"({c['imu_refused']} refused, {c['imu_gaps']} gaps), "
+        f"{nav.gnss_messages} fixes ({c['fixes_used']} used, {c['fixes_excluded']} excluded)"
+        + (f"; wrote {out_path}" if out_path else ""),
+        err=True,
+    )
+
+
+#: Messages collected before one call of the filter (offline); live batches also end every 50 ms.
+_BATCH = 256
+
+
+def run_causal(log: str, out_path: str | None, hal: float | None, val: float | None) -> None:
+    """``nav --causal LOG``: the log's messages (as ``uasnav replay`` sends them) through the
+    causal filter."""
+    from uasnav.live.source import log_packets
+
+    def feed(nav: Any, w: _TrackWriter) -> None:
+        for pk in log_packets(log):
+            nav.on_message(pk.msg)
+            if nav.pending >= _BATCH:
+                w.add(nav.flush(), nav)
+
+    _run(feed, out_path, hal, val, status=False)
+
+
+def run_live(
+    connection: str, out_path: str | None, hal: float | None, val: float | None, idle_exit: float | None
+) -> None:
+    """``nav --live CONNECTION``: the causal filter on a live stream until interrupted."""
+    from uasnav.live.stream import open_connection, receive, stop_on_signals
+
+    conn = open_connection(connection)
+
+    def feed(nav: Any, w: _TrackWriter) -> None:
+        last = [0.0]
+
+        def on_message(msg: Any, wall: float) -> None:
+            nav.on_message(msg)
+            if nav.pending >= _BATCH:
+                last[0] = wall
+                w.add(nav.flush(), nav)
+
+        def on_tick(wall: float) -> None:
+            if wall - last[0] >= 0.05:
+                last[0] = wall
+                w.add(nav.flush(), nav)
+
+        with stop_on_signals() as stop:
+            receive(conn, on_message, on_tick, stop=stop, idle_timeout_s=idle_exit)
+
+    try:
+        _run(feed, out_path, hal, val, status=True)
+    finally:
+        conn.close()

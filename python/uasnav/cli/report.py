@@ -33,3 +33,9 @@ def command(out_dir: str, seed: int, quick: bool, only: str | None, as_json: boo
         echo_json({"html": str(res.html_path), "json": str(res.json_path), "sections": res.data})
     else:
         click.echo(f"report written to {res.html_path}")
+
+
+# The report writes its own files as one output set (`build_report`), and its experiments write
+# scratch files (the simulated fleet in a temporary folder) that they read back within the run:
+# those must not be staged by the command-level output set.
+command.incremental_outputs = True  # type: ignore[attr-defined]

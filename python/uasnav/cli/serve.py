@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import ipaddress
+from typing import Any
 
 import click
 
+from uasnav.errors import InputError
 from uasnav.web.security import LOOPBACK_HOSTS
 
 
@@ -48,8 +50,12 @@ def command(
     import uvicorn
 
     from uasnav.web.app import create_app, load_documents
+    from uasnav.web.server_limits import harden, uvicorn_settings
 
+    settings = uvicorn_settings()  # invalid deadlines in the environment: refused first
+    addr = _address(host, port)
     docs = load_documents(db, matrices, regulations)
+    _check_bindable(host, port, addr)
     extra = tuple(allow_hosts)
     if host.strip("[]").lower() not in LOOPBACK_HOSTS and host not in ("0.0.0.0", "::"):
         extra += (host.strip("[]"),)
@@ -63,4 +69,38 @@ def command(
         )
     shown = f"[{host}]" if ":" in host else host
     click.echo(f"uasnav serve: http://{shown}:{port}/  (Ctrl-C to stop)", err=True)
-    uvicorn.run(create_app(docs, extra), host=host, port=port, log_level="warning", server_header=False)
+    uvicorn.run(
+        harden(create_app(docs, extra)),
+        host=host,
+        port=port,
+        log_level="warning",
+        server_header=False,
+        **settings,
+    )
+
+
+def _address(host: str, port: int) -> tuple[int, int, int, Any]:
+    """``(family, type, proto, sockaddr)`` of ``host``; one-line error for a name or address
+    that does not resolve (``256.256.256.256``), before anything is loaded."""
+    import socket
+
+    try:
+        infos = socket.getaddrinfo(host.strip("[]"), port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except (OSError, UnicodeError) as e:
+        raise InputError(f"--host {host}: not an address this machine can bind ({e})") from None
+    family, kind, proto, _, sockaddr = infos[0]
+    return family, kind, proto, sockaddr
+
+
+def _check_bindable(host: str, port: int, addr: tuple[int, int, int, Any]) -> None:
+    """Refuse, in one line, an address this machine does not have or a port that is taken
+    (uvicorn would log a multi-line failure and exit 3)."""
+    import socket
+
+    family, kind, proto, sockaddr = addr
+    with socket.socket(family, kind, proto) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            s.bind(sockaddr)
+        except OSError as e:
+            raise InputError(f"--host {host} --port {port}: cannot bind ({e.strerror or e})") from None

@@ -23,7 +23,7 @@ from uasnav.cli._common import (
     parse_float_list,
     warnings_after_success,
 )
-from uasnav.errors import InputError
+from uasnav.errors import DataFormatError, InputError
 
 if TYPE_CHECKING:
     from uasnav.io.autopilot_limits import AutopilotLimits
@@ -330,10 +330,14 @@ def _log_limits(flights: Sequence[str], logs: Any) -> tuple[AutopilotLimits, str
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed, as_json):  # type: ignore[no-untyped-def]
-    """e% (eq. 59) per element and per run of LVQ vs the baselines.
+    """ETA and per-waypoint errors of the predictors on real flights, or the thesis' experiment.
 
-    Real FLIGHT...: leave-one-run-out (each mission run predicted by a model trained on the
-    others). --simulated: the thesis' experiment, 7 flights per trajectory train, 3 test.
+    Real FLIGHT... (.tlog, .bin, .ulg with their mission): every AUTO run predicted by the
+    autopilot's mission execution model with the log's own parameters (one flight is enough;
+    no training), beside QGroundControl's mission-time estimate and plan length ÷ speed; the
+    element methods (LVQ, kinematic point mass …, e% of eq. 59) by leave-one-run-out where the
+    logs hold two runs or more. --simulated: the thesis' experiment, 7 flights per trajectory
+    train, 3 test.
     """
     if simulated:
         from uasnav.experiments.trajectory import run_phantom4
@@ -352,47 +356,9 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
         t17 = [{"piece": p.piece, "t_nn_s": p.t_nn_s, "t_real_s": list(p.t_real_s)} for p in r.table17]
         out = {"methods": table, "table17": t17, "n_train": len(r.train), "n_test": len(r.test)}
     else:
-        from uasnav.trajectory.flights import flight_samples, leave_one_run_out
-
         if not flights:
             raise click.UsageError("give FLIGHT files or --simulated")
-        wind = parse_wind(wind_text) if wind_text else None
-        # warnings (telemetry gaps) are shown once the evaluation succeeded: a failed run
-        # prints its one error line only
-        with warnings_after_success():
-            fs = flight_samples(flights, plan, speed, wind, segment, max_gap)
-            limits, _ = _log_limits(flights, fs.logs)
-            errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
-        table = {
-            e.name: {
-                "applicable": True,
-                "element_e_pct_mean": float(np.mean(e.element_pct)),
-                "element_e_pct_median": float(np.median(e.element_pct)),
-                "run_e_pct_mean": float(np.mean(e.run_pct)),
-                # per-run ETA error |e%|: median, 95th percentile, worst (issue 17)
-                "run_abs_e_pct_median": float(np.median(np.abs(e.run_pct))),
-                "run_abs_e_pct_p95": float(np.percentile(np.abs(e.run_pct), 95)),
-                "run_abs_e_pct_worst": float(np.max(np.abs(e.run_pct))),
-                "run_e_pct": list(e.run_pct),
-            }
-            if e.applicable
-            else {"applicable": False, "reason": e.reason}
-            for e in errors
-        }
-        from uasnav.trajectory.models import DEFAULT_METHOD
-
-        out = {
-            "methods": table,
-            # the method `train` fits by default (chosen by this leave-one-run-out measurement)
-            "default_method": {"kinematic": "kinematic point mass", "lvq": "LVQ (thesis)"}[DEFAULT_METHOD],
-            "n_runs": len(fs),
-            "n_elements": fs.n_elements,
-            # the kinematic models' limits: from the logs' parameters, else the stated defaults
-            "limits": {
-                "accel_ms2": limits.accel_ms2,
-                "from_log": "accel_ms2" in limits.source,
-            },
-        }
+        out = _evaluate_flights(flights, plan, speed, wind_text, segment, max_gap, seed)
     if as_json:
         echo_json(out)
         return
@@ -406,12 +372,210 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
             if "run_abs_e_pct_median" in d
             else ""
         )
-        click.echo(f"{name:24s} element e% mean {d['element_e_pct_mean']:6.2f}{extra}")
+        element = f" element e% mean {d['element_e_pct_mean']:6.2f}" if "element_e_pct_mean" in d else ""
+        click.echo(f"{name:24s}{element}{extra}")
+    for r in out.get("runs", []):
+        wp = r["waypoint_errors"]
+        worst = max((abs(w["error_s"]) for w in wp), default=float("nan"))
+        click.echo(
+            f"run {Path(r['log']).name} @ {r['start_s']:.1f} s ({r['stack']}"
+            f"{'' if r['landed'] else ', cut'}): real {r['eta_real_s']:.1f} s, "
+            + ", ".join(f"{k} {v:.1f} s" for k, v in r["eta_pred_s"].items())
+            + f"; {len(wp)} waypoints, worst arrival error {worst:.1f} s"
+        )
+    tb = out.get("time_bounds")
+    if tb:
+        lo, hi = tb["covered_ci95"]
+        click.echo(
+            f"{tb['coverage']:.0%} time bounds ({tb['source']}): {tb['covered']}/{tb['n_runs']} real runs "
+            f"within (Clopper–Pearson 95 %: {lo:.3f}–{hi:.3f})"
+        )
     for row in out.get("table17", []):
         click.echo(
             f"{row['piece']}: t_NN {row['t_nn_s']:.2f} s, t_Real "
             + ", ".join(f"{x:.2f}" for x in row["t_real_s"])
         )
+
+
+def _evaluate_flights(
+    flights: Sequence[str],
+    plan: str | None,
+    speed: float | None,
+    wind_text: str | None,
+    segment: float,
+    max_gap: float,
+    seed: int,
+) -> dict[str, Any]:
+    """``evaluate FLIGHT…``: every AUTO run predicted by the autopilot's mission execution
+    model with the log's own parameters (no training: one flight is enough) beside
+    QGroundControl's estimate and plan length ÷ speed; and, where the logs allow, the
+    element methods (LVQ, kinematic point mass …) by leave-one-run-out."""
+    from uasnav.io.logfile import open_log
+    from uasnav.trajectory.flights import flight_samples, leave_one_run_out
+    from uasnav.trajectory.mission_runs import MISSION_VIEWS, MODEL, evaluate_logs
+
+    wind = parse_wind(wind_text) if wind_text else None
+    # one decoding pass per log serves both evaluations
+    opened: list[Any] = [
+        open_log(f, need=(*MISSION_VIEWS, "limits"))
+        if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg") and Path(f).is_file()
+        else f
+        for f in flights
+    ]
+    table: dict[str, Any] = {}
+    mission: dict[str, Any] | None = None
+    mission_error = None
+    logs_with_plan = [lf for lf in opened if not isinstance(lf, str)]
+    if logs_with_plan and plan is None and speed is None:
+        try:
+            mission = evaluate_logs(logs_with_plan)
+            table.update(mission["methods"])
+        except (InputError, DataFormatError) as e:
+            mission_error = str(e)
+    element_error: str | None = None
+    fs = None
+    limits = None
+    # warnings (telemetry gaps) are shown once the evaluation succeeded: a failed run prints
+    # its one error line only
+    with warnings_after_success():
+        try:
+            # the element methods measure elements between waypoints the telemetry names:
+            # logs without them (PX4 keeps its mission out of the telemetry) are left to the
+            # mission model when it evaluates them
+            element_logs = [
+                lf
+                for lf in opened
+                if isinstance(lf, str) or plan is not None or mission is None or lf.flight.waypoints
+            ]
+            skipped = [Path(str(lf.path)).name for lf in opened if lf not in element_logs]
+            if skipped:
+                element_error = f"{', '.join(skipped)}: no waypoints in the telemetry"
+            if not element_logs:
+                raise InputError(element_error or "no flights")
+            fs = flight_samples(element_logs, plan, speed, wind, segment, max_gap)
+            limits, _ = _log_limits(flights, fs.logs)
+            errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
+        except InputError as why:
+            if mission is None:
+                raise
+            element_error = "; ".join(dict.fromkeys(x for x in (element_error, str(why)) if x))
+            errors, fs = [], None
+    for res in errors:
+        table[res.name] = (
+            {
+                "applicable": True,
+                "element_e_pct_mean": float(np.mean(res.element_pct)),
+                "element_e_pct_median": float(np.median(res.element_pct)),
+                "run_e_pct_mean": float(np.mean(res.run_pct)),
+                # per-run ETA error |e%|: median, 95th percentile, worst
+                "run_abs_e_pct_median": float(np.median(np.abs(res.run_pct))),
+                "run_abs_e_pct_p95": float(np.percentile(np.abs(res.run_pct), 95)),
+                "run_abs_e_pct_worst": float(np.max(np.abs(res.run_pct))),
+                "run_e_pct": list(res.run_pct),
+            }
+            if res.applicable
+            else {"applicable": False, "reason": res.reason}
+        )
+    from uasnav.trajectory.models import DEFAULT_METHOD
+
+    out: dict[str, Any] = {
+        "methods": table,
+        # the mission execution model when the logs carry their missions; else the element
+        # method `train` fits by default (chosen by leave-one-run-out)
+        "default_method": MODEL
+        if mission is not None
+        else {"kinematic": "kinematic point mass", "lvq": "LVQ (thesis)"}[DEFAULT_METHOD],
+        "n_runs": len(fs) if fs is not None else len(mission["runs"]) if mission else 0,
+        "n_elements": fs.n_elements if fs is not None else 0,
+    }
+    if limits is not None:
+        # the kinematic models' limits: from the logs' parameters, else the stated defaults
+        out["limits"] = {"accel_ms2": limits.accel_ms2, "from_log": "accel_ms2" in limits.source}
+    if mission is not None:
+        out["runs"] = mission["runs"]
+        out["per_stack"] = mission["per_stack"]
+        out["parameters"] = mission["parameters"]
+        out["time_bounds"] = mission["time_bounds"]
+    if element_error is not None:
+        out["element_methods"] = f"not evaluated: {element_error}"
+    if mission_error is not None:
+        out["mission_model"] = f"not evaluated: {mission_error}"
+    return out
+
+
+@command.command("mission")
+@click.argument("plan_path", metavar="PLAN", type=click.Path(dir_okay=False))
+@click.option(
+    "--autopilot",
+    type=click.Choice(["arducopter", "px4-mc", "plane"]),
+    help="Autopilot family that flies the plan; default the log's (--params-from), else from the "
+    "plan (fixed-wing/VTOL commands: plane), else arducopter.",
+)
+@click.option("--firmware", help="Firmware version (e.g. 3.6, 4.5, 1.14); default the log's or current.")
+@click.option(
+    "--params-from",
+    "params_log",
+    type=click.Path(dir_okay=False),
+    help="Flight log (.tlog .bin .ulg) of the vehicle: its parameters replace the firmware defaults.",
+)
+@click.option("--home-alt", type=Real(-1000.0, 9000.0), help="Home altitude AMSL (m) for AMSL items.")
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # type: ignore[no-untyped-def]
+    """When each item of PLAN (.plan, .waypoints, a log's mission) is reached and when the
+    mission ends, as the autopilot flies it (no training: the firmware's mission execution with
+    the vehicle's parameters or the firmware defaults, each with its source), beside
+    QGroundControl's own mission-time estimate."""
+    from uasnav.io.plans import read_plan
+    from uasnav.trajectory.autopilot import (
+        family_of,
+        mission_params,
+        predict_mission,
+        qgc_mission_time,
+    )
+
+    plan = read_plan(plan_path)
+    log_params: dict[str, float] = {}
+    ident = None
+    if params_log:
+        from uasnav.io.logfile import open_log
+
+        lf = open_log(params_log, need=("params", "identity"))
+        log_params, ident = lf.params, lf.identity
+    if autopilot is None:
+        if ident is not None:
+            autopilot = family_of(ident, log_params)
+        elif any(it.command in (84, 85) for it in plan.items) or plan.vehicle_type == 1:
+            autopilot = "plane"
+        else:
+            autopilot = "arducopter"
+    version = firmware or (getattr(ident, "firmware_version", None) if ident is not None else None)
+    params = mission_params(autopilot, version, log_params)
+    pred = predict_mission(plan, params, home_amsl_m=home_alt)
+    qgc = qgc_mission_time(plan, params.cruise_ms, home_alt)
+    out = {
+        "autopilot": autopilot,
+        "firmware": params.version,
+        "eta_s": pred.eta_s,
+        "landed": pred.landed,
+        "qgc_estimate_s": qgc,
+        "items": [
+            {"item": int(i), "command": int(c), "arrive_s": float(t)}
+            for i, c, t in zip(pred.items, pred.commands, pred.arrive_s, strict=True)
+        ],
+        "parameters": {k: {"value": params.values[k], "source": params.sources[k]} for k in params.values},
+    }
+    if as_json:
+        echo_json(out)
+        return
+    for r in out["items"]:
+        click.echo(f"item {r['item']:>3} (MAV_CMD {r['command']:>3}) reached at {r['arrive_s']:8.1f} s")
+    end = "touch-down" if pred.landed else "last item"
+    click.echo(
+        f"ETA ({end}) {pred.eta_s:.1f} s, {autopilot} {params.version or ''}".rstrip()
+        + f"; QGroundControl's estimate {qgc:.1f} s"
+    )
+    from_log = sorted(k for k, v in params.sources.items() if v == "log")
+    click.echo(f"parameters from the log: {', '.join(from_log) or 'none'}; others the firmware defaults")
 
 
 @command.command("calibrate")
@@ -442,17 +606,32 @@ def evaluate(flights, plan, speed, wind_text, segment, max_gap, simulated, seed,
     show_default=True,
     help="Coverage reported for the held-out runs.",
 )
+@click.option(
+    "--flights",
+    "flight_logs",
+    multiple=True,
+    type=click.Path(dir_okay=False),
+    help="The vehicle's own earlier flights (.tlog .bin .ulg with their mission; repeat the option): "
+    "the bounds come from their AUTO runs instead of simulation.",
+)
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # type: ignore[no-untyped-def]
-    """Calibrate the time bounds of a model (split-conformal on simulated 3D runs with truth:
-    random routes with take-off, sloped legs, holds and landing, scored at every element)."""
+def calibrate(model_path, out, runs, test_runs, coverage, flight_logs, seed, as_json):  # type: ignore[no-untyped-def]
+    """Calibrate the time bounds of a model: split-conformal on the vehicle's own earlier
+    flights (--flights: each AUTO run scored at its waypoint arrivals and its end, predicted by
+    the autopilot's mission execution model), else on simulated 3D runs with truth (random
+    routes with take-off, sloped legs, holds and landing, scored at every element). The source
+    is kept in the model and stated in the intents made with it."""
+    if flight_logs:
+        _calibrate_from_flights(model_path, out, flight_logs, coverage, as_json)
+        return
     from uasnav.trajectory.calibration import calibrate as fit_bounds
-    from uasnav.trajectory.calibration import covered
+    from uasnav.trajectory.calibration import check_runs, covered
     from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
     from uasnav.trajectory.timebounds import clopper_pearson
 
+    check_runs(runs + test_runs, "--runs + --test-runs")
     check_outputs([model_path], {"--out": out})
     model = load_model(model_path)
     with click.progressbar(
@@ -485,6 +664,36 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
         click.echo(
             f"held-out coverage {res['covered']}/{test_runs} (Clopper–Pearson 95 %: {lo:.3f}–{hi:.3f})"
         )
+
+
+def _calibrate_from_flights(
+    model_path: str, out: str, flight_logs: Sequence[str], coverage: float, as_json: bool
+) -> None:
+    """``calibrate --flights``: the model's time bounds from the vehicle's own AUTO runs."""
+    from uasnav.trajectory.mission_runs import calibrate_from_flights
+    from uasnav.trajectory.models import load_model, method_of
+
+    check_outputs([model_path, *flight_logs], {"--out": out})
+    model = load_model(model_path)
+    bounds = calibrate_from_flights(flight_logs)
+    q = bounds.quantile(coverage)  # refuses a coverage that too few runs cannot give
+    model.time_bounds_ = bounds
+    model.save(out)
+    res = {
+        "method": method_of(model),
+        "runs": bounds.n_runs,
+        "coverage": coverage,
+        "quantile": q,
+        "tau_s": bounds.tau_s,
+        "source": bounds.source,
+    }
+    if as_json:
+        echo_json(res)
+        return
+    click.echo(
+        f"{res['method']} model, time bounds: ±{q:.3f}·(t + {bounds.tau_s:g} s) at {coverage:.0%} "
+        f"coverage from {bounds.source}"
+    )
 
 
 @command.command("intent")
@@ -545,7 +754,8 @@ def calibrate(model_path, out, runs, test_runs, coverage, seed, as_json):  # typ
     "limits_log",
     type=click.Path(dir_okay=False),
     help="Flight log (.tlog .bin .ulg) of the vehicle: its WPNAV_SPEED_UP/DN, WPNAV_ACCEL_Z or "
-    "MPC_Z_VEL_MAX_UP/DN, MPC_ACC_UP_MAX replace the model's vertical limits, its WPNAV_SPEED or "
+    "MPC_Z_V_AUTO_UP/DN (MPC_Z_VEL_MAX_UP/DN before PX4 1.12), MPC_ACC_UP_MAX replace the model's "
+    "vertical limits, its WPNAV_SPEED or "
     "MPC_XY_CRUISE the model's speed (explicit options and the plan's own speed win).",
 )
 @click.option(
@@ -602,6 +812,9 @@ def intent(  # type: ignore[no-untyped-def]
         if lim.cruise_ms is not None and speed is None and plan_cruise_speed(plan) is None:
             speed, from_log = lim.cruise_ms, [*from_log, "cruise_ms"]
     if model.time_bounds_ is None:
+        from uasnav.trajectory.calibration import check_runs
+
+        check_runs(calibration_runs, "--calibration-runs")
         with click.progressbar(
             length=calibration_runs, label="calibrating time bounds", file=click.get_text_stream("stderr")
         ) as bar:
@@ -641,6 +854,8 @@ def intent(  # type: ignore[no-untyped-def]
         "descent_ms": down,
         "accel_z_ms2": a_z,
         "limits_from_log": from_log,
+        # what calibrated the time bounds: the vehicle's own flights or simulation
+        "time_bounds_source": b.time_bounds_source,
         # where the W84 altitudes' geoid heights came from: the user's N, or the installed model
         "geoid": "given" if geoid_height is not None else geoid_model(),
     }
@@ -656,5 +871,6 @@ def intent(  # type: ignore[no-untyped-def]
         return
     click.echo(
         f"{len(b.details.volumes)} volumes; ETA {b.eta_s:.0f} s "
-        f"({b.eta_bounds_s[0]:.0f}–{b.eta_bounds_s[1]:.0f} s at {coverage:.0%}); wrote {out}"
+        f"({b.eta_bounds_s[0]:.0f}–{b.eta_bounds_s[1]:.0f} s at {coverage:.0%}, bounds from "
+        f"{b.time_bounds_source or 'calibration'}); wrote {out}"
     )

@@ -35,14 +35,18 @@ writes the same file again (same name, same bytes): each log is in the output ex
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import logging
+import math
 import os
 import re
 import shutil
 import tempfile
+import threading
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -156,6 +160,7 @@ def process_log(
     *,
     fetch_timeout_s: float = FETCH_TIMEOUT_S,
     fetch_max_bytes: int | None = None,
+    log_timeout_s: float | None = None,
 ) -> TaskResult:
     """Run ``analysis`` on one log and write its rows (or its error row); idempotent.
 
@@ -164,20 +169,21 @@ def process_log(
     its file in ``out`` is not computed again: logs are identified by content, so two copies of
     one log are stored once (under the path of the copy processed first). An http(s) ``path``
     is downloaded first (module docs), within ``fetch_timeout_s`` seconds and
-    ``fetch_max_bytes`` bytes (default :func:`uasnav.limits.max_memory`).
+    ``fetch_max_bytes`` bytes (default :func:`uasnav.limits.max_memory`). The analysis of one
+    log stops after ``log_timeout_s`` seconds (an errors-table row).
     """
     cpu0 = time.process_time()
     out_p = Path(out)
     if is_url(path):
         limit = max_memory() if fetch_max_bytes is None else int(fetch_max_bytes)
-        return _process_url(path, analysis, out_p, cpu0, fetch_timeout_s, limit)
+        return _process_url(path, analysis, out_p, cpu0, fetch_timeout_s, limit, log_timeout_s)
     try:
         size, mtime_ns = stat_key(path)[1:]
     except OSError as e:
         row = error_row(path, None, analysis.name, e)
         write_table(pa.Table.from_pylist([row], schema=ERRORS_SCHEMA), error_file(out_p, _path_key(path)))
         return TaskResult(path, -1, -1, None, "error", error=row["error"])
-    return _process_file(path, path, size, mtime_ns, analysis, out_p, cpu0)
+    return _process_file(path, path, size, mtime_ns, analysis, out_p, cpu0, log_timeout_s)
 
 
 def _local_name(url: str) -> str:
@@ -190,7 +196,13 @@ def _local_name(url: str) -> str:
 
 
 def _process_url(
-    url: str, analysis: Analysis, out_p: Path, cpu0: float, timeout_s: float, max_bytes: int
+    url: str,
+    analysis: Analysis,
+    out_p: Path,
+    cpu0: float,
+    timeout_s: float,
+    max_bytes: int,
+    log_timeout_s: float | None = None,
 ) -> TaskResult:
     tmpdir = tempfile.mkdtemp(prefix="uasnav-fleet-")
     try:
@@ -206,13 +218,59 @@ def _process_url(
             )
         # fetched now: an error row left by an earlier failed fetch of this URL no longer holds
         error_file(out_p, _path_key(url)).unlink(missing_ok=True)
-        return _process_file(local, url, size, 0, analysis, out_p, cpu0)
+        return _process_file(local, url, size, 0, analysis, out_p, cpu0, log_timeout_s)
     finally:
         shutil.rmtree(tmpdir, ignore_errors=True)
 
 
+class LogTimeout(Exception):
+    """A log's analysis ran past the run's per-log deadline (``log_timeout_s``)."""
+
+
+@contextlib.contextmanager
+def _deadline(seconds: float | None) -> Iterator[None]:
+    """Raise :class:`LogTimeout` in this thread once ``seconds`` have passed inside the block.
+
+    The exception is delivered asynchronously (``PyThreadState_SetAsyncExc``) so the same
+    deadline works in the main thread and in a Dask worker's task thread; it lands at the next
+    Python bytecode (a long call into the Rust core finishes first). A timer that fires after the
+    block ended is withdrawn under the lock, so it cannot escape the block.
+    """
+    if seconds is None or not math.isfinite(seconds):
+        yield
+        return
+    tid = threading.get_ident()
+    lock = threading.Lock()
+    state = {"done": False, "fired": False}
+
+    def fire() -> None:
+        with lock:
+            if not state["done"]:
+                state["fired"] = True
+                ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(tid), ctypes.py_object(LogTimeout))
+
+    timer = threading.Timer(seconds, fire)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        with lock:
+            state["done"] = True
+            timer.cancel()
+            if state["fired"]:  # delivered or pending: withdraw a pending one
+                ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(tid), None)
+
+
 def _process_file(
-    local: str, path: str, size: int, mtime_ns: int, analysis: Analysis, out_p: Path, cpu0: float
+    local: str,
+    path: str,
+    size: int,
+    mtime_ns: int,
+    analysis: Analysis,
+    out_p: Path,
+    cpu0: float,
+    log_timeout_s: float | None = None,
 ) -> TaskResult:
     """Hash, analyse and write the log in the file ``local``, known to the tables as ``path``."""
     log_hash: str | None = None
@@ -229,7 +287,14 @@ def _process_file(
         with warnings.catch_warnings():
             # corrupt-record warnings of the readers: the log is salvaged; the run stays quiet
             warnings.simplefilter("ignore")
-            result = analysis.compute(local)
+            try:
+                with _deadline(log_timeout_s):
+                    result = analysis.compute(local)
+            except LogTimeout:
+                raise LogTimeout(
+                    f"{path}: analysis stopped after the per-log deadline of {log_timeout_s:g} s "
+                    "(--log-timeout)"
+                ) from None
         if not result.rows:
             return TaskResult(path, size, mtime_ns, log_hash, "empty", cpu_s=time.process_time() - cpu0)
         table = _rows_table(analysis, result.rows, {"log_hash": log_hash, "path": path, "size_bytes": size})
@@ -237,7 +302,7 @@ def _process_file(
         return TaskResult(
             path, size, mtime_ns, log_hash, "ok", n_rows=table.num_rows, cpu_s=time.process_time() - cpu0
         )
-    except Exception as e:  # a corrupt log must never stop the run (issue 19): record it
+    except Exception as e:  # a corrupt log must never stop the run: record it
         row = error_row(path, log_hash, analysis.name, e)
         if local != path:  # the reader names the temporary download: name the URL instead
             row["error"] = row["error"].replace(local, path)
@@ -321,6 +386,7 @@ def run(
     fetch_timeout_s: float = FETCH_TIMEOUT_S,
     fetch_max_bytes: int | None = None,
     memory_limit: str | int = "auto",
+    log_timeout_s: float | None = None,
 ) -> RunSummary:
     """Run ``analysis`` over every log of ``sources`` and write the dataset ``out``.
 
@@ -345,6 +411,9 @@ def run(
     fetch_timeout_s, fetch_max_bytes : optional
         Total deadline (s) and size limit (bytes, default :func:`uasnav.limits.max_memory` on
         the worker) of the download of each http(s) log.
+    log_timeout_s : float, optional
+        Deadline of one log's analysis (s); a log past it is an errors-table row and the run
+        goes on. Default: no deadline beyond the decoders' own bounds.
     memory_limit : str or int
         Memory limit of each worker process of the local cluster (bytes, or Dask's ``"auto"``:
         the machine's memory ÷ workers); a worker above it is restarted by its nanny.
@@ -373,7 +442,11 @@ def run(
             todo.append(p)
     created = not out_p.exists()
     out_p.mkdir(parents=True, exist_ok=True)
-    fetch = {"fetch_timeout_s": fetch_timeout_s, "fetch_max_bytes": fetch_max_bytes}
+    fetch = {
+        "fetch_timeout_s": fetch_timeout_s,
+        "fetch_max_bytes": fetch_max_bytes,
+        "log_timeout_s": log_timeout_s,
+    }
     try:
         return _run(analysis, out_p, todo, len(paths), skipped, manifest or Manifest(out_p), t0,
                     client, scheduler, scheduler_file, workers, progress, fetch, memory_limit)  # fmt: skip
@@ -518,6 +591,7 @@ __all__ = [
     "KEY_FIELDS",
     "Analysis",
     "LogRows",
+    "LogTimeout",
     "RunSummary",
     "TaskResult",
     "local_cluster",

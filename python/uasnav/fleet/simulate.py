@@ -204,6 +204,12 @@ def _nav_flight(
     )  # fmt: skip
 
 
+#: Elementary operations per IMU sample written (simulation and CSV text), for the work estimate.
+OPS_PER_IMU_SAMPLE = 2e3
+#: Elementary operations per sample of a GNSS/INS flight (trajectory, IMU, GNSS, tlog messages).
+OPS_PER_NAV_SAMPLE = 2e4
+
+
 def simulate_fleet(
     out: str | Path,
     vehicles: int = 5,
@@ -250,9 +256,16 @@ def simulate_fleet(
         raise InputError(f"vehicles and flights must be >= 1, got {vehicles} and {flights}")
     if not (duration_s > 0 and rate_hz > 0 and 0 <= static_fraction <= 1):
         raise InputError("duration_s and rate_hz must be > 0 and static_fraction within 0 … 1")
-    from uasnav.limits import check_count
+    from uasnav.limits import check_count, check_work
 
     check_count(vehicles * flights * duration_s * rate_hz, 8 * 8, "fleet simulation", option="flights")
+    imu_samples = vehicles * flights * duration_s * rate_hz
+    nav_samples = vehicles * nav_flights * nav_duration_s * rate_hz
+    check_work(
+        OPS_PER_IMU_SAMPLE * imu_samples + OPS_PER_NAV_SAMPLE * nav_samples,
+        f"fleet simulation of {vehicles} vehicle(s) × {flights} flight(s) + {nav_flights} GNSS/INS flight(s)",
+        option="--vehicles, --flights or --nav-flights",
+    )
     out_p = Path(out)
     rng = np.random.default_rng([seed, 19])
     n_total = vehicles * flights

@@ -20,12 +20,14 @@ from __future__ import annotations
 
 import glob
 import os
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from uasnav.errors import InputError
 from uasnav.httpfetch import is_url
+from uasnav.limits import check_input_file
 
 #: Extensions picked up when a directory is scanned.
 LOG_EXTENSIONS = (".ulg", ".bin", ".tlog", ".csv", ".txt", ".npz")
@@ -56,7 +58,18 @@ def _walk(d: Path) -> list[str]:
             for f in files
             if not f.startswith(".") and os.path.splitext(f)[1].lower() in LOG_EXTENSIONS
         ]
-    return out
+    return [f for f in out if _readable(f)]
+
+
+def _readable(path: str) -> bool:
+    """False, with a warning, for a FIFO or socket found among the logs: opening it would
+    block the run (:func:`uasnav.limits.check_input_file`)."""
+    try:
+        check_input_file(path)
+    except InputError as e:
+        warnings.warn(f"skipped {e}", stacklevel=3)
+        return False
+    return True
 
 
 def discover(sources: Sequence[str | os.PathLike[str]]) -> list[str]:

@@ -22,6 +22,7 @@ from uasnav.errors import InputError
 from uasnav.geo.frames import radii_of_curvature
 from uasnav.ins.core import InsConfig, InsResult, run
 from uasnav.io.navdata import Flight, Trajectory
+from uasnav.limits import check_work
 
 FloatArray = NDArray[np.float64]
 
@@ -293,6 +294,10 @@ def outage_starts(
     return [float(x) for x in np.linspace(lo, hi, count)]
 
 
+#: Elementary operations of one filter step (15-state error-state predict and update).
+OPS_PER_FILTER_STEP = 1e4
+
+
 def outage_experiment(
     flight: Flight,
     durations: Sequence[float] = (10.0, 30.0, 60.0),
@@ -309,6 +314,13 @@ def outage_experiment(
     cfg = config or InsConfig()
     span = interval or flight.airborne or (float(flight.gnss.t[0]), float(flight.gnss.t[-1]))
     table = OutageTable()
+    # estimate first: one whole filter run per outage (≈ 10⁴ operations per IMU sample)
+    n_durations = len(durations)
+    check_work(
+        float(n_durations) * per_duration * len(flight.imu.t) * OPS_PER_FILTER_STEP,
+        f"outage sweep of {n_durations} duration(s) × {per_duration} start(s), one filter run each",
+        option="the number of outage durations (--outage-sweep)",
+    )
     jobs = [(d, s) for d in durations for s in outage_starts(span, d, per_duration)]
     for k, (d, s) in enumerate(jobs):
         res = run(flight, cfg.replace(gnss_outages=((s, d),)))

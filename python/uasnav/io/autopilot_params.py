@@ -20,6 +20,9 @@ PX4_PARAMS: dict[str, tuple[str, float]] = {
     "MPC_XY_CRUISE": ("cruise_ms", 1.0),
     "MPC_ACC_HOR": ("accel_ms2", 1.0),
     "MPC_ACC_HOR_MAX": ("accel_ms2", 1.0),
+    # AUTO climbs and descends at MPC_Z_V_AUTO_UP/DN (PX4 ≥ 1.12); older firmware at _VEL_MAX_
+    "MPC_Z_V_AUTO_UP": ("climb_ms", 1.0),
+    "MPC_Z_V_AUTO_DN": ("descent_ms", 1.0),
     "MPC_Z_VEL_MAX_UP": ("climb_ms", 1.0),
     "MPC_Z_VEL_MAX_DN": ("descent_ms", 1.0),
     # one vertical limit per model: PX4's up-acceleration, its down one only when that is missing

@@ -13,6 +13,11 @@ volumes: ``outline_polygon`` / ``outline_circle``, ``altitude_lower`` / ``altitu
 ``OperationalIntentDetails`` (:mod:`uasnav.io.operational_intent`), checked as any intent is;
 ``astm_f3548_21.priority`` becomes the priority. ``$ref`` entries (flight authorisation data)
 are not followed: they carry nothing F3548 uses.
+
+The YAML is composed by a loader that refuses, before any Python object is built, nesting
+deeper than :data:`MAX_YAML_DEPTH` and a document whose aliases expand to more than
+:data:`MAX_YAML_NODES` nodes ("billion laughs": a few lines of anchors that name each other ten
+times over stand for 10⁹ nodes once merged or copied).
 """
 
 from __future__ import annotations
@@ -26,6 +31,11 @@ from typing import Any
 from uasnav import jsoncheck as jc
 from uasnav.errors import DataFormatError, InputError
 from uasnav.io.operational_intent import MAX_INTENT_BYTES, NamedIntent, parse_details, rfc3339
+
+#: Deepest nesting of YAML collections accepted (the JSON readers' limit).
+MAX_YAML_DEPTH = jc.MAX_DEPTH
+#: Most nodes a document may stand for with every alias expanded (a real collection: a few thousand).
+MAX_YAML_NODES = 200_000
 
 _OFFSET = re.compile(r"^\s*([+-]?\d+(?:\.\d+)?)\s*(ms|s|m|h|d)\s*$")
 _UNIT_S = {"ms": 1e-3, "s": 1.0, "m": 60.0, "h": 3600.0, "d": 86400.0}
@@ -125,25 +135,104 @@ def resolve_flight_intents(data: object, source: str, now: datetime) -> list[Nam
         return out
 
 
-def read_flight_intents(path: str | os.PathLike[str], now: datetime) -> list[NamedIntent]:
-    """Read an InterUSS flight-intent collection (YAML), resolved at ``now`` (aware datetime)."""
+def _bounded_loader(source: str) -> type:
+    """A ``yaml.SafeLoader`` subclass that checks depth while composing and the alias-expanded
+    size of the node graph before constructing (see module)."""
     import yaml
 
-    p = os.fspath(path)
-    if not os.path.exists(p):
-        raise InputError(f"no such flight-intent file: {p}")
-    text = jc.read_text(p, MAX_INTENT_BYTES)
+    class BoundedLoader(yaml.SafeLoader):
+        _depth = 0
+
+        def compose_node(self, parent: Any, index: Any) -> Any:
+            self._depth += 1
+            try:
+                if self._depth > MAX_YAML_DEPTH:
+                    mark = self.peek_event().start_mark
+                    raise DataFormatError(
+                        f"YAML nested deeper than {MAX_YAML_DEPTH} levels", path=source, line=mark.line + 1
+                    )
+                return super().compose_node(parent, index)
+            finally:
+                self._depth -= 1
+
+        def construct_document(self, node: Any) -> Any:
+            _check_expanded_size(node, source)
+            return super().construct_document(node)
+
+    return BoundedLoader
+
+
+def _check_expanded_size(root: Any, source: str) -> None:
+    """Refuse a node graph that stands for more than :data:`MAX_YAML_NODES` nodes (aliases
+    counted once per use), computed bottom-up on the shared graph, without expanding it."""
+    import yaml
+
+    size: dict[int, int] = {}
+    stack: list[tuple[Any, bool]] = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        if id(node) in size:
+            continue
+        kids: list[Any] = []
+        if isinstance(node, yaml.SequenceNode):
+            kids = list(node.value)
+        elif isinstance(node, yaml.MappingNode):
+            kids = [n for pair in node.value for n in pair]
+        if done or not kids:
+            total = 1 + sum(size.get(id(k), 0) for k in kids)
+            if total > MAX_YAML_NODES:
+                raise DataFormatError(
+                    f"YAML aliases expand to more than {MAX_YAML_NODES} nodes (alias bomb)",
+                    path=source,
+                    line=node.start_mark.line + 1,
+                )
+            size[id(node)] = total
+            continue
+        stack.append((node, True))
+        stack.extend((k, False) for k in kids if id(k) not in size)
+
+
+def load_yaml(text: str, source: str) -> Any:
+    """Parse one YAML document with the bounded safe loader (see module).
+
+    Raises
+    ------
+    DataFormatError
+        Invalid YAML, nesting deeper than :data:`MAX_YAML_DEPTH`, or aliases expanding
+        beyond :data:`MAX_YAML_NODES` nodes; the line where it was found is named.
+    """
+    import yaml
+
     try:
-        data = yaml.safe_load(text)  # safe_load: no Python objects from tags
+        return yaml.load(text, Loader=_bounded_loader(source))
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         line = None if mark is None else mark.line + 1
         raise DataFormatError(
-            f"not valid YAML ({getattr(e, 'problem', None) or e})", path=p, line=line
+            f"not valid YAML ({getattr(e, 'problem', None) or e})", path=source, line=line
         ) from None
+    except RecursionError:
+        raise DataFormatError(f"YAML nested deeper than {MAX_YAML_DEPTH} levels", path=source) from None
+
+
+def read_flight_intents(path: str | os.PathLike[str], now: datetime) -> list[NamedIntent]:
+    """Read an InterUSS flight-intent collection (YAML), resolved at ``now`` (aware datetime)."""
+    p = os.fspath(path)
+    if not os.path.exists(p):
+        raise InputError(f"no such flight-intent file: {p}")
+    text = jc.read_text(p, MAX_INTENT_BYTES)
+    data = load_yaml(text, p)
     if jc.depth(data) > jc.MAX_DEPTH:
         raise DataFormatError(f"nested deeper than {jc.MAX_DEPTH} levels", path=p)
     return resolve_flight_intents(data, p, now)
 
 
-__all__ = ["merge", "parse_offset", "read_flight_intents", "resolve_flight_intents"]
+__all__ = [
+    "MAX_YAML_DEPTH",
+    "MAX_YAML_NODES",
+    "load_yaml",
+    "merge",
+    "parse_offset",
+    "read_flight_intents",
+    "resolve_flight_intents",
+]

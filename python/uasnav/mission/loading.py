@@ -39,6 +39,7 @@ from lxml import etree
 from uasnav.atomicfile import atomic_write_bytes, atomic_write_text
 from uasnav.errors import DataFormatError, InputError, ResourceLimitError
 from uasnav.httpfetch import Deadline as _Deadline
+from uasnav.httpfetch import new_request
 from uasnav.httpfetch import one_line as _one_line
 from uasnav.httpfetch import opener as _opener
 from uasnav.limits import read_file_limited, read_limited
@@ -248,7 +249,7 @@ def fetch(
                 cached = blob
     except (OSError, ValueError, AttributeError):  # unreadable, oversize or not a JSON object
         cached, meta = None, {}
-    req = urllib.request.Request(url, headers={"User-Agent": "uasnav-mission", "Accept": accept})
+    req = new_request(url, {"User-Agent": "uasnav-mission", "Accept": accept})
     if cached is not None:
         if meta.get("etag"):
             req.add_header("If-None-Match", meta["etag"])

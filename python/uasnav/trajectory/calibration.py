@@ -110,6 +110,24 @@ def simulate_run(predictor: Predictor, seed: int, cruise_ms: float | None = None
     )
 
 
+#: Elementary operations of one simulated calibration run (≈ 36 ms of one core: a simulated
+#: flight of a few minutes at the simulator step, plus its prediction).
+OPS_PER_SIMULATED_RUN = 4e7
+
+
+def check_runs(n_runs: int, option: str = "n_runs") -> None:
+    """Refuse, up front, more simulated runs than the work limit allows (with the estimate).
+
+    Raises
+    ------
+    ResourceLimitError
+        ``n_runs`` × :data:`OPS_PER_SIMULATED_RUN` beyond :func:`uasnav.limits.max_work`.
+    """
+    from uasnav.limits import check_work
+
+    check_work(float(n_runs) * OPS_PER_SIMULATED_RUN, f"{n_runs} simulated calibration runs", option=option)
+
+
 def simulated_runs(
     predictor: Predictor,
     n_runs: int,
@@ -117,7 +135,9 @@ def simulated_runs(
     progress: Callable[[int, int], None] | None = None,
     cruise_ms: float | None = None,
 ) -> list[SimulatedRun]:
-    """``n_runs`` runs, run i from seed ``seed·100003 + i`` (distinct seeds → independent sets)."""
+    """``n_runs`` runs, run i from seed ``seed·100003 + i`` (distinct seeds → independent sets).
+    More runs than the work limit allows are refused up front (:func:`check_runs`)."""
+    check_runs(n_runs)
     out = []
     for i in range(n_runs):
         out.append(simulate_run(predictor, seed * 100_003 + i, cruise_ms))
@@ -229,7 +249,9 @@ def simulated_route_runs(
     progress: Callable[[int, int], None] | None = None,
     cruise_ms: float | None = None,
 ) -> list[SimulatedRouteRun]:
-    """``n_runs`` 3D runs, run i from seed ``seed·100003 + i``."""
+    """``n_runs`` 3D runs, run i from seed ``seed·100003 + i``. More runs than the work limit
+    allows are refused up front (:func:`check_runs`)."""
+    check_runs(n_runs)
     out = []
     for i in range(n_runs):
         out.append(simulate_route_run(predictor, seed * 100_003 + i, cruise_ms))

@@ -98,20 +98,25 @@ def flight_samples(
         if lf is not None:
             opened[str(path)] = lf
         runs: list[FlownRun] | list[None]
+        v_log = cruise_ms
+        if v_log is None and log.cruise_ms is None and lf is not None and lf.carries("limits"):
+            # the waypoint speed parameter (WPNAV_SPEED, MPC_XY_CRUISE) when the telemetry
+            # itself names no speed (DataFlash logs keep it in PARM)
+            v_log = lf.limits.cruise_ms
         if log.waypoints:
-            runs, samples = run_samples(log, segment_m, cruise_ms, wind_ne, max_gap_s=max_gap_s)
+            runs, samples = run_samples(log, segment_m, v_log, wind_ne, max_gap_s=max_gap_s)
         else:
             if plan is None:
                 raise InputError(f"{path}: no mission waypoints in the log; give --plan")
             plan_ne, origin = read_plan_route(plan, other_as_csv=True)
             if origin is None:
                 raise InputError("--plan for telemetry must be geodetic (lat,lon,alt)")
-            if cruise_ms is None:
+            if v_log is None:
                 raise InputError(f"{path}: no waypoint speed in the log; give --speed")
             pos = geodetic_to_local(log.lat, log.lon, log.alt, origin=origin)[:, :2]
             w = wind_ne if wind_ne is not None else (log.wind_ne if log.wind_ne is not None else np.zeros(2))
             _, s = measure_elements(
-                plan_ne, log.t, pos, log.vel_ned[:, :2], w, cruise_ms, segment_m, max_gap_s=max_gap_s
+                plan_ne, log.t, pos, log.vel_ned[:, :2], w, v_log, segment_m, max_gap_s=max_gap_s
             )
             runs, samples = [None], [s]
         for r, s in zip(runs, samples, strict=True):

@@ -199,6 +199,36 @@ def check_element_count(plan_ne: np.ndarray, segment_m: float, what: str = "plan
     return n
 
 
+def merge_short_legs(plan_ne: np.ndarray, segment_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """The plan with its legs shorter than the segment length L merged into their neighbours,
+    so that the thesis' elements (two segments of L) can cover it; and, for each waypoint of
+    ``plan_ne``, the index of the merged plan's waypoint that stands for it.
+
+    A waypoint whose incoming leg is shorter than L is dropped (the vehicle passes within L of
+    it at the next kept waypoint); when the last leg is short, the waypoint before the last is
+    dropped instead, so the plan still ends where it ends. Repeated waypoints (legs of 0 m)
+    merge the same way. Real plans have such legs: a VTOL landing a metre or two from the last
+    waypoint, waypoints a few metres apart for a camera.
+
+    >>> merged, idx = merge_short_legs(np.array([[0.0, 0.0], [100.0, 0.0], [101.0, 0.0]]), 10.0)
+    >>> merged.tolist(), idx.tolist()
+    ([[0.0, 0.0], [101.0, 0.0]], [0, 1, 1])
+    """
+    p = np.asarray(plan_ne, dtype=float)[:, :2]
+    keep = [0]
+    for i in range(1, len(p)):
+        if float(np.hypot(*(p[i] - p[keep[-1]]))) >= segment_m:
+            keep.append(i)
+    if keep[-1] != len(p) - 1:
+        if len(keep) > 1:
+            keep[-1] = len(p) - 1  # the plan ends at its own last waypoint
+        else:
+            keep.append(len(p) - 1)
+    keep_a = np.asarray(keep)
+    idx = np.searchsorted(keep_a, np.arange(len(p)), side="left")
+    return p[keep_a], np.minimum(idx, len(keep_a) - 1)
+
+
 def discretise(plan_ne: np.ndarray, segment_m: float = DEFAULT_SEGMENT_M) -> Elements:
     """Cut a plan into elements of two segments of length ``segment_m`` (thesis §5.1.2).
 
@@ -365,6 +395,7 @@ __all__ = [
     "element_count_bound",
     "geodetic_to_local",
     "heading_deg",
+    "merge_short_legs",
     "plan_length",
     "signed_angle_deg",
 ]

@@ -37,7 +37,7 @@ from uasnav.atomicfile import atomic_write_text
 from uasnav.errors import DataFormatError, InputError
 from uasnav.trajectory.baselines import kinematic_times
 from uasnav.trajectory.features import N_CELLS, WIND_MAX_MS, cell_index, features
-from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, check_element_count, discretise
+from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, check_element_count, discretise, merge_short_legs
 from uasnav.trajectory.predictor import (
     MAX_MODEL_BYTES,
     MAX_SEGMENT_M,
@@ -166,6 +166,13 @@ class KinematicPredictor:
         v_ref = self.cruise_ms_ if cruise_ms is None else float(cruise_ms)
         if not (np.isfinite(v_ref) and v_ref > 0):
             raise InputError(f"cruise speed must be > 0 m/s, got {cruise_ms}")
+        # legs shorter than L merge into their neighbours (geometry.merge_short_legs); each
+        # waypoint's time is that of the merged waypoint standing for it
+        plan_in = np.asarray(plan_ne, dtype=float)[:, :2]
+        plan_ne, wp_index = merge_short_legs(plan_in, self.segment_m)
+        if leg_speed_ms is not None and len(plan_ne) != len(plan_in):
+            keep = np.flatnonzero(np.r_[True, np.diff(wp_index) > 0])
+            leg_speed_ms = np.asarray(leg_speed_ms, dtype=float)[np.maximum(keep[1:] - 1, 0)]
         check_element_count(plan_ne, self.segment_m)
         el = discretise(plan_ne, self.segment_m)
         f = features(el.heading1_deg, el.turn_deg, el.kind, wind_ne)
@@ -200,7 +207,7 @@ class KinematicPredictor:
             dv_ms=el.length_m / t - v_ref,
             time_s=t,
             eta_s=float(t.sum()),
-            waypoint_times_s=np.interp(s_wp, s_knots, t_knots),
+            waypoint_times_s=np.interp(s_wp, s_knots, t_knots)[wp_index],
             flags=flags,
         )
 

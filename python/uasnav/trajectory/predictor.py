@@ -23,7 +23,7 @@ from uasnav import jsoncheck as jc
 from uasnav.atomicfile import atomic_write_text
 from uasnav.errors import DataFormatError, InputError
 from uasnav.trajectory.features import N_CELLS, WIND_MAX_MS, Features, cell_index, features
-from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, Elements, discretise
+from uasnav.trajectory.geometry import DEFAULT_SEGMENT_M, Elements, discretise, merge_short_legs
 from uasnav.trajectory.lvq import LVQClassifier
 from uasnav.trajectory.samples import ElementSamples
 from uasnav.trajectory.timebounds import TimeBounds
@@ -297,6 +297,9 @@ class TrajectoryPredictor:
         v_ref = self.cruise_ms_ if cruise_ms is None else float(cruise_ms)
         if not (np.isfinite(v_ref) and v_ref > 0):
             raise InputError(f"cruise speed must be > 0 m/s, got {cruise_ms}")
+        # legs shorter than L merge into their neighbours (geometry.merge_short_legs); each
+        # waypoint's time is that of the merged waypoint standing for it
+        plan_ne, wp_index = merge_short_legs(np.asarray(plan_ne, dtype=float)[:, :2], self.segment_m)
         el = discretise(plan_ne, self.segment_m)
         f = features(el.heading1_deg, el.turn_deg, el.kind, wind_ne)
         dv, cell, used = self.predict_dv(f)
@@ -331,7 +334,7 @@ class TrajectoryPredictor:
             dv_ms=dv,
             time_s=t,
             eta_s=float(t.sum()),
-            waypoint_times_s=np.interp(s_wp, s_knots, t_knots),
+            waypoint_times_s=np.interp(s_wp, s_knots, t_knots)[wp_index],
             flags=flags,
         )
 

@@ -73,6 +73,8 @@ class IntentBuild:
     flags : list of list of str — the predictor's flags per horizontal element.
     route_prediction : RoutePrediction or None — the 3D elements (legs, turns, climbs,
         descents, hovers) and their times.
+    time_bounds_source : str — what calibrated the time bounds: the vehicle's own flights
+        (``trajectory calibrate --flights``) or simulated runs.
     """
 
     details: Any
@@ -91,6 +93,7 @@ class IntentBuild:
     coverage: float
     flags: list[list[str]]
     route_prediction: RoutePrediction | None = None
+    time_bounds_source: str = ""
 
 
 def _positive(x: float, name: str) -> float:
@@ -263,6 +266,7 @@ def build_intent(
         coverage=coverage,
         flags=flags,
         route_prediction=rp,
+        time_bounds_source=bounds.source,
     )
 
 

@@ -5,7 +5,8 @@ script of this package: nothing from a CDN), the JSON API (``/api/…``) and its
 description (``/openapi.json``, rendered as a page at ``/api`` by the app itself). Each page and
 the API is a router of :mod:`uasnav.web.routes`; pages and API call the same functions:
 :func:`uasnav.mission.request.run_select` on the documents loaded when the server started, and
-:mod:`uasnav.web.prediction`.
+:mod:`uasnav.web.prediction`. The ``/live`` page (:mod:`uasnav.web.live`) shows live
+telemetry.
 
 Every page works without JavaScript: forms post, tables filter and sort through query
 parameters, downloads are links. Errors: a bad value is a 4xx naming the field (on a page, the
@@ -29,7 +30,7 @@ from uasnav import __version__
 from uasnav.mission.planner import plan
 from uasnav.mission.request import parse_select_options, run_select
 from uasnav.mission.scoring import PARAMETERS
-from uasnav.web import forms
+from uasnav.web import forms, live
 from uasnav.web.context import (
     GENERIC_500,
     MAX_BODY_BYTES,
@@ -108,6 +109,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
     app.include_router(database.router)
     app.include_router(api_page.router)
     app.include_router(api.router)
+    app.include_router(live.router)
 
     # -- middleware (outermost last) -----------------------------------------------------------
     guarded = GuardMiddleware(app, allowed_hosts, MAX_BODY_BYTES, _SECURITY_HEADERS)

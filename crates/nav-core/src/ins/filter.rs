@@ -379,7 +379,9 @@ impl<T: Real> InsFilter<T> {
             self.q_rate[3] * dt,
         ];
         strapdown::propagate_covariance(&mut self.p, &e, self.cfg.discretisation, &gamma);
-        self.index += 1;
+        // Wraps rather than panicking (release keeps overflow checks): a 32-bit flight
+        // controller stepping at 1 kHz reaches usize::MAX after 49.7 days.
+        self.index = self.index.wrapping_add(1);
         self.check_health()
     }
 

@@ -87,10 +87,12 @@
 //! the last sample before it (the sample after a gap averages over an unknown part of it).
 mod filter;
 mod separation;
+mod stream;
 
 pub use filter::{
     FixStatus, InsBatchInput, InsBatchOutput, InsBatchSummary, InsFilter, MagnetometerAiding,
 };
+pub use stream::{GnssFix, InsStream, StreamCounts, StreamSolution, PENDING_FIXES};
 
 use crate::scalar::lit;
 pub use crate::strapdown::Discretisation;

@@ -246,7 +246,9 @@ impl<T: Real> ZuptFilter<T> {
             self.cfg.discretisation,
             &self.gamma,
         );
-        self.index += 1;
+        // Wraps rather than panicking (release keeps overflow checks): a 32-bit flight
+        // controller stepping at 1 kHz reaches usize::MAX after 49.7 days.
+        self.index = self.index.wrapping_add(1);
         self.check_health()
     }
 
@@ -300,7 +302,7 @@ impl<T: Real> ZuptFilter<T> {
         self.q = strapdown::correct_attitude(&self.q, &dpsi);
         self.ba -= dx.fixed_rows::<3>(9);
         self.bg -= dx.fixed_rows::<3>(12);
-        self.n_updates += 1;
+        self.n_updates = self.n_updates.saturating_add(1);
         self.check_health()
     }
 

@@ -1,0 +1,1029 @@
+"""Mission execution models per autopilot family: when the vehicle reaches each item of a
+mission plan, and when it touches down, as ArduCopter, PX4 multicopter or ArduPlane/QuadPlane
+fly it, with the parameters of the vehicle's log or the firmware's defaults.
+
+Every time is seconds from the start of the mission (lift-off, or the moment AUTO was entered
+when the vehicle was already flying).
+
+Kinematics (closed forms, one leg at a time)
+--------------------------------------------
+A leg of length d flown from speed v₀ to speed v₁ under the speed limit v and the acceleration
+limit a (and jerk limit j where the firmware has one) takes
+
+* speed change Δv: T(Δv) = Δv/a + a/j if Δv ≥ a²/j, else 2·√(Δv/j) (jerk-limited, symmetric
+  S-curve; without a jerk limit T = Δv/a), covering (v₀ + v₁)/2 · T;
+* the peak speed v_p ≤ v is the largest one whose speed-up and slow-down fit in d; the rest is
+  flown at v_p.
+
+Vertical legs and climbs use the vertical limits the same way; a 3-D leg takes the longer of its
+horizontal and vertical times (both controllers run at once).
+
+Family rules
+------------
+ArduCopter (``AC_WPNav``): ``WPNAV_SPEED/ACCEL/SPEED_UP/SPEED_DN/ACCEL_Z``; firmware 3.x flies
+straight lines (no jerk limit; its target slows down at 2·``WPNAV_ACCEL``, the
+``get_slow_down_speed`` √(4·a·d) law; a waypoint followed by another waypoint without a delay is
+a "fast waypoint" passed at full speed); 4.x plans S-curves (``WPNAV_JERK``) and rounds corners
+within ``WPNAV_RADIUS`` at the lateral acceleration ``WPNAV_ACCEL_C`` (0: 2·``WPNAV_ACCEL``).
+Take-off climbs vertically; LAND descends at ``LAND_SPEED_HIGH`` (0: ``WPNAV_SPEED_DN``) down
+to ``LAND_ALT_LOW`` and at ``LAND_SPEED`` below; RTL climbs to ``RTL_ALT``, returns at
+``RTL_SPEED`` (0: ``WPNAV_SPEED``), loiters ``RTL_LOIT_TIME`` and lands (or descends to
+``RTL_ALT_FINAL`` and hovers when it is non-zero).
+
+PX4 multicopter (``FlightTaskAuto`` + ``PositionSmoothing``): ``MPC_XY_CRUISE``,
+``MPC_ACC_HOR``, ``MPC_JERK_AUTO``, ``MPC_Z_V_AUTO_UP/DN`` (before 1.12: ``MPC_Z_VEL_MAX_UP/DN``),
+corner speed √(a·R·tan(α/2)) with R = ``NAV_ACC_RAD`` and α the angle between the legs
+(``computeMaxSpeedInWaypoint``); take-off at ``MPC_TKO_SPEED`` after a ``MPC_TKO_RAMP_T`` ramp;
+landing at ``MPC_Z_V_AUTO_DN`` above ``MPC_LAND_ALT1``, blending linearly to ``MPC_LAND_SPEED``
+at ``MPC_LAND_ALT2`` and below.
+
+Fixed wing and QuadPlane (ArduPlane): legs at the cruise airspeed (``AIRSPEED_CRUISE``, before
+4.5 ``TRIM_ARSPD_CM``), corners as circular arcs of radius v²/(g·tan φ) with φ = ``ROLL_LIMIT_DEG``
+(before 4.5 ``LIM_ROLL_CD``); VTOL take-off and landing climb and descend at
+``Q_WP_SPEED_UP/DN`` (the last ``Q_LAND_FINAL_ALT`` at ``Q_LAND_SPEED``) plus a transition of
+``Q_TRANSITION_MS``.
+
+Waypoints closer together than the corner geometry needs (a VTOL landing 1.85 m from the last
+waypoint, PX4 waypoints metres apart) are flown as short legs: each leg's own speed profile
+never exceeds what its length allows, so no leg is merged or refused.
+
+Terrain frames (``MAV_FRAME`` 10/11) are taken as relative to home (flat ground): the models
+know no terrain.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from uasnav.errors import InputError
+from uasnav.io.mission_plan import (
+    MAV_CMD_DO_CHANGE_SPEED,
+    MAV_CMD_NAV_LAND,
+    MAV_CMD_NAV_LOITER_TIME,
+    MAV_CMD_NAV_LOITER_TURNS,
+    MAV_CMD_NAV_LOITER_UNLIM,
+    MAV_CMD_NAV_RETURN_TO_LAUNCH,
+    MAV_CMD_NAV_SPLINE_WAYPOINT,
+    MAV_CMD_NAV_TAKEOFF,
+    MAV_CMD_NAV_VTOL_LAND,
+    MAV_CMD_NAV_VTOL_TAKEOFF,
+    MAV_CMD_NAV_WAYPOINT,
+    AltitudeFrame,
+    MissionPlan,
+    flight_sequence,
+)
+
+G0 = 9.80665
+MAV_CMD_NAV_DELAY = 93
+#: Families :func:`predict_mission` knows.
+FAMILIES = ("arducopter", "px4-mc", "plane")
+
+
+# --------------------------------------------------------------------------- kinematics
+def speed_change_time(dv: float, accel: float, jerk: float | None = None) -> float:
+    """Time (s) to change speed by ``dv`` (m/s) at acceleration limit ``accel`` (m/s²) and, when
+    given, jerk limit ``jerk`` (m/s³): Δv/a + a/j when the acceleration limit is reached
+    (Δv ≥ a²/j), else 2·√(Δv/j); Δv/a without a jerk limit.
+
+    >>> speed_change_time(5.0, 1.0)
+    5.0
+    >>> speed_change_time(5.0, 1.0, 1.0)
+    6.0
+    """
+    dv = abs(dv)
+    if dv == 0.0:
+        return 0.0
+    if jerk is None or not math.isfinite(jerk) or jerk <= 0:
+        return dv / accel
+    if dv >= accel * accel / jerk:
+        return dv / accel + accel / jerk
+    return 2.0 * math.sqrt(dv / jerk)
+
+
+def _change(v0: float, v1: float, accel: float, jerk: float | None) -> tuple[float, float]:
+    t = speed_change_time(v1 - v0, accel, jerk)
+    return t, 0.5 * (v0 + v1) * t
+
+
+def leg_time(
+    d: float,
+    v_max: float,
+    accel: float,
+    jerk: float | None = None,
+    v0: float = 0.0,
+    v1: float = 0.0,
+    decel: float | None = None,
+) -> tuple[float, float]:
+    """Time (s) to fly ``d`` m from speed ``v0`` to ``v1`` under ``v_max``, the acceleration
+    ``accel`` (``decel`` for slowing down, default the same) and the jerk limit; and the speed
+    the leg actually ends at (lower than ``v1`` when the leg is too short to reach it).
+
+    >>> leg_time(100.0, 5.0, 1.0)  # trapezoid: 100/5 + 5/1
+    (25.0, 0.0)
+    """
+    if d <= 0.0:
+        return 0.0, v0
+    dec = decel or accel
+    v0 = min(v0, v_max)
+    v1 = min(v1, v_max)
+    # the end speed reachable from v0 within d
+    _, d01 = _change(v0, v1, accel if v1 > v0 else dec, jerk)
+    if d01 > d:
+        if v1 > v0:  # cannot reach v1: accelerate all the way
+            vb = math.sqrt(v0 * v0 + 2.0 * accel * d)
+        else:  # cannot slow down to v1: arrive faster (the autopilot would overshoot the corner)
+            vb = math.sqrt(max(v0 * v0 - 2.0 * dec * d, 0.0))
+        vb = min(vb, v_max)
+        return 2.0 * d / max(v0 + vb, 1e-9), vb
+
+    def dist(vp: float) -> tuple[float, float]:
+        ta, da = _change(v0, vp, accel, jerk)
+        tb, db = _change(vp, v1, dec, jerk)
+        return ta + tb, da + db
+
+    lo, hi = max(v0, v1), v_max
+    t_lh, d_lh = dist(hi)
+    if d_lh <= d:
+        return t_lh + (d - d_lh) / hi, v1
+    for _ in range(60):  # bisection on the peak speed
+        mid = 0.5 * (lo + hi)
+        if dist(mid)[1] > d:
+            hi = mid
+        else:
+            lo = mid
+    t_p, d_p = dist(lo)
+    return t_p + (d - d_p) / max(lo, 1e-9), v1
+
+
+def banded_descent_time(h: float, v_high: float, v_low: float, alt_low: float) -> float:
+    """Time (s) to descend ``h`` m at ``v_high`` down to ``alt_low`` m and ``v_low`` below
+    (ArduCopter LAND; accelerations neglected, the land controller's are fast)."""
+    if h <= 0:
+        return 0.0
+    low = min(h, alt_low)
+    return (h - low) / v_high + low / v_low
+
+
+def px4_land_time(h: float, v_dn: float, v_land: float, alt1: float, alt2: float) -> float:
+    """Time (s) to land from ``h`` m with PX4's landing speed: ``v_dn`` above ``alt1``, linear
+    in height from ``v_dn`` to ``v_land`` between ``alt1`` and ``alt2``, ``v_land`` below.
+    In the blend v(z) = v_land + (v_dn − v_land)·(z − alt2)/(alt1 − alt2), so the time across
+    it is (alt1 − alt2)·ln(v_dn/v_land)/(v_dn − v_land)."""
+    if h <= 0:
+        return 0.0
+    t = 0.0
+    if h > alt1:
+        t += (h - alt1) / v_dn
+    lo, hi = alt2, min(h, alt1)
+    if hi > lo and alt1 > alt2:
+        k = (v_dn - v_land) / (alt1 - alt2)
+        if abs(k) < 1e-12:
+            t += (hi - lo) / v_land
+        else:
+            t += (math.log(v_land + k * (hi - lo)) - math.log(v_land)) / k
+    t += min(h, alt2) / v_land
+    return t
+
+
+def px4_max_speed_from_distance(d: float, accel: float, jerk: float, v_final: float = 0.0) -> float:
+    """PX4's speed limit at distance ``d`` (m) from a waypoint to be passed at ``v_final``
+    (``math::trajectory::computeMaxSpeedFromDistance``):
+    v = ½·(−b + √(b² + 8·a·d + 4·v_f²)) with b = 4·a²/j.
+
+    >>> round(px4_max_speed_from_distance(4.4, 3.0, 4.0), 3)
+    2.33
+    """
+    b = 4.0 * accel * accel / jerk
+    return 0.5 * (-b + math.sqrt(b * b + 8.0 * accel * max(d, 0.0) + 4.0 * v_final * v_final))
+
+
+def px4_braking_time(d1: float, d2: float, accel: float, jerk: float, v_final: float = 0.0) -> float:
+    """Time (s) to go from ``d1`` to ``d2`` m before the waypoint following PX4's speed limit
+    (:func:`px4_max_speed_from_distance`). With w = √(b² + 8·a·d + 4·v_f²), dd = w·dw/(4a) and
+    v = (w − b)/2, so t = [w + b·ln(w − b)] / (2a) between the two ends."""
+    if d1 <= d2:
+        return 0.0
+    b = 4.0 * accel * accel / jerk
+
+    def w(d: float) -> float:
+        return math.sqrt(b * b + 8.0 * accel * d + 4.0 * v_final * v_final)
+
+    w1, w2 = w(d1), w(d2)
+    return ((w1 - w2) + b * math.log((w1 - b) / max(w2 - b, 1e-12))) / (2.0 * accel)
+
+
+def px4_leg_time(
+    d: float,
+    v_max: float,
+    accel: float,
+    jerk: float,
+    v0: float,
+    v_final: float,
+    accept_m: float,
+    lag_s: float,
+) -> tuple[float, float]:
+    """Time (s) until PX4 accepts a waypoint ``d`` m away, and the speed then: speeding up
+    (jerk-limited) from ``v0`` until the speed meets the braking limit
+    (:func:`px4_max_speed_from_distance`, or ``v_max``), then following it down to where the
+    vehicle — ``lag_s``·v behind its trajectory (1/``MPC_XY_P``) — is ``accept_m`` from the
+    waypoint."""
+
+    def v_lim(x: float) -> float:
+        return min(v_max, px4_max_speed_from_distance(x, accel, jerk, v_final))
+
+    # where the acceptance happens on the trajectory: d_a + lag·v(d_a) = accept
+    lo, hi = 0.0, max(accept_m, 0.0)
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        if mid + lag_s * v_lim(mid) > accept_m:
+            hi = mid
+        else:
+            lo = mid
+    d_acc = lo
+    if d <= d_acc:
+        return 0.0, min(v0, v_lim(d))
+    v0 = min(v0, v_max)
+    if v0 >= v_lim(d):  # already at the limit: follow it
+        return _braking_with_cruise(d, d_acc, v_max, accel, jerk, v_final), v_lim(d_acc)
+    # meet the limit: bisection on the speed reached by speeding up
+    a_lo, a_hi = v0, v_lim(d)
+    for _ in range(50):
+        vm = 0.5 * (a_lo + a_hi)
+        t_a, x_a = _change(v0, vm, accel, jerk)
+        if x_a > d - d_acc or vm > v_lim(d - x_a):
+            a_hi = vm
+        else:
+            a_lo = vm
+    t_a, x_a = _change(v0, a_lo, accel, jerk)
+    return t_a + _braking_with_cruise(d - x_a, d_acc, v_max, accel, jerk, v_final), v_lim(d_acc)
+
+
+def _braking_with_cruise(
+    d1: float, d2: float, v_max: float, accel: float, jerk: float, v_final: float
+) -> float:
+    """Time from ``d1`` to ``d2`` before the waypoint at min(``v_max``, the braking limit)."""
+    b = 4.0 * accel * accel / jerk
+    # the distance where the braking limit equals v_max: v_max² + b·v_max = 2a·d + v_f²
+    d_c = max((v_max * v_max + b * v_max - v_final * v_final) / (2.0 * accel), 0.0)
+    t = 0.0
+    if d1 > d_c:
+        t += (d1 - max(d_c, d2)) / v_max
+        d1 = max(d_c, d2)
+    return t + px4_braking_time(d1, d2, accel, jerk, v_final)
+
+
+# --------------------------------------------------------------------------- parameters
+@dataclass(frozen=True)
+class Default:
+    """A firmware default and where it is defined."""
+
+    value: float
+    source: str
+
+
+#: ArduCopter defaults, SI units, by major version. Sources: ArduPilot
+#: ``libraries/AC_WPNav/AC_WPNav.cpp`` (``WPNAV_*``), ``ArduCopter/Parameters.cpp``
+#: (``RTL_*``, ``LAND_*``), ``ArduCopter/mode_land.cpp`` (``LAND_ALT_LOW``; 3.x hard-codes
+#: ``LAND_START_ALT`` 1000 cm in ``ArduCopter/defines.h``).
+ARDUCOPTER_DEFAULTS: dict[str, dict[str, Default]] = {
+    "3": {
+        "WPNAV_SPEED": Default(5.0, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_SPEED 500 cm/s"),
+        "WPNAV_ACCEL": Default(1.0, "AC_WPNav.cpp Copter-3.6: WPNAV_ACCELERATION 100 cm/s²"),
+        "WPNAV_SPEED_UP": Default(2.5, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_SPEED_UP 250 cm/s"),
+        "WPNAV_SPEED_DN": Default(1.5, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_SPEED_DOWN 150 cm/s"),
+        "WPNAV_ACCEL_Z": Default(1.0, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²"),
+        "WPNAV_RADIUS": Default(2.0, "AC_WPNav.cpp Copter-3.6: WPNAV_WP_RADIUS 200 cm"),
+        "LAND_SPEED": Default(0.5, "ArduCopter/Parameters.cpp Copter-3.6: LAND_SPEED 50 cm/s"),
+        "LAND_SPEED_HIGH": Default(0.0, "ArduCopter/Parameters.cpp Copter-3.6: LAND_SPEED_HIGH 0"),
+        "LAND_ALT_LOW": Default(10.0, "ArduCopter/defines.h Copter-3.6: LAND_START_ALT 1000 cm"),
+        "RTL_ALT": Default(15.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_ALT 1500 cm"),
+        "RTL_SPEED": Default(0.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_SPEED 0 (WPNAV_SPEED)"),
+        "RTL_LOIT_TIME": Default(5.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_LOIT_TIME 5000 ms"),
+        "RTL_ALT_FINAL": Default(0.0, "ArduCopter/Parameters.cpp Copter-3.6: RTL_ALT_FINAL 0"),
+    },
+    "4": {
+        "WPNAV_SPEED": Default(10.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED 1000 cm/s"),
+        "WPNAV_ACCEL": Default(2.5, "AC_WPNav.cpp Copter-4.5: WPNAV_ACCELERATION 250 cm/s²"),
+        "WPNAV_SPEED_UP": Default(2.5, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED_UP 250 cm/s"),
+        "WPNAV_SPEED_DN": Default(1.5, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED_DOWN 150 cm/s"),
+        "WPNAV_ACCEL_Z": Default(1.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²"),
+        "WPNAV_RADIUS": Default(2.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_RADIUS 200 cm"),
+        "WPNAV_JERK": Default(1.0, "AC_WPNav.cpp Copter-4.5: WPNAV_JERK 1 m/s³"),
+        "WPNAV_ACCEL_C": Default(0.0, "AC_WPNav.cpp Copter-4.5: WPNAV_ACCEL_C 0 (2×WPNAV_ACCEL)"),
+        "LAND_SPEED": Default(0.5, "ArduCopter/Parameters.cpp Copter-4.5: LAND_SPEED 50 cm/s"),
+        "LAND_SPEED_HIGH": Default(0.0, "ArduCopter/Parameters.cpp Copter-4.5: LAND_SPEED_HIGH 0"),
+        "LAND_ALT_LOW": Default(10.0, "ArduCopter/mode_land.cpp Copter-4.5: LAND_ALT_LOW 1000 cm"),
+        "RTL_ALT": Default(15.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_ALT 1500 cm"),
+        "RTL_SPEED": Default(0.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_SPEED 0 (WPNAV_SPEED)"),
+        "RTL_LOIT_TIME": Default(5.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_LOIT_TIME 5000 ms"),
+        "RTL_ALT_FINAL": Default(0.0, "ArduCopter/Parameters.cpp Copter-4.5: RTL_ALT_FINAL 0"),
+    },
+}
+#: ArduCopter parameters logged in cm, cm/s, cm/s² or ms (→ SI by these factors).
+_AC_SCALE = {
+    "WPNAV_SPEED": 0.01, "WPNAV_ACCEL": 0.01, "WPNAV_SPEED_UP": 0.01, "WPNAV_SPEED_DN": 0.01,
+    "WPNAV_ACCEL_Z": 0.01, "WPNAV_RADIUS": 0.01, "WPNAV_ACCEL_C": 0.01, "LAND_SPEED": 0.01,
+    "LAND_SPEED_HIGH": 0.01, "LAND_ALT_LOW": 0.01, "RTL_ALT": 0.01, "RTL_SPEED": 0.01,
+    "RTL_LOIT_TIME": 0.001, "RTL_ALT_FINAL": 0.01, "WPNAV_JERK": 1.0,
+}  # fmt: skip
+
+#: PX4 multicopter defaults (SI). Sources: PX4-Autopilot
+#: ``src/modules/mc_pos_control/mc_pos_control_params.c`` and
+#: ``src/modules/navigator/navigator_params.c``, release 1.11 / 1.14 as named.
+PX4_MC_DEFAULTS: dict[str, Default] = {
+    "MPC_XY_CRUISE": Default(5.0, "mc_pos_control_params.c v1.11–1.14: MPC_XY_CRUISE 5 m/s"),
+    "MPC_ACC_HOR": Default(3.0, "mc_pos_control_params.c v1.11–1.14: MPC_ACC_HOR 3 m/s²"),
+    "MPC_JERK_AUTO": Default(4.0, "mc_pos_control_params.c v1.11–1.14: MPC_JERK_AUTO 4 m/s³"),
+    "MPC_Z_V_AUTO_UP": Default(3.0, "mc_pos_control_params.c v1.14: MPC_Z_V_AUTO_UP 3 m/s"),
+    "MPC_Z_V_AUTO_DN": Default(1.5, "mc_pos_control_params.c v1.14: MPC_Z_V_AUTO_DN 1.5 m/s"),
+    "MPC_Z_VEL_MAX_UP": Default(3.0, "mc_pos_control_params.c v1.11: MPC_Z_VEL_MAX_UP 3 m/s"),
+    "MPC_Z_VEL_MAX_DN": Default(1.0, "mc_pos_control_params.c v1.11: MPC_Z_VEL_MAX_DN 1 m/s"),
+    "MPC_ACC_UP_MAX": Default(4.0, "mc_pos_control_params.c v1.11–1.14: MPC_ACC_UP_MAX 4 m/s²"),
+    "MPC_TKO_SPEED": Default(1.5, "mc_pos_control_params.c v1.11–1.14: MPC_TKO_SPEED 1.5 m/s"),
+    "MPC_TKO_RAMP_T": Default(3.0, "mc_pos_control_params.c v1.11–1.14: MPC_TKO_RAMP_T 3 s"),
+    "MPC_LAND_SPEED": Default(0.7, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_SPEED 0.7 m/s"),
+    "MPC_LAND_ALT1": Default(10.0, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_ALT1 10 m"),
+    "MPC_LAND_ALT2": Default(5.0, "mc_pos_control_params.c v1.11–1.14: MPC_LAND_ALT2 5 m"),
+    "NAV_ACC_RAD": Default(10.0, "navigator_params.c v1.11–1.14: NAV_ACC_RAD 10 m"),
+    "NAV_MC_ALT_RAD": Default(0.8, "navigator_params.c v1.11–1.14: NAV_MC_ALT_RAD 0.8 m"),
+    "MIS_YAW_ERR": Default(12.0, "mission_params.c v1.11–1.14: MIS_YAW_ERR 12°"),
+    "MIS_YAW_TMT": Default(-1.0, "mission_params.c v1.11–1.14: MIS_YAW_TMT −1 (no timeout)"),
+    "MPC_YAWRAUTO_MAX": Default(45.0, "mc_pos_control_params.c v1.11–1.14: MPC_YAWRAUTO_MAX 45°/s"),
+    "MPC_XY_TRAJ_P": Default(0.5, "mc_pos_control_params.c v1.11–1.14: MPC_XY_TRAJ_P 0.5"),
+    "MPC_XY_P": Default(0.95, "mc_pos_control_params.c v1.11–1.14: MPC_XY_P 0.95"),
+    "MPC_SPOOLUP_TIME": Default(
+        1.0, "mc_pos_control_params.c v1.11: MPC_SPOOLUP_TIME 1 s (COM_SPOOLUP_TIME from 1.12)"
+    ),
+    "RTL_RETURN_ALT": Default(60.0, "rtl_params.c v1.11–1.14: RTL_RETURN_ALT 60 m"),
+    "RTL_DESCEND_ALT": Default(30.0, "rtl_params.c v1.11–1.14: RTL_DESCEND_ALT 30 m"),
+    "RTL_LAND_DELAY": Default(0.0, "rtl_params.c v1.13–1.14: RTL_LAND_DELAY 0 s (−1 before: hover)"),
+}
+
+#: ArduPlane / QuadPlane defaults (SI). Sources: ArduPilot ``ArduPlane/Parameters.cpp``
+#: (``TRIM_ARSPD_CM``/``AIRSPEED_CRUISE``, ``LIM_ROLL_CD``/``ROLL_LIMIT_DEG``, ``WP_RADIUS``),
+#: ``ArduPlane/quadplane.cpp`` (``Q_TRANSITION_MS``, ``Q_LAND_SPEED``, ``Q_LAND_FINAL_ALT``;
+#: ``Q_WP_SPEED_UP/DN`` are the ``AC_WPNav`` defaults), Plane-4.5.
+PLANE_DEFAULTS: dict[str, Default] = {
+    "AIRSPEED_CRUISE": Default(12.0, "ArduPlane/Parameters.cpp Plane-4.5: AIRSPEED_CRUISE 12 m/s"),
+    "ROLL_LIMIT_DEG": Default(45.0, "ArduPlane/Parameters.cpp Plane-4.5: ROLL_LIMIT_DEG 45°"),
+    "WP_RADIUS": Default(90.0, "ArduPlane/Parameters.cpp Plane-4.5: WP_RADIUS 90 m"),
+    "Q_WP_SPEED_UP": Default(2.5, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_SPEED_UP 250 cm/s"),
+    "Q_WP_SPEED_DN": Default(1.5, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_SPEED_DOWN 150 cm/s"),
+    "Q_WP_ACCEL_Z": Default(1.0, "AC_WPNav.cpp Plane-4.5 (Q_WP_): WPNAV_WP_ACCEL_Z_DEFAULT 100 cm/s²"),
+    "Q_LAND_SPEED": Default(0.5, "ArduPlane/quadplane.cpp Plane-4.5: Q_LAND_SPEED 50 cm/s"),
+    "Q_LAND_FINAL_ALT": Default(6.0, "ArduPlane/quadplane.cpp Plane-4.5: Q_LAND_FINAL_ALT 6 m"),
+    "Q_TRANSITION_MS": Default(5.0, "ArduPlane/quadplane.cpp Plane-4.5: Q_TRANSITION_MS 5000 ms"),
+    "TECS_CLMB_MAX": Default(5.0, "libraries/AP_TECS/AP_TECS.cpp Plane-4.5: TECS_CLMB_MAX 5 m/s"),
+    "TECS_SINK_MAX": Default(5.0, "libraries/AP_TECS/AP_TECS.cpp Plane-4.5: TECS_SINK_MAX 5 m/s"),
+}
+#: Older ArduPlane names in their logged units → the names above (SI).
+_PLANE_ALIASES = {"TRIM_ARSPD_CM": ("AIRSPEED_CRUISE", 0.01), "LIM_ROLL_CD": ("ROLL_LIMIT_DEG", 0.01),
+                  "Q_WP_SPEED_UP": ("Q_WP_SPEED_UP", 0.01), "Q_WP_SPEED_DN": ("Q_WP_SPEED_DN", 0.01),
+                  "Q_WP_ACCEL_Z": ("Q_WP_ACCEL_Z", 0.01), "Q_LAND_SPEED": ("Q_LAND_SPEED", 0.01),
+                  "Q_TRANSITION_MS": ("Q_TRANSITION_MS", 0.001)}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class MissionParams:
+    """The parameters a mission execution model flies with (SI units).
+
+    Attributes
+    ----------
+    family : str
+        ``"arducopter"``, ``"px4-mc"`` or ``"plane"``.
+    version : str or None
+        Firmware version (decides 3.x vs 4.x behaviour for ArduCopter, the PX4 vertical speeds).
+    values : dict of str → float
+        Parameter name → value in SI units (m, m/s, m/s², m/s³, s, deg).
+    sources : dict of str → str
+        Parameter name → ``"log"`` or the firmware default's citation.
+    """
+
+    family: str
+    version: str | None
+    values: dict[str, float]
+    sources: dict[str, str] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> float:
+        return self.values[name]
+
+    @property
+    def major(self) -> int | None:
+        """The firmware's major version number, when known."""
+        try:
+            return int(str(self.version).split(".")[0])
+        except ValueError:
+            return None
+
+    @property
+    def minor(self) -> int:
+        """The firmware's minor version number (0 when unknown)."""
+        try:
+            return int(str(self.version).split(".")[1])
+        except (ValueError, IndexError):
+            return 0
+
+    @property
+    def cruise_ms(self) -> float:
+        """The horizontal mission speed (m/s)."""
+        return self.values[
+            {"arducopter": "WPNAV_SPEED", "px4-mc": "MPC_XY_CRUISE", "plane": "AIRSPEED_CRUISE"}[self.family]
+        ]
+
+
+def family_of(identity: object | None, params: dict[str, float]) -> str:
+    """The model family of a log: from its identity (autopilot, vehicle type) and, failing
+    that, from which parameters it carries."""
+    auto = str(getattr(identity, "autopilot", "") or "").lower()
+    vtype = str(getattr(identity, "vehicle_type", "") or "").lower()
+    if "plane" in vtype or "fixed" in vtype or "Q_ENABLE" in params or "TRIM_ARSPD_CM" in params:
+        return "plane"
+    if "px4" in auto or any(k.startswith("MPC_") for k in params):
+        return "px4-mc"
+    return "arducopter"
+
+
+def mission_params(
+    family: str,
+    version: str | None = None,
+    log_params: dict[str, float] | None = None,
+) -> MissionParams:
+    """The parameters of ``family`` at firmware ``version``: the log's where it has them, the
+    firmware defaults (:data:`ARDUCOPTER_DEFAULTS`, :data:`PX4_MC_DEFAULTS`,
+    :data:`PLANE_DEFAULTS`) otherwise; :attr:`MissionParams.sources` says which.
+
+    Raises
+    ------
+    InputError
+        Unknown family, or a parameter that is not finite or not positive where it must be.
+    """
+    lp = dict(log_params or {})
+    values: dict[str, float] = {}
+    sources: dict[str, str] = {}
+    if family == "arducopter":
+        major = "4"
+        try:
+            major = "3" if version is not None and int(str(version).split(".")[0]) <= 3 else "4"
+        except ValueError:
+            pass
+        for k, d in ARDUCOPTER_DEFAULTS[major].items():
+            if k in lp and math.isfinite(lp[k]):
+                values[k], sources[k] = lp[k] * _AC_SCALE[k], "log"
+            else:
+                values[k], sources[k] = d.value, d.source
+        version = version or ("3.6" if major == "3" else "4.5")
+    elif family == "px4-mc":
+        for k, d in PX4_MC_DEFAULTS.items():
+            if k in lp and math.isfinite(lp[k]):
+                values[k], sources[k] = float(lp[k]), "log"
+            elif (
+                k == "MPC_SPOOLUP_TIME" and "COM_SPOOLUP_TIME" in lp and math.isfinite(lp["COM_SPOOLUP_TIME"])
+            ):
+                values[k], sources[k] = float(lp["COM_SPOOLUP_TIME"]), "log: COM_SPOOLUP_TIME"
+            else:
+                values[k], sources[k] = d.value, d.source
+    elif family == "plane":
+        for k, d in PLANE_DEFAULTS.items():
+            values[k], sources[k] = d.value, d.source
+        for k, v in lp.items():
+            if k in _PLANE_ALIASES and math.isfinite(v):
+                name, scale = _PLANE_ALIASES[k]
+                values[name], sources[name] = v * scale, "log"
+            elif k in PLANE_DEFAULTS and math.isfinite(v):
+                values[k], sources[k] = float(v), "log"
+    else:
+        raise InputError(f"unknown autopilot family {family!r} (known: {', '.join(FAMILIES)})")
+    for k, v in values.items():
+        if not math.isfinite(v) or (v < 0 and k not in ("MIS_YAW_TMT", "RTL_LAND_DELAY")):
+            raise InputError(f"parameter {k} = {v}: must be finite and ≥ 0")
+    return MissionParams(family, version, values, sources)
+
+
+# --------------------------------------------------------------------------- prediction
+@dataclass(frozen=True)
+class MissionPrediction:
+    """When a mission's items are reached.
+
+    Attributes
+    ----------
+    items : tuple of int
+        Mission item index (in :attr:`MissionPlan.items`) of each event, flown order.
+    commands : tuple of int
+        Their ``MAV_CMD``.
+    arrive_s : ndarray
+        Time each item is reached (s from the mission start).
+    eta_s : float
+        Time the mission ends (touch-down, or the last item reached when it does not land).
+    landed : bool
+        Whether the mission ends on the ground.
+    params : MissionParams
+        The parameters used.
+    """
+
+    items: tuple[int, ...]
+    commands: tuple[int, ...]
+    arrive_s: np.ndarray
+    eta_s: float
+    landed: bool
+    params: MissionParams
+
+    def arrival_of(self, item: int) -> float | None:
+        """The first time item ``item`` is reached (None when the prediction never reaches it)."""
+        for i, t in zip(self.items, self.arrive_s, strict=True):
+            if i == item:
+                return float(t)
+        return None
+
+
+@dataclass
+class _State:
+    ne: np.ndarray  # north, east (m) from the origin
+    h: float  # height above home (m)
+    v: float = 0.0  # horizontal speed at the current point (m/s)
+    t: float = 0.0
+    airborne: bool = False
+    heading: float = math.nan  # rad from north (NaN: unknown)
+    vdir: np.ndarray | None = None  # unit vector of the horizontal motion (north, east)
+
+
+def _local(plan: MissionPlan, origin: tuple[float, float]) -> dict[int, np.ndarray]:
+    from uasnav.trajectory.geometry import geodetic_to_local
+
+    idx = [i for i, it in enumerate(plan.items) if it.has_position]
+    if not idx:
+        return {}
+    lat = np.array([plan.items[i].lat_deg for i in idx])
+    lon = np.array([plan.items[i].lon_deg for i in idx])
+    ned = geodetic_to_local(lat, lon, np.zeros(len(idx)), origin=(origin[0], origin[1], 0.0))
+    return {i: ned[k, :2] for k, i in enumerate(idx)}
+
+
+def _height(plan: MissionPlan, i: int, home_amsl: float | None, current: float) -> float:
+    """Height above home (m) of item ``i`` (its current height when it has no altitude)."""
+    it = plan.items[i]
+    if not math.isfinite(it.alt_m):
+        return current
+    try:
+        frame = it.altitude_frame
+    except InputError:
+        return current
+    if frame is AltitudeFrame.AMSL:
+        if home_amsl is None or not math.isfinite(home_amsl):
+            return current
+        return it.alt_m - home_amsl
+    return it.alt_m  # relative to home; terrain frames taken as relative (flat ground)
+
+
+def _turn_angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
+    """The heading change (rad, 0 … π) at b between the legs a→b and b→c."""
+    u, w = b - a, c - b
+    nu, nw = float(np.hypot(*u)), float(np.hypot(*w))
+    if nu < 1e-6 or nw < 1e-6:
+        return math.pi
+    cos = float(np.clip(np.dot(u, w) / (nu * nw), -1.0, 1.0))
+    return math.acos(cos)
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def corner_speed(p: MissionParams, theta: float, v: float) -> float:
+    """Speed (m/s) a multicopter passes a waypoint at whose legs turn by ``theta`` rad.
+
+    * PX4: √(a·R·tan(α/2)) with α = π − θ the angle between the legs, R = ``NAV_ACC_RAD``,
+      a = ``MPC_ACC_HOR``·``MPC_XY_TRAJ_P`` (``computeMaxSpeedInWaypoint``);
+    * ArduCopter 4.x: the arc that stays within R = ``WPNAV_RADIUS`` of the corner has radius
+      r = R/(1/cos(θ/2) − 1); speed √(a_c·r) with a_c = ``WPNAV_ACCEL_C`` (0: 2·``WPNAV_ACCEL``);
+    * ArduCopter 3.x passes a fast waypoint at full speed.
+    """
+    if theta < 1e-6:
+        return v
+    if theta >= math.pi - 1e-6:
+        return 0.0
+    if p.family == "px4-mc":
+        a = p["MPC_ACC_HOR"] * p["MPC_XY_TRAJ_P"]  # max_acc_xy_radius_scale
+        return min(v, math.sqrt(a * p["NAV_ACC_RAD"] * math.tan((math.pi - theta) / 2)))
+    if p.family == "arducopter":
+        if (p.major or 4) <= 3:
+            return v
+        a_c = p["WPNAV_ACCEL_C"] or 2.0 * p["WPNAV_ACCEL"]
+        r = p["WPNAV_RADIUS"] / (1.0 / math.cos(theta / 2) - 1.0)
+        return min(v, math.sqrt(a_c * r))
+    return v
+
+
+def predict_mission(
+    plan: MissionPlan,
+    params: MissionParams,
+    *,
+    home_amsl_m: float | None = None,
+    start_ne: tuple[float, float] | None = None,
+    start_height_m: float = 0.0,
+    origin: tuple[float, float] | None = None,
+) -> MissionPrediction:
+    """When each item of ``plan`` is reached and when the mission ends, as the autopilot
+    family of ``params`` flies it (see the module docs).
+
+    Parameters
+    ----------
+    plan : MissionPlan
+        The mission (``DO_JUMP`` expanded, ``DO_CHANGE_SPEED`` applied).
+    params : MissionParams
+        From :func:`mission_params`.
+    home_amsl_m : float, optional
+        Home altitude AMSL (m), for items in AMSL; default the plan's home.
+    start_ne, start_height_m : the vehicle's position at the start, north/east m from
+        ``origin`` and height above home (default: at home, on the ground).
+    origin : (lat, lon), optional
+        The local frame's origin (default home, else the first positioned item).
+
+    Raises
+    ------
+    InputError
+        A plan without positioned items, or an unlimited loiter (the mission has no end time).
+    """
+    p = params
+    home = plan.home
+    if home_amsl_m is None and home is not None and math.isfinite(home.alt_amsl_m):
+        home_amsl_m = home.alt_amsl_m
+    seq = flight_sequence(plan)
+    first = next((i for i in seq if plan.items[i].has_position), None)
+    if origin is None:
+        if home is not None:
+            origin = (home.lat_deg, home.lon_deg)
+        elif first is not None:
+            origin = (plan.items[first].lat_deg, plan.items[first].lon_deg)
+        else:
+            raise InputError(f"{plan.source}: no item with a position")
+    pos = _local(plan, origin)
+    home_ne = np.zeros(2) if home is not None else (pos[first] if first is not None else np.zeros(2))
+    s = _State(np.array(start_ne if start_ne is not None else home_ne, dtype=float), float(start_height_m))
+    s.airborne = start_height_m > 0.5
+    cruise = p.cruise_ms
+    out_items: list[int] = []
+    out_cmds: list[int] = []
+    out_t: list[float] = []
+    landed = False
+
+    def next_nav_after(k: int) -> int | None:
+        later = [j for j in seq[k + 1 :] if plan.items[j].command < 95]
+        return later[0] if later else None
+
+    for k, i in enumerate(seq):
+        it = plan.items[i]
+        cmd = it.command
+        if cmd == MAV_CMD_DO_CHANGE_SPEED:
+            if it.speed_ms is not None:
+                cruise = it.speed_ms
+            continue
+        if cmd >= 95 and cmd != MAV_CMD_NAV_DELAY:
+            continue  # other DO_/CONDITION_ items run alongside the navigation
+        if cmd == MAV_CMD_NAV_DELAY:
+            s.t += max(it.params[0], 0.0) if math.isfinite(it.params[0]) else 0.0
+        elif cmd in (MAV_CMD_NAV_TAKEOFF, MAV_CMD_NAV_VTOL_TAKEOFF):
+            h1 = _height(plan, i, home_amsl_m, s.h)
+            if i in pos and p.family != "plane":
+                s.ne = pos[i]
+            s.t += _climb_time(
+                p, max(h1 - s.h, 0.0), vtol=cmd == MAV_CMD_NAV_VTOL_TAKEOFF, ground=not s.airborne
+            )
+            s.h, s.v, s.airborne = max(h1, s.h), 0.0, True
+        elif cmd in (MAV_CMD_NAV_WAYPOINT, MAV_CMD_NAV_SPLINE_WAYPOINT, MAV_CMD_NAV_LOITER_TIME,
+                     MAV_CMD_NAV_LOITER_TURNS, MAV_CMD_NAV_LOITER_UNLIM):  # fmt: skip
+            if cmd == MAV_CMD_NAV_LOITER_UNLIM:
+                raise InputError(
+                    f"{plan.source}: item {i} loiters without limit: the mission has no end time"
+                )
+            target = pos.get(i, s.ne)
+            h1 = _height(plan, i, home_amsl_m, s.h)
+            if p.family == "px4-mc" and not s.airborne:
+                # PX4's navigator inserts a take-off to the first waypoint's altitude when the
+                # mission starts on the ground (Mission::do_need_vertical_takeoff)
+                s.t += _climb_time(p, max(h1 - s.h, 0.0), vtol=False, ground=True)
+                s.h, s.airborne = h1, True
+            hold = it.hold_s if cmd != MAV_CMD_NAV_LOITER_TURNS else 0.0
+            nxt = next_nav_after(k)
+            v_out = 0.0
+            if p.family == "plane":
+                v_out = cruise
+            elif nxt is not None and hold == 0.0 and cmd == MAV_CMD_NAV_WAYPOINT:
+                nc = plan.items[nxt].command
+                if nc in (MAV_CMD_NAV_WAYPOINT, MAV_CMD_NAV_SPLINE_WAYPOINT) and nxt in pos:
+                    theta = _turn_angle(s.ne, target, pos[nxt])
+                    v_out = corner_speed(p, theta, cruise)
+            _leg(p, s, target, h1, cruise, v_out)
+            if p.family == "px4-mc":
+                _px4_yaw(p, s, it.params[3])
+            if cmd == MAV_CMD_NAV_LOITER_TURNS:
+                turns = it.params[0] if math.isfinite(it.params[0]) else 1.0
+                radius = abs(it.params[2]) if math.isfinite(it.params[2]) and it.params[2] != 0 else 60.0
+                s.t += abs(turns) * 2 * math.pi * radius / max(cruise, 0.1)
+            out_items.append(i)
+            out_cmds.append(cmd)
+            out_t.append(s.t)
+            s.t += hold if math.isfinite(hold) else 0.0
+            if hold > 0:
+                s.v = 0.0
+            continue
+        elif cmd in (MAV_CMD_NAV_LAND, MAV_CMD_NAV_VTOL_LAND):
+            target = pos.get(i, s.ne)
+            # PX4 starts the descent once within NAV_ACC_RAD of the landing point
+            _leg(p, s, target, s.h, cruise, 0.0, accept=p.family == "px4-mc")
+            s.v = 0.0
+            if p.family == "plane":
+                s.t += p["Q_TRANSITION_MS"]
+            s.t += _land_time(p, s.h, vtol=cmd == MAV_CMD_NAV_VTOL_LAND)
+            s.h, landed = 0.0, True
+        elif cmd == MAV_CMD_NAV_RETURN_TO_LAUNCH:
+            landed = _rtl(p, s, home_ne, cruise)
+        else:
+            continue
+        out_items.append(i)
+        out_cmds.append(cmd)
+        out_t.append(s.t)
+        if landed and any(plan.items[j].command in (MAV_CMD_NAV_VTOL_TAKEOFF, MAV_CMD_NAV_TAKEOFF)
+                          for j in seq[k + 1:]):  # fmt: skip
+            landed, s.airborne = False, False  # the mission takes off again
+        elif landed:
+            break
+    return MissionPrediction(
+        tuple(out_items), tuple(out_cmds), np.asarray(out_t, dtype=float), float(s.t), landed, p
+    )
+
+
+def _px4_yaw(p: MissionParams, s: _State, yaw_deg: float) -> None:
+    """PX4 accepts a waypoint with a heading only once the heading is within ``MIS_YAW_ERR``
+    (or after ``MIS_YAW_TMT`` when ≥ 0); the heading turns at ``MPC_YAWRAUTO_MAX``."""
+    if not math.isfinite(yaw_deg):
+        return
+    want = math.radians(yaw_deg)
+    if math.isfinite(s.heading):
+        err = abs(_wrap(want - s.heading)) - math.radians(p["MIS_YAW_ERR"])
+        if err > 0:
+            wait = err / math.radians(p["MPC_YAWRAUTO_MAX"])
+            if p["MIS_YAW_TMT"] >= 0:
+                wait = min(wait, p["MIS_YAW_TMT"])
+            s.t += wait
+    s.heading = want
+
+
+def _tail_time(r: float, v_end: float, v_peak: float, decel: float) -> float:
+    """Time (s) a speed profile that slows to ``v_end`` at ``decel`` spends on its last ``r`` m."""
+    if r <= 0:
+        return 0.0
+    v_r = min(math.sqrt(v_end * v_end + 2.0 * decel * r), max(v_peak, v_end))
+    d_dec = (v_r * v_r - v_end * v_end) / (2.0 * decel)
+    return (v_r - v_end) / decel + max(r - d_dec, 0.0) / max(v_r, 1e-9)
+
+
+def _leg(
+    p: MissionParams, s: _State, target: np.ndarray, h1: float, cruise: float, v_out: float,
+    accept: bool = True,
+) -> None:  # fmt: skip
+    """Fly the state to (``target``, ``h1``): the time of the leg up to the moment the
+    autopilot accepts the waypoint, and the state there.
+
+    PX4 accepts within ``NAV_ACC_RAD`` horizontally and ``NAV_MC_ALT_RAD`` vertically and goes
+    on from there; ArduCopter's waypoint controller moves a target that reaches the waypoint
+    first (its acceptance is the target's arrival); a plane accepts within ``WP_RADIUS``."""
+    u = np.asarray(target, dtype=float) - s.ne
+    d = float(np.hypot(*u))
+    dz = h1 - s.h
+    up, dn, az = _vertical_limits(p)
+    vz = up if dz > 0 else dn
+    t_v = leg_time(abs(dz), vz, az)[0] if abs(dz) > 0 else 0.0
+    r_h = r_v = 0.0
+    if (
+        accept and p.family == "px4-mc"
+        and d <= p["NAV_ACC_RAD"] and abs(dz) <= p["NAV_MC_ALT_RAD"]
+    ):  # fmt: skip
+        return  # already within the acceptance radius: accepted at once
+    # the speed carried into the leg is the part along it; motion against it is stopped first
+    t_stop = 0.0
+    v0 = s.v
+    if v0 > 0 and s.vdir is not None and d > 1e-6:
+        along = v0 * float(np.dot(s.vdir, u / d))
+        a_stop = (
+            p["MPC_ACC_HOR"]
+            if p.family == "px4-mc"
+            else p["WPNAV_ACCEL"]
+            if p.family == "arducopter"
+            else 1.0
+        )
+        j_stop = p["MPC_JERK_AUTO"] if p.family == "px4-mc" else None
+        if along < 0:
+            t_stop = speed_change_time(-along, a_stop, j_stop)
+            d += 0.5 * (-along) * t_stop  # the overshoot flown back
+            v0 = 0.0
+        else:
+            v0 = along
+    if p.family == "plane":
+        a = 1.0
+        r_h = min(p["WP_RADIUS"], d) if accept else 0.0
+        t_h, v_end = d / max(cruise, 0.1), cruise
+        t_h -= r_h / max(cruise, 0.1)
+    elif p.family == "arducopter":
+        a = p["WPNAV_ACCEL"]
+        if (p.major or 4) <= 3:
+            a = 2.0 * a  # the 3.x target slows down at twice WPNAV_ACCEL (get_slow_down_speed)
+            t_h, v_end = leg_time(d, cruise, p["WPNAV_ACCEL"], None, v0, v_out, decel=a)
+        else:
+            t_h, v_end = leg_time(d, cruise, a, p["WPNAV_JERK"], v0, v_out)
+    else:
+        a, j = p["MPC_ACC_HOR"], p["MPC_JERK_AUTO"]
+        if accept:
+            r_h = min(p["NAV_ACC_RAD"], d)
+            r_v = min(p["NAV_MC_ALT_RAD"], abs(dz))
+            t_h, v_end = px4_leg_time(d, cruise, a, j, v0, v_out, p["NAV_ACC_RAD"], 1.0 / p["MPC_XY_P"])
+            t_v -= _tail_time(r_v, 0.0, vz, az)
+        else:
+            # to the point itself: the braking limit approaches it exponentially, so the leg
+            # ends 0.1 m before it
+            t_h, v_end = px4_leg_time(d, cruise, a, j, v0, 0.0, 0.1, 0.0)
+    t_h += t_stop
+    t = max(t_h, t_v, 0.0)
+    if d > 1e-6:
+        s.ne = s.ne + u * (1.0 - r_h / d)
+        s.vdir = u / d
+        if d > r_h:
+            s.heading = math.atan2(u[1], u[0])
+    s.h = h1 - math.copysign(r_v, dz) if r_v > 0 else h1
+    s.t += t
+    s.v = v_end
+
+
+def _vertical_limits(p: MissionParams) -> tuple[float, float, float]:
+    """Climb speed, descent speed (m/s), vertical acceleration (m/s²) for waypoint legs."""
+    if p.family == "arducopter":
+        return p["WPNAV_SPEED_UP"], p["WPNAV_SPEED_DN"], p["WPNAV_ACCEL_Z"]
+    if p.family == "px4-mc":
+        if p.sources.get("MPC_Z_V_AUTO_UP") == "log" or (p.major or 1) > 1 or p.minor >= 12:
+            return p["MPC_Z_V_AUTO_UP"], p["MPC_Z_V_AUTO_DN"], p["MPC_ACC_UP_MAX"]
+        return p["MPC_Z_VEL_MAX_UP"], p["MPC_Z_VEL_MAX_DN"], p["MPC_ACC_UP_MAX"]
+    return p["TECS_CLMB_MAX"], p["TECS_SINK_MAX"], 1.0
+
+
+def _climb_time(p: MissionParams, dz: float, *, vtol: bool, ground: bool) -> float:
+    if dz <= 0:
+        return 0.0
+    if p.family == "px4-mc":
+        # the take-off ramp raises the speed setpoint linearly over MPC_TKO_RAMP_T: half of it
+        # is lost against climbing at MPC_TKO_SPEED throughout
+        # on the ground: the motors spool up, then the take-off ramp raises the climb-speed
+        # setpoint over MPC_TKO_RAMP_T from the one that holds the vehicle down; the
+        # take-off is accepted within NAV_MC_ALT_RAD
+        lead = p["MPC_SPOOLUP_TIME"] + p["MPC_TKO_RAMP_T"] if ground else 0.0
+        return lead + max(dz - p["NAV_MC_ALT_RAD"], 0.0) / p["MPC_TKO_SPEED"]
+    if p.family == "plane":
+        if vtol:
+            t, _ = leg_time(dz, p["Q_WP_SPEED_UP"], p["Q_WP_ACCEL_Z"])
+            return t + p["Q_TRANSITION_MS"]
+        return dz / p["TECS_CLMB_MAX"]
+    up, _, az = _vertical_limits(p)
+    return leg_time(dz, up, az)[0]
+
+
+def _land_time(p: MissionParams, h: float, *, vtol: bool) -> float:
+    if p.family == "arducopter":
+        high = p["LAND_SPEED_HIGH"] or p["WPNAV_SPEED_DN"]
+        return banded_descent_time(h, high, p["LAND_SPEED"], p["LAND_ALT_LOW"])
+    if p.family == "px4-mc":
+        _, dn, _ = _vertical_limits(p)
+        return px4_land_time(h, dn, p["MPC_LAND_SPEED"], p["MPC_LAND_ALT1"], p["MPC_LAND_ALT2"])
+    return banded_descent_time(h, p["Q_WP_SPEED_DN"], p["Q_LAND_SPEED"], p["Q_LAND_FINAL_ALT"])
+
+
+def _rtl(p: MissionParams, s: _State, home_ne: np.ndarray, cruise: float) -> bool:
+    """Return to launch from the state (updating it); whether it ends on the ground."""
+    up, _, az = _vertical_limits(p)
+    if p.family == "arducopter":
+        rtl_alt = p["RTL_ALT"]
+        v = p["RTL_SPEED"] or p["WPNAV_SPEED"]
+        loiter, final = p["RTL_LOIT_TIME"], p["RTL_ALT_FINAL"]
+    elif p.family == "px4-mc":
+        rtl_alt, v = p["RTL_RETURN_ALT"], cruise
+        # RTL_LAND_DELAY < 0: hover at RTL_DESCEND_ALT instead of landing
+        loiter = max(p["RTL_LAND_DELAY"], 0.0)
+        final = p["RTL_DESCEND_ALT"] if p["RTL_LAND_DELAY"] < 0 else 0.0
+    else:
+        rtl_alt, v, loiter, final = s.h, cruise, 0.0, 0.0
+    if s.h < rtl_alt:
+        s.t += leg_time(rtl_alt - s.h, up, az)[0]
+        s.h = rtl_alt
+    s.v = 0.0
+    _leg(p, s, home_ne, s.h, v, 0.0, accept=False)
+    s.t += loiter
+    s.ne, s.v = home_ne.copy(), 0.0
+    if p.family == "px4-mc" and s.h > p["RTL_DESCEND_ALT"]:
+        _, dn, _ = _vertical_limits(p)
+        s.t += (s.h - p["RTL_DESCEND_ALT"]) / dn
+        s.h = p["RTL_DESCEND_ALT"]
+    if final > 0:
+        _, dn, _ = _vertical_limits(p)
+        s.t += max(s.h - final, 0.0) / dn
+        s.h = final
+        return False
+    s.t += _land_time(p, s.h, vtol=p.family == "plane")
+    s.h = 0.0
+    return True
+
+
+# --------------------------------------------------------------------------- baselines
+#: QGroundControl's offline-editing ascent and descent speeds (m/s): ``AppSettings.json``
+#: ``offlineEditingAscentSpeed`` 5, ``offlineEditingDescentSpeed`` 3.
+QGC_ASCENT_MS = 5.0
+QGC_DESCENT_MS = 3.0
+
+
+def qgc_mission_time(plan: MissionPlan, hover_speed_ms: float, home_amsl_m: float | None = None) -> float:
+    """QGroundControl's mission time (s) as ``MissionController::_recalcMissionFlightStatus``
+    computes it for a multicopter: a take-off first item climbs |Δalt| at the ascent speed
+    (:data:`QGC_ASCENT_MS`); every item with a coordinate adds its horizontal distance from the
+    previous one ÷ the hover speed (``DO_CHANGE_SPEED`` replaces it); every item adds its
+    ``additionalTimeDelay`` (a waypoint's or a timed loiter's hold); after an RTL item no more
+    items count and the way home adds its distance ÷ speed and |Δalt| ÷ the descent speed
+    (:data:`QGC_DESCENT_MS`). A land item adds no descent time.
+    """
+    from uasnav.trajectory.geometry import geodetic_to_local
+
+    speed = hover_speed_ms
+    t = 0.0
+    prev: tuple[float, float, float] | None = None
+    home = plan.home
+    first = True
+    home_h = 0.0
+    rtl = False
+    for i in flight_sequence(plan):
+        it = plan.items[i]
+        if it.speed_ms is not None:
+            speed = it.speed_ms
+            continue
+        if it.command == MAV_CMD_NAV_RETURN_TO_LAUNCH:
+            rtl = True
+            break
+        hold = it.hold_s
+        if math.isfinite(hold):
+            t += hold
+        if not it.has_position:
+            if first and it.command in (MAV_CMD_NAV_TAKEOFF, MAV_CMD_NAV_VTOL_TAKEOFF) and home is not None:
+                h = _height(plan, i, home_amsl_m, 0.0)
+                t += abs(h - home_h) / QGC_ASCENT_MS
+                prev = (home.lat_deg, home.lon_deg, h)
+                first = False
+            continue
+        h = _height(plan, i, home_amsl_m, prev[2] if prev else 0.0)
+        if first and it.command in (MAV_CMD_NAV_TAKEOFF, MAV_CMD_NAV_VTOL_TAKEOFF) and home is not None:
+            t += abs(h - home_h) / QGC_ASCENT_MS
+            prev = (home.lat_deg, home.lon_deg, home_h)
+        first = False
+        if prev is not None:
+            ne = geodetic_to_local(
+                np.array([it.lat_deg]), np.array([it.lon_deg]), np.zeros(1), origin=(prev[0], prev[1], 0.0)
+            )[0, :2]
+            t += float(np.hypot(*ne)) / speed
+        prev = (it.lat_deg, it.lon_deg, h)
+    if rtl and prev is not None and home is not None:
+        ne = geodetic_to_local(
+            np.array([home.lat_deg]), np.array([home.lon_deg]), np.zeros(1), origin=(prev[0], prev[1], 0.0)
+        )[0, :2]
+        t += float(np.hypot(*ne)) / speed + abs(prev[2]) / QGC_DESCENT_MS
+    return t
+
+
+def distance_over_speed_time(plan: MissionPlan, speed_ms: float, home_amsl_m: float | None = None) -> float:
+    """The naive estimate (s): the 3-D path length through the plan's items ÷ ``speed_ms``."""
+    params = MissionParams("plane", None, {**{k: d.value for k, d in PLANE_DEFAULTS.items()},
+                                           "AIRSPEED_CRUISE": speed_ms, "TECS_CLMB_MAX": speed_ms,
+                                           "TECS_SINK_MAX": speed_ms, "Q_WP_SPEED_UP": speed_ms,
+                                           "Q_WP_SPEED_DN": speed_ms, "Q_LAND_SPEED": speed_ms,
+                                           "Q_TRANSITION_MS": 0.0, "Q_WP_ACCEL_Z": 1e9,
+                                           "WP_RADIUS": 0.0})  # fmt: skip
+    try:
+        return predict_mission(plan, params, home_amsl_m=home_amsl_m).eta_s
+    except InputError:
+        return math.nan
+
+
+__all__ = [
+    "ARDUCOPTER_DEFAULTS",
+    "FAMILIES",
+    "PLANE_DEFAULTS",
+    "PX4_MC_DEFAULTS",
+    "Default",
+    "MissionParams",
+    "MissionPrediction",
+    "banded_descent_time",
+    "corner_speed",
+    "distance_over_speed_time",
+    "family_of",
+    "leg_time",
+    "mission_params",
+    "predict_mission",
+    "px4_land_time",
+    "qgc_mission_time",
+    "speed_change_time",
+]

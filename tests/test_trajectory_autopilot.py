@@ -1,0 +1,291 @@
+"""Mission execution models per autopilot family: closed forms against numerical simulation,
+the parameter defaults against their cited firmware sources, and the real flights."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from uasnav.cli import main
+from uasnav.io.mission_plan import HomePosition, MissionItem, MissionPlan
+from uasnav.trajectory import autopilot as ap
+from uasnav.trajectory.geometry import merge_short_legs
+
+
+# --- closed forms ---------------------------------------------------------------------------
+def _simulate_1d(d: float, v_max: float, a: float, decel: float, dt: float = 1e-4) -> float:
+    """Rest-to-rest point mass under a speed and acceleration limit, braking as late as it can
+    (the time-optimal bang-bang profile), integrated numerically."""
+    x = v = t = 0.0
+    while x < d - 1e-9:
+        brake = v * v / (2 * decel) >= d - x
+        acc = -decel if brake else (a if v < v_max else 0.0)
+        v = min(max(v + acc * dt, 0.0), v_max)
+        x += v * dt
+        t += dt
+        if brake and v <= 0.0:
+            break
+    return t
+
+
+@pytest.mark.parametrize(
+    ("d", "v", "a", "dec"), [(100.0, 5.0, 1.0, 1.0), (3.0, 5.0, 1.0, 1.0), (50.0, 5.0, 1.0, 2.0)]
+)
+def test_leg_time_is_the_time_optimal_profile(d: float, v: float, a: float, dec: float) -> None:
+    t, v_end = ap.leg_time(d, v, a, decel=dec)
+    assert v_end == 0.0
+    assert t == pytest.approx(_simulate_1d(d, v, a, dec), rel=0.01)
+    if d >= v * v / (2 * a) + v * v / (2 * dec):  # trapezoid: d/v + v/(2a) + v/(2·dec)
+        assert t == pytest.approx(d / v + v / (2 * a) + v / (2 * dec))
+    else:  # triangle
+        vp = math.sqrt(2 * d * a * dec / (a + dec))
+        assert t == pytest.approx(vp / a + vp / dec)
+
+
+def test_jerk_limited_speed_change() -> None:
+    # Δv ≥ a²/j: Δv/a + a/j; below it the acceleration never saturates: 2·√(Δv/j)
+    assert ap.speed_change_time(5.0, 1.0, 1.0) == pytest.approx(6.0)
+    assert ap.speed_change_time(0.5, 1.0, 1.0) == pytest.approx(2 * math.sqrt(0.5))
+    # numerically: jerk ±j up to a, the distance covered equals (v0 + v1)/2 · T
+    j, a, dv, dt = 2.0, 1.5, 4.0, 1e-5
+    t_ramp = a / j
+    t_total = ap.speed_change_time(dv, a, j)
+    ts = np.arange(0.0, t_total, dt)
+    acc = np.minimum(np.minimum(j * ts, a), j * (t_total - ts))
+    assert np.sum(acc) * dt == pytest.approx(dv, rel=1e-3)
+    assert t_ramp < t_total / 2
+
+
+def test_px4_braking_law_closed_form() -> None:
+    a, j = 3.0, 4.0
+    # computeMaxSpeedFromDistance: v = ½(−b + √(b² + 8ad + 4v_f²)), b = 4a²/j
+    b = 4 * a * a / j
+    for d, vf in ((4.4, 0.0), (20.0, 1.0)):
+        assert ap.px4_max_speed_from_distance(d, a, j, vf) == pytest.approx(
+            0.5 * (-b + math.sqrt(b * b + 8 * a * d + 4 * vf * vf))
+        )
+    # the time along the law equals ∫ dd / v(d), numerically
+    d1, d2 = 10.0, 1.0
+    dd = np.linspace(d2, d1, 200_001)
+    v = np.array([ap.px4_max_speed_from_distance(x, a, j) for x in dd[::100]])
+    t_num = np.trapezoid(1.0 / v, dd[::100])
+    assert ap.px4_braking_time(d1, d2, a, j) == pytest.approx(t_num, rel=1e-4)
+
+
+def test_landing_speed_profiles() -> None:
+    # ArduCopter: 10 m at WPNAV_SPEED_DN above LAND_ALT_LOW, the rest at LAND_SPEED
+    assert ap.banded_descent_time(20.0, 1.5, 0.5, 10.0) == pytest.approx(10 / 1.5 + 10 / 0.5)
+    assert ap.banded_descent_time(5.0, 1.5, 0.5, 10.0) == pytest.approx(10.0)
+    # PX4: linear blend between MPC_LAND_ALT1 and ALT2, integrated numerically
+    h, vdn, vl, a1, a2 = 30.0, 1.5, 0.7, 10.0, 5.0
+    z = np.linspace(0.0, h, 300_001)
+    v = np.where(z > a1, vdn, np.where(z < a2, vl, vl + (vdn - vl) * (z - a2) / (a1 - a2)))
+    assert ap.px4_land_time(h, vdn, vl, a1, a2) == pytest.approx(np.trapezoid(1 / v, z), rel=1e-5)
+
+
+def test_corner_speeds() -> None:
+    px4 = ap.mission_params("px4-mc", "1.14.0", {"NAV_ACC_RAD": 2.0})
+    # √(a·TRAJ_P·R·tan(α/2)), α = π − θ: a 90° turn gives tan(45°) = 1
+    assert ap.corner_speed(px4, math.pi / 2, 10.0) == pytest.approx(math.sqrt(3.0 * 0.5 * 2.0))
+    assert ap.corner_speed(px4, 0.0, 5.0) == 5.0 and ap.corner_speed(px4, math.pi, 5.0) == 0.0
+    ac4 = ap.mission_params("arducopter", "4.5.7")
+    r = 2.0 / (1 / math.cos(math.pi / 4) - 1)  # the arc within WPNAV_RADIUS of the corner
+    assert ap.corner_speed(ac4, math.pi / 2, 10.0) == pytest.approx(math.sqrt(2 * 2.5 * r))
+    ac3 = ap.mission_params("arducopter", "3.6.12")
+    assert ap.corner_speed(ac3, math.pi / 2, 5.0) == 5.0  # a 3.x fast waypoint
+
+
+# --- defaults against their citations -------------------------------------------------------
+_UNIT_SCALE = {"cm/s²": 0.01, "cm/s": 0.01, "cm": 0.01, "ms": 0.001}
+
+
+@pytest.mark.parametrize(
+    "table", [ap.ARDUCOPTER_DEFAULTS["3"], ap.ARDUCOPTER_DEFAULTS["4"], ap.PX4_MC_DEFAULTS, ap.PLANE_DEFAULTS]
+)
+def test_defaults_match_their_cited_source(table: dict[str, ap.Default]) -> None:
+    for name, d in table.items():
+        # "<file> <version>: <NAME> <number> <unit>": the number, in the firmware's unit, is the value
+        m = re.search(r":\s*[A-Z_0-9]+ (−?[\d.]+)\s*(cm/s²|cm/s|cm|ms|m/s³|m/s²|m/s|m|s|°/s|°)?", d.source)
+        assert m is not None, d.source
+        number = float(m.group(1).replace("−", "-"))
+        assert d.value == pytest.approx(number * _UNIT_SCALE.get(m.group(2) or "", 1.0)), (name, d.source)
+        assert re.search(r"\.(cpp|c|h)\b", d.source) and re.search(r"\d\.\d", d.source), d.source
+
+
+def test_log_parameters_win_and_are_converted() -> None:
+    p = ap.mission_params("arducopter", "3.5.7", {"WPNAV_SPEED": 500.0, "WPNAV_ACCEL": 100.0})
+    assert p["WPNAV_SPEED"] == 5.0 and p.sources["WPNAV_SPEED"] == "log"
+    assert p.sources["LAND_SPEED"].startswith("ArduCopter/Parameters.cpp Copter-3.6")
+    # PX4 before 1.12 climbs at MPC_Z_VEL_MAX_UP in AUTO, from 1.12 at MPC_Z_V_AUTO_UP
+    old = ap.mission_params("px4-mc", "1.11.0", {"MPC_Z_VEL_MAX_DN": 1.0})
+    new = ap.mission_params("px4-mc", "1.14.0", {"MPC_Z_V_AUTO_DN": 2.0})
+    assert ap._vertical_limits(old)[1] == 1.0 and ap._vertical_limits(new)[1] == 2.0
+    with pytest.raises(Exception, match="unknown autopilot family"):
+        ap.mission_params("betaflight")
+
+
+# --- whole missions, simulated --------------------------------------------------------------
+def _plan(items: list[MissionItem]) -> MissionPlan:
+    return MissionPlan(items=tuple(items), home=HomePosition(47.0, 8.0, 400.0))
+
+
+def _north(m: float) -> float:
+    return 47.0 + m / 111_195.0  # about a metre of latitude
+
+
+def test_arducopter_3x_mission_is_the_sum_of_its_closed_forms() -> None:
+    p = ap.mission_params("arducopter", "3.6.0")  # defaults: 5 m/s, 1 m/s², up 2.5, dn 1.5
+    plan = _plan(
+        [
+            MissionItem(22, 3, alt_m=20.0),
+            MissionItem(16, 3, lat_deg=_north(100.0), lon_deg=8.0, alt_m=20.0),
+            MissionItem(21, 3, alt_m=0.0),
+        ]
+    )
+    r = ap.predict_mission(plan, p)
+    t_takeoff = ap.leg_time(20.0, 2.5, 1.0)[0]
+    t_leg = ap.leg_time(100.0, 5.0, 1.0, decel=2.0)[0]
+    t_land = 10 / 1.5 + 10 / 0.5
+    assert r.arrive_s == pytest.approx([t_takeoff, t_takeoff + t_leg, t_takeoff + t_leg + t_land], rel=2e-3)
+    assert r.landed and r.eta_s == pytest.approx(r.arrive_s[-1])
+
+
+def test_px4_mission_simulated_point_mass() -> None:
+    """A PX4 leg against a numerical point mass that follows the braking law with the
+    acceleration limit, accepted NAV_ACC_RAD before the waypoint."""
+    p = ap.mission_params("px4-mc", "1.14.0", {"NAV_ACC_RAD": 2.0, "MPC_XY_P": 1e9})
+    d, a, j, v_max = 60.0, 3.0, 4.0, 5.0
+    x = v = t = 0.0
+    dt = 1e-4
+    acc = 0.0
+    while d - x > 2.0:
+        lim = min(v_max, ap.px4_max_speed_from_distance(d - x, a, j))
+        want = min(v + a * dt, lim)
+        acc_new = (want - v) / dt
+        acc = min(acc_new, acc + j * dt) if acc_new > acc else acc_new  # jerk while speeding up
+        v += acc * dt
+        x += v * dt
+        t += dt
+    plan = _plan([MissionItem(16, 3, lat_deg=_north(d), lon_deg=8.0, alt_m=10.0)])
+    r = ap.predict_mission(plan, p, start_height_m=10.0)
+    assert r.arrive_s[0] == pytest.approx(t, rel=0.02)
+
+
+def test_quadplane_dalby_plan_predicts(shared_data: Path) -> None:
+    plan = shared_data / "missions" / "ardupilot_autotest_dalby_obc2016.waypoints"
+    r = CliRunner().invoke(main, ["trajectory", "mission", str(plan), "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["autopilot"] == "plane" and out["landed"]
+    # km-long legs at 12–24 m/s with a DO_JUMP loop repeated four times: most of an hour
+    assert 1800 < out["eta_s"] < 7200
+    assert out["parameters"]["AIRSPEED_CRUISE"]["source"].startswith("ArduPlane/Parameters.cpp")
+    # VTOL take-off (84) and landing (85) are items with times
+    assert {84, 85} <= {i["command"] for i in out["items"]}
+
+
+def test_short_legs_merge() -> None:
+    plan = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 1.85], [200.0, 1.85], [201.0, 1.85]])
+    merged, idx = merge_short_legs(plan, 10.0)
+    assert merged.tolist() == [[0.0, 0.0], [100.0, 0.0], [201.0, 1.85]]
+    assert idx.tolist() == [0, 1, 2, 2, 2]
+
+
+# --- real flights ---------------------------------------------------------------------------
+def test_real_px4_mission_evaluates_without_options(shared_data: Path) -> None:
+    from uasnav.trajectory.mission_runs import MODEL, QGC, evaluate_logs
+
+    r = evaluate_logs([shared_data / "flights" / "px4_s500_mission_land.ulg"])
+    (run,) = r["runs"]
+    assert run["stack"].startswith("px4-mc 1.11") and run["landed"]
+    assert len(run["waypoint_errors"]) == 11  # navigator_mission_item v1.11 layout read
+    e = abs(run["eta_pred_s"][MODEL] - run["eta_real_s"]) / run["eta_real_s"]
+    e_qgc = abs(run["eta_pred_s"][QGC] - run["eta_real_s"]) / run["eta_real_s"]
+    assert e <= 0.15 and e_qgc >= 2 * e
+    assert r["parameters"][str(shared_data / "flights" / "px4_s500_mission_land.ulg")]["NAV_ACC_RAD"] == {
+        "value": 2.0,
+        "source": "log",
+    }
+
+
+def test_arducopter_4x_rtl_closed_form_and_final_altitude_hover() -> None:
+    items = [
+        MissionItem(22, 3, alt_m=20.0),
+        MissionItem(16, 3, lat_deg=_north(100.0), lon_deg=8.0, alt_m=20.0),
+        MissionItem(20, 2),
+    ]
+    p = ap.mission_params("arducopter", "4.5.7")  # 10 m/s, 2.5 m/s², jerk 1 m/s³; RTL_ALT 15 m
+    r = ap.predict_mission(_plan(items), p)
+    t_leg = ap.leg_time(100.0, 10.0, 2.5, 1.0)[0]
+    # already above RTL_ALT: back at WPNAV_SPEED, RTL_LOIT_TIME 5 s, land 10 m at 1.5 + 10 m at 0.5
+    assert r.eta_s - r.arrive_s[1] == pytest.approx(t_leg + 5.0 + 10 / 1.5 + 10 / 0.5, rel=2e-3)
+    assert r.landed
+    hover = ap.mission_params("arducopter", "4.5.7", {"RTL_ALT_FINAL": 500.0})
+    h = ap.predict_mission(_plan(items), hover)
+    assert not h.landed and h.eta_s - h.arrive_s[1] == pytest.approx(t_leg + 5.0 + 15 / 1.5, rel=2e-3)
+
+
+def test_time_bounds_from_the_vehicles_own_flights(shared_data: Path) -> None:
+    from uasnav.errors import InputError
+    from uasnav.trajectory.mission_runs import calibrate_from_flights, simulated_scores
+
+    ulg = shared_data / "flights" / "px4_s500_mission_land.ulg"
+    b = calibrate_from_flights([ulg])
+    assert b.n_runs == 1 and "1 AUTO runs of the vehicle (px4_s500_mission_land.ulg)" == b.source
+    # one run cannot give 95 % coverage (19 are needed): refused, not a silent band
+    with pytest.raises(InputError, match="at least 19 calibration runs"):
+        b.quantile(0.95)
+    assert b.quantile(0.5) == b.scores[0]
+    # without flights: simulated executions of the plan; the nominal parameters score 0
+    p = ap.mission_params("arducopter", "4.5.7")
+    plan = _plan([MissionItem(22, 3, alt_m=20.0), MissionItem(21, 3, alt_m=0.0)])
+    s = simulated_scores(plan, p, n_runs=50, seed=1)
+    assert s.shape == (50,) and np.all(s >= 0) and np.all(s < 1.0) and s.max() > 0
+
+
+def test_px4_auto_vertical_speeds_win_in_the_limits() -> None:
+    from uasnav.io.autopilot_params import PX4_PARAMS, limits_from_params
+
+    lim = limits_from_params(
+        {"MPC_Z_V_AUTO_UP": 2.0, "MPC_Z_VEL_MAX_UP": 3.0, "MPC_Z_VEL_MAX_DN": 1.0}, PX4_PARAMS
+    )
+    assert lim.climb_ms == 2.0 and lim.descent_ms == 1.0  # 1.11 logs have only the _VEL_MAX_ pair
+
+
+def test_evaluate_cli_on_a_px4_log_keeps_the_keys_and_adds_waypoints(shared_data: Path) -> None:
+    ulg = shared_data / "flights" / "px4_s500_mission_land.ulg"
+    r = CliRunner().invoke(main, ["trajectory", "evaluate", str(ulg), "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["default_method"] == "autopilot model"
+    m = out["methods"]["autopilot model"]
+    assert m["applicable"] and m["run_abs_e_pct_median"] <= 15.0 and len(m["run_e_pct"]) == 1
+    assert out["methods"]["QGroundControl estimate"]["run_abs_e_pct_median"] >= 2 * m["run_abs_e_pct_median"]
+    (run,) = out["runs"]
+    assert [w["item"] for w in run["waypoint_errors"]] == list(range(11))
+    assert all(abs(w["error_s"]) < 5.0 for w in run["waypoint_errors"])
+    tb = out["time_bounds"]
+    assert tb["n_runs"] == 1 and 0.0 <= tb["covered_ci95"][0] < tb["covered_ci95"][1] <= 1.0
+    # the element methods need waypoints in the telemetry, which a PX4 log keeps out of it
+    assert "no waypoints in the telemetry" in out["element_methods"]
+    r = CliRunner().invoke(main, ["trajectory", "evaluate", str(ulg)])
+    assert r.exit_code == 0 and "autopilot model" in r.output and "Clopper–Pearson" in r.output
+
+
+def test_web_prediction_takes_the_dalby_plan_with_its_short_vtol_leg(shared_data: Path) -> None:
+    from uasnav.web.default_model import default_model
+    from uasnav.web.prediction import predict_plan, read_uploaded_plan
+
+    data = (shared_data / "missions" / "ardupilot_autotest_dalby_obc2016.waypoints").read_bytes()
+    up = read_uploaded_plan("dalby.waypoints", data)
+    legs = np.hypot(*np.diff(up.route_ne, axis=0).T)
+    assert legs.min() < 10.0  # the VTOL landing's 1.85 m leg, shorter than L
+    r = predict_plan(default_model(), up.route_ne, up.origin, 3.0, 0.0, 20.0, "default")
+    times = [w["time_s"] for w in r.waypoints]
+    assert len(times) == len(up.route_ne) and np.all(np.diff(times) >= 0) and r.eta_s > 0
