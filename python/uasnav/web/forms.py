@@ -59,6 +59,8 @@ OPERATOR_HELP: dict[str, str] = {
     "resolution": "Ground size of one image pixel you need (0.05 m = 5 cm per pixel).",
     "image_size": "Ground one image must cover, length × width, e.g. 70x70.",
     "altitude": "Planned height above the ground (the open category allows up to 120 m).",
+    "camera_height": "Height at which the cameras' resolution and field of view are checked: the "
+    "height you fly (planned), or the highest the rules allow (regulatory-max, the thesis' test).",
     "imagery": "The kind of camera the task needs, or any.",
     "wind": "Strongest wind expected during the flight.",
     "rain": "The aircraft must be able to fly in rain.",
@@ -99,6 +101,12 @@ OPERATOR_HELP: dict[str, str] = {
 }
 
 
+def operator_help(opt: SelectOption) -> str:
+    """``opt``'s help in the operator's words: what the page, ``/api/options`` and the OpenAPI
+    description show (the command line keeps the option table's own)."""
+    return OPERATOR_HELP.get(opt.name, opt.help)
+
+
 def is_field(opt: SelectOption) -> bool:
     """Whether ``opt`` is a form field (and an API key)."""
     return opt.kind not in NOT_FIELDS and not opt.kind.startswith("output")
@@ -133,7 +141,7 @@ class FormField:
     @property
     def help(self) -> str:
         """The field's help in the operator's words (the option's own help otherwise)."""
-        return OPERATOR_HELP.get(self.name, self.option.help)
+        return operator_help(self.option)
 
     @property
     def core(self) -> bool:
@@ -319,6 +327,7 @@ __all__ = [
     "file_value",
     "form_fields",
     "is_field",
+    "operator_help",
     "pair_values",
     "plan_values",
     "values_from_form",

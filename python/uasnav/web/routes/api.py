@@ -73,7 +73,7 @@ def select_schema() -> dict[str, Any]:
     for o in select_request.SELECT_OPTIONS:
         if not forms.is_field(o):
             continue
-        s: dict[str, Any] = {"description": o.help + (f" Unit: {o.unit}." if o.unit else "")}
+        s: dict[str, Any] = {"description": forms.operator_help(o) + (f" Unit: {o.unit}." if o.unit else "")}
         if o.kind in kind_types:
             s["type"] = kind_types[o.kind]
         if o.minimum is not None:
@@ -157,7 +157,7 @@ def api_options() -> Response:
                 "maximum": o.maximum,
                 "choices": list(o.choices) if o.choices else None,
                 "label": o.label,
-                "help": o.help,
+                "help": forms.operator_help(o),
             }
             for o in select_request.SELECT_OPTIONS
             if forms.is_field(o)
