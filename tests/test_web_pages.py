@@ -56,6 +56,45 @@ def test_help_is_in_the_operators_words(client) -> None:
         assert "http(s) URL" not in h and "path or" not in h, h
 
 
+def test_api_help_is_in_the_operators_words(client) -> None:
+    """``/api/options`` and the OpenAPI description give the form's help, not the CLI's."""
+    options = client.get("/api/options").json()
+    schema = client.get("/openapi.json").json()["paths"]["/api/select"]["post"]["requestBody"]
+    props = schema["content"]["application/json"]["schema"]["properties"]
+    assert {o["name"] for o in options} == set(props) == forms.field_names()
+    for o in options:
+        for text in (o["help"], props[o["name"]]["description"]):
+            assert not re.search(r"--[a-z]", text), (o["name"], text)
+            assert "http(s) URL" not in text and "path or" not in text, (o["name"], text)
+            assert "Table 2" not in text and "eq. " not in text, (o["name"], text)  # no thesis references
+    assert {o["name"]: o["help"] for o in options}["camera_height"] == forms.OPERATOR_HELP["camera_height"]
+
+
+def test_summary_from_column_names_fields_and_the_area(client) -> None:
+    """The authorisation summary's "from" column in the form's words; a pilot distance measured
+    on the uploaded area says so (it was not typed)."""
+    r = client.post("/select", data={"range": "", "altitude": "50"}, files={"area": ("field.geojson", AREA)})
+    assert r.status_code == 200
+    froms = from_column(r.text)
+    assert froms["visibility"].startswith("the area&#x27;s farthest point from the pilot position = ")
+    assert all(not re.search(r"--[a-z]", src) for src in froms.values()), froms
+    assert froms["height"] == "“Altitude” = 50 m"
+    typed = client.post(
+        "/select",
+        data={"range": "", "altitude": "50", "max_distance": "300"},
+        files={"area": ("f.geojson", AREA)},
+    )
+    assert from_column(typed.text)["visibility"].startswith("“Max pilot distance” = 300 m")
+
+
+def from_column(html: str) -> dict[str, str]:
+    """The authorisation summary's derivation table: fact → its "from" cell."""
+    cells = r"<td data-label='{}'>([^<]*)</td>"
+    rows = re.findall(cells.format("fact") + cells.format("value") + cells.format("from"), html)
+    assert rows
+    return {name: src for name, _, src in rows}
+
+
 def test_empty_required_field_is_answered_beside_it(client) -> None:
     r = client.post("/select", data={"range": "", "resolution": "0.02", "wind": "7"})
     assert r.status_code == 422

@@ -9,6 +9,7 @@ The selector itself reaches the routes through the context too (``run_select``,
 from __future__ import annotations
 
 import base64
+import dataclasses
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -179,6 +180,30 @@ def plain(text: Any) -> str:
         return f"“{labels[m.group(0)]}”" if m.group(0) in labels else m.group(0)
 
     return _OPTION_NAME.sub(label, str(text))
+
+
+#: Where the pilot distance comes from when an area was uploaded and no distance typed.
+AREA_DISTANCE_WORDS = "the area's farthest point from the pilot position"
+
+
+def in_operator_words(selection: Any, typed: Mapping[str, Any]) -> Any:
+    """``selection`` whose operation derivation (the authorisation summary's "from" column)
+    names the form's fields instead of command-line options, and says when the pilot distance
+    was measured on the uploaded area rather than typed. ``typed``: the values the operator
+    entered. The API's answer keeps the selector's own wording."""
+    op = getattr(selection, "operation", None)
+    if op is None:
+        return selection
+    from_area = typed.get("max_distance") in (None, "") and selection.requirements.max_distance_m is not None
+
+    def words(text: str) -> str:
+        text = text.replace("--range (no --max-distance given)", "--range (no pilot distance given)")
+        if from_area:
+            text = text.replace("--max-distance", AREA_DISTANCE_WORDS)
+        return plain(text)
+
+    facts = tuple(dataclasses.replace(f, requirement=words(f.requirement)) for f in op.derivation)
+    return dataclasses.replace(selection, operation=dataclasses.replace(op, derivation=facts))
 
 
 def auto_num(x: Any) -> str:

@@ -29,6 +29,7 @@ from uasnav.web.context import (
     data_uri,
     download,
     field_of,
+    in_operator_words,
     read_form,
     web_context,
 )
@@ -94,15 +95,17 @@ def run_view(ctx: WebContext, values: dict[str, Any], files: dict[str, Any]) -> 
         "ranking": data_uri("text/csv", selection_view.ranking_csv(sel)),
         "rejections": data_uri("text/csv", selection_view.rejections_csv(sel)),
     }
-    # the authorisation summary is the page's print view: one document, one renderer
-    downloads["summary_html"] = data_uri("text/html", summary.summary_html(selection))
+    # the authorisation summary is the page's print view: one document, one renderer, in the
+    # form's words
+    shown = in_operator_words(selection, values)
+    downloads["summary_html"] = data_uri("text/html", summary.summary_html(shown))
     downloads["summary_json"] = data_uri(
-        "application/json", json.dumps(summary.summary_dict(selection), ensure_ascii=False, indent=2)
+        "application/json", json.dumps(summary.summary_dict(shown), ensure_ascii=False, indent=2)
     )
     onboard = {x["id"]: x["state"] for x in sel["chosen_equipment"] or []}
     return {
         "sel": sel,
-        "summary": Markup(summary.summary_fragment(selection)),
+        "summary": Markup(summary.summary_fragment(shown)),
         "onboard": onboard,
         "equipment": equipment,
         "plots": selection_view.transfer_plots(sel, req.targets, ctx.docs.database),
