@@ -197,7 +197,6 @@ def in_operator_words(selection: Any, typed: Mapping[str, Any]) -> Any:
     from_area = typed.get("max_distance") in (None, "") and selection.requirements.max_distance_m is not None
 
     def words(text: str) -> str:
-        text = text.replace("--range (no --max-distance given)", "--range (no pilot distance given)")
         if from_area:
             text = text.replace("--max-distance", AREA_DISTANCE_WORDS)
         return plain(text)

@@ -4,10 +4,18 @@
   document.documentElement.classList.add("js");
 
   // After a run, the answer (or the list of fields to correct) takes the focus, so a keyboard
-  // or screen-reader user lands on it rather than at the top of the form.
-  var landing = document.getElementById("form-error") ||
-    (location.hash ? document.getElementById(location.hash.slice(1)) : null);
-  if (landing && landing.matches("#form-error, #results, #prediction")) {
+  // or screen-reader user lands on it rather than at the top of the form. The script lands the
+  // page itself, once, and only if nothing has been focused yet: the forms then post to a URL
+  // without the "#results" fragment they carry for browsers without scripts, whose own
+  // fragment focus comes at a time of the browser's choosing (after the page's render-blocking
+  // resources) and would take the focus back from whatever the user had moved it to.
+  document.querySelectorAll("form[data-lands]").forEach(function (form) {
+    form.setAttribute("action", form.getAttribute("action").split("#")[0]);
+  });
+  var landing = document.getElementById("form-error") || document.getElementById("results") ||
+    document.getElementById("prediction");
+  var untouched = !document.activeElement || document.activeElement === document.body;
+  if (landing && untouched) {
     if (!landing.hasAttribute("tabindex")) landing.tabIndex = -1;
     landing.focus();
   }
