@@ -466,6 +466,53 @@ def test_area_upload_map_results_downloads(pages, server, tmp_path) -> None:
         assert result["survey"]["lines"] == page.locator("svg.map polyline.survey").count()
 
 
+def test_map_click_places_takeoff_and_pilot(pages, server, tmp_path) -> None:
+    """A click on the offline map fills the take-off (then the pilot) field with the clicked
+    latitude,longitude and moves its marker; the next run, on the area the page kept, plans
+    from there and draws the points where they were clicked."""
+    area = tmp_path / "field.geojson"
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [FIELD_RING]}))
+    page = pages.new()
+    page.goto(server.url + "/")
+    page.set_input_files("#f-area", str(area))
+    page.fill("#f-range", "")
+    page.click("#select-form button[type=submit]")
+    landed(page)
+    svg = page.locator("svg.map")
+    box = svg.bounding_box()
+    assert box and page.locator("#map-set").is_visible()
+    placed = {}
+    for which, (fx, fy) in (("takeoff", (0.3, 0.75)), ("pilot", (0.7, 0.3))):
+        page.check(f"#map-set input[value={which}]")
+        page.mouse.click(box["x"] + fx * box["width"], box["y"] + fy * box["height"])
+        placed[which] = page.input_value(f"#f-{which}")
+        lat, lon = map(float, placed[which].split(","))
+        assert 46.2 < lat < 46.23 and 6.15 < lon < 6.18, placed[which]
+        assert placed[which] in page.locator("#map-status").inner_text()
+        dot = page.locator(f"svg.map g.pt.{which} circle").bounding_box()
+        assert dot and abs(dot["x"] + dot["width"] / 2 - (box["x"] + fx * box["width"])) < 2
+    assert placed["takeoff"] != placed["pilot"]
+    shot(page, "select-map-placed-desktop")
+    page.click("#select-form button[type=submit]")  # no new upload: the kept area
+    landed(page)
+    assert page.locator("#plan").count() == 1
+    for which, text in placed.items():
+        assert page.input_value(f"#f-{which}") == text
+        lat, lon = map(float, text.split(","))
+        got = page.evaluate(
+            """(which) => {
+              const svg = document.querySelector("svg.map"), c = svg.querySelector(`g.pt.${which} circle`);
+              const n = (s) => s.split(",").map(Number);
+              const [lat0, lon0] = n(svg.dataset.origin), [mLat, mLon] = n(svg.dataset.mPerDeg);
+              const [ox, oy, k, x0, y1] = n(svg.dataset.view);
+              const e = x0 + (c.cx.baseVal.value - ox) / k, no = y1 - (c.cy.baseVal.value - oy) / k;
+              return [lat0 + no / mLat, lon0 + e / mLon];
+            }""",
+            which,
+        )
+        assert abs(got[0] - lat) * 111e3 < 0.5 and abs(got[1] - lon) * 77e3 < 0.5, (which, got, text)
+
+
 def test_oversize_upload_is_refused_beside_the_field(pages, server, tmp_path) -> None:
     big = tmp_path / "big.geojson"
     with big.open("wb") as f:

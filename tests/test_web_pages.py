@@ -95,6 +95,48 @@ def from_column(html: str) -> dict[str, str]:
     return {name: src for name, _, src in rows}
 
 
+def marker_latlon(html: str, which: str) -> tuple[float, float]:
+    """A map point's position from the drawing and the georeference on the svg."""
+    svg = re.search(r"<svg class=\"map\"[^>]*>", html).group(0)
+    lat0, lon0 = map(float, re.search(r'data-origin="([^"]+)"', svg).group(1).split(","))
+    m_lat, m_lon = map(float, re.search(r'data-m-per-deg="([^"]+)"', svg).group(1).split(","))
+    ox, oy, k, x0, y1 = map(float, re.search(r'data-view="([^"]+)"', svg).group(1).split(","))
+    dot = re.search(rf'<g class="pt {which}"><circle cx="([\d.]+)" cy="([\d.]+)"', html)
+    cx, cy = map(float, dot.groups())
+    east, north = x0 + (cx - ox) / k, y1 - (cy - oy) / k
+    return lat0 + north / m_lat, lon0 + east / m_lon
+
+
+def test_kept_area_reruns_with_the_points_placed(client) -> None:
+    """The page keeps the uploaded area for the next run (a file field cannot be re-filled), so a
+    take-off and pilot point placed on the map (or typed) plan from the same area; the map's
+    georeference puts them where they are."""
+    first = client.post(
+        "/select", data={"range": "", "altitude": "50"}, files={"area": ("field.geojson", AREA)}
+    )
+    assert first.status_code == 200 and "Using <b>field.geojson</b> from the last run" in first.text
+    kept = re.search(r'name="kept-data.area" value="([^"]*)"', first.text).group(1)
+    again = client.post(
+        "/select",
+        data={
+            "range": "",
+            "altitude": "50",
+            "kept-name.area": "field.geojson",
+            "kept-data.area": kept,
+            "takeoff": "46.2161,6.1681",
+            "pilot": "46.21655,6.16895",
+        },
+    )
+    assert again.status_code == 200 and 'id="plan"' in again.text
+    for which, (lat, lon) in (("takeoff", (46.2161, 6.1681)), ("pilot", (46.21655, 6.16895))):
+        got = marker_latlon(again.text, which)
+        # within 0.3 m: the drawing's coordinates are written to 0.1 unit (~0.02 m here)
+        assert abs(got[0] - lat) * 111e3 < 0.3 and abs(got[1] - lon) * 77e3 < 0.3, (which, got)
+    bad = client.post("/select", data={"range": "", "altitude": "50", "kept-data.area": "@@@"})
+    assert bad.status_code == 422
+    assert "kept file is damaged" in re.search(r'id="e-area"[^>]*>([^<]*)<', bad.text).group(1)
+
+
 def test_empty_required_field_is_answered_beside_it(client) -> None:
     r = client.post("/select", data={"range": "", "resolution": "0.02", "wind": "7"})
     assert r.status_code == 422

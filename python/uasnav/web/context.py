@@ -32,8 +32,10 @@ from uasnav.web import forms
 MAX_BODY_BYTES = 16 * 2**20
 #: Largest JSON body of ``POST /api/select`` (bytes).
 MAX_JSON_BYTES = 256 * 2**10
-#: Multipart limits: files, fields, bytes per non-file part.
-MAX_FILES, MAX_FIELDS, MAX_PART_BYTES = 4, 64, 64 * 2**10
+#: Multipart limits: files, fields, bytes per non-file part (a document the page keeps from the
+#: last run is a non-file part: base64 of at most an option file; the body limit bounds them all).
+MAX_FILES, MAX_FIELDS = 4, 96
+MAX_PART_BYTES = forms.MAX_OPTION_FILE_BYTES * 4 // 3 + 4096
 GENERIC_500 = "internal server error: the details are in the server log"
 
 

@@ -11,6 +11,8 @@ sources and output paths are never fields.
 
 from __future__ import annotations
 
+import base64
+import binascii
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -264,6 +266,28 @@ def empty_required(form: Mapping[str, Any], has_area: bool = False) -> dict[str,
     return errors
 
 
+#: Form fields carrying a document of the last run, by file field: its name and its content.
+KEPT_NAME, KEPT_DATA = "kept-name.{}", "kept-data.{}"
+
+
+def kept_file(filename: str, data: bytes) -> tuple[str, str]:
+    """An uploaded document as the page keeps it for the next run: (file name, base64)."""
+    return filename, base64.b64encode(data).decode("ascii")
+
+
+def read_kept(name: str, form: Mapping[str, Any]) -> tuple[str, bytes] | None:
+    """The document of file field ``name`` kept by the page from the last run, if any."""
+    text = form.get(KEPT_DATA.format(name))
+    if not isinstance(text, str) or not text:
+        return None
+    try:
+        data = base64.b64decode(text, validate=True)
+    except (binascii.Error, ValueError):
+        raise OptionError(name, f"{name}: the kept file is damaged; choose the file again") from None
+    label = form.get(KEPT_NAME.format(name))
+    return (label if isinstance(label, str) and label else name), data
+
+
 def pair_values(text: str | None) -> dict[str, str]:
     """``"range=1,cost=2"`` → {"range": "1", "cost": "2"} for re-filling the sub-fields."""
     out: dict[str, str] = {}
@@ -327,9 +351,11 @@ __all__ = [
     "file_value",
     "form_fields",
     "is_field",
+    "kept_file",
     "operator_help",
     "pair_values",
     "plan_values",
+    "read_kept",
     "values_from_form",
     "widget",
 ]

@@ -55,6 +55,7 @@ def selection_page(
     errors: dict[str, str],
     result: dict[str, Any] | None,
     status: int,
+    kept: dict[str, tuple[str, str]] | None = None,
 ) -> HTMLResponse:
     fields = forms.form_fields(ctx.choices)
     core = sorted((f for f in fields if f.core), key=lambda f: forms.CORE_FIELDS.index(f.name))
@@ -75,6 +76,7 @@ def selection_page(
             if o.kind == "pairs"
         },
         "errors": errors,
+        "kept": kept or {},
         "result": result,
         "page": "select",
     }
@@ -173,21 +175,28 @@ def index(request: Request, ctx: Ctx) -> Response:
 async def select_form(request: Request, ctx: Ctx) -> Response:
     form = await read_form(request)
     values = forms.values_from_form(form, form.getlist)
-    up_area = form.get("area")
-    has_area = isinstance(up_area, UploadFile) and bool(up_area.filename)
-    errors = {**forms.field_errors(values), **forms.empty_required(form, has_area)}
+    errors: dict[str, str] = {}
     result = None
     files: dict[str, Any] = {}
+    # uploads, or the documents of the last run the page kept (a file field cannot be re-filled)
+    kept: dict[str, tuple[str, str]] = {}
     file_names = [f.name for f in forms.form_fields(ctx.choices) if f.widget == "file"]
     file_names += [n for n, spec in forms.PLAN_FIELDS.items() if spec[3] == "file"]
     for name in file_names:
         up = form.get(name)
-        if isinstance(up, UploadFile) and up.filename:
-            data = await up.read(forms.MAX_OPTION_FILE_BYTES + 1)
-            try:
+        try:
+            if isinstance(up, UploadFile) and up.filename:
+                data = await up.read(forms.MAX_OPTION_FILE_BYTES + 1)
                 files[name] = forms.file_value(name, up.filename, data)
-            except OptionError as e:
-                errors[e.option] = str(e)
+                kept[name] = forms.kept_file(up.filename, data)
+            elif (k := forms.read_kept(name, form)) is not None:
+                files[name] = forms.file_value(name, k[0], k[1])
+                kept[name] = forms.kept_file(k[0], k[1])
+        except OptionError as e:
+            errors[e.option] = str(e)
+    # values checked with the documents: a take-off point is measured on the area
+    errors = {**forms.field_errors({**values, **files}), **errors}
+    errors.update(forms.empty_required(form, "area" in files))
     extra = forms.plan_values(form)
     values.update(extra)
     if not errors:
@@ -202,7 +211,7 @@ async def select_form(request: Request, ctx: Ctx) -> Response:
         except UasnavError as e:
             errors["form"] = str(e)
             result = None
-    return selection_page(request, ctx, values, errors, result, 422 if errors else 200)
+    return selection_page(request, ctx, values, errors, result, 422 if errors else 200, kept)
 
 
 async def plan_part(

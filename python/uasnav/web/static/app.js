@@ -60,6 +60,46 @@
   cues();
   window.addEventListener("resize", cues);
 
+  // The offline map: a click or tap places the take-off point or the pilot's position (the
+  // latitude,longitude fields under "Advanced" stay the keyboard's way); the next run uses them.
+  // The drawing's georeference is on the svg (uasnav.web.area_map).
+  var map = document.querySelector("svg.map[data-view]"), chooser = document.getElementById("map-set");
+  if (map && chooser) {
+    chooser.hidden = false;
+    var nums = function (s) { return s.split(",").map(Number); };
+    var origin = nums(map.dataset.origin), perDeg = nums(map.dataset.mPerDeg), view = nums(map.dataset.view);
+    var status = document.getElementById("map-status");
+    var NS = "http://www.w3.org/2000/svg";
+    var marker = function (which, x, y) {
+      var g = map.querySelector("g.pt." + which);
+      if (!g) {
+        g = document.createElementNS(NS, "g");
+        g.setAttribute("class", "pt " + which);
+        g.appendChild(document.createElementNS(NS, "circle")).setAttribute("r", "6");
+        g.appendChild(document.createElementNS(NS, "text")).textContent = which === "pilot" ? "pilot" : "take-off";
+        map.insertBefore(g, map.querySelector("g.scale"));
+      }
+      g.querySelector("circle").setAttribute("cx", x.toFixed(1));
+      g.querySelector("circle").setAttribute("cy", y.toFixed(1));
+      g.querySelector("text").setAttribute("x", (x + 9).toFixed(1));
+      g.querySelector("text").setAttribute("y", (y + 4).toFixed(1));
+    };
+    map.addEventListener("click", function (ev) {
+      var pt = map.createSVGPoint();
+      pt.x = ev.clientX; pt.y = ev.clientY;
+      var p = pt.matrixTransform(map.getScreenCTM().inverse());
+      var east = view[3] + (p.x - view[0]) / view[2], north = view[4] - (p.y - view[1]) / view[2];
+      var lat = origin[0] + north / perDeg[0], lon = origin[1] + east / perDeg[1];
+      var which = chooser.querySelector("input[name=map-point]:checked").value;
+      var field = document.getElementById("f-" + which);
+      if (!field) return;
+      field.value = lat.toFixed(6) + "," + lon.toFixed(6);
+      marker(which, p.x, p.y);
+      status.textContent = (which === "pilot" ? "Your position" : "Take-off point") + " set to " +
+        field.value + ". Run again to plan from it.";
+    });
+  }
+
   // Print buttons.
   document.querySelectorAll("[data-print]").forEach(function (b) {
     b.addEventListener("click", function () { window.print(); });
