@@ -1,4 +1,4 @@
-"""The web application's API and pages through the framework's test client (issue 16): status
+"""The web application's API and pages through the framework's test client: status
 codes, JSON bodies, validation errors naming the field, hostile uploads, Host/Origin guards,
 generic 500s. The same application runs under ``uasnav serve`` (tests/test_web_serve.py,
 tests/test_web_browser.py)."""
@@ -459,7 +459,7 @@ def test_page_downloads_are_what_is_shown(client) -> None:
     assert [row["uas"] for row in csv.DictReader(io.StringIO(uris["ranking.csv"]))] == [
         x["uas"] for x in api["ranking"]
     ]
-    # each configuration with the operation it implies (issue 18: the operation follows the UA)
+    # each configuration with the operation it implies (the operation follows the UA)
     assert [
         (row["visibility"], row["category"]) for row in csv.DictReader(io.StringIO(uris["ranking.csv"]))
     ] == [(x["visibility"], x["category"]) for x in api["ranking"]]
@@ -483,7 +483,7 @@ def test_page_shows_the_operation_of_each_configuration_and_every_operation(clie
 
 
 def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
-    """An option added to the table later (issue 18: an area file, an output summary) appears
+    """An option added to the table later (an area file, an output summary) appears
     in the form and the API without editing the web app; a file option's value is the document
     (bytes or parsed JSON), never a path the server opens; an output path is never a request
     option."""
@@ -622,7 +622,7 @@ def test_not_authorisable_is_shown_and_nothing_is_flyable(client, shared_data, t
     assert table.group(1).count("withheld</span>") == len(rows)
 
 
-def test_issue18_inputs_by_kind(client, tmp_path) -> None:
+def test_operation_inputs_by_kind(client, tmp_path) -> None:
     """Density, mitigations, datetime as text; a choice whose default is None has an empty
     option (selected, so nothing is submitted); a flag defaulting on is sent as ``false`` when
     unchecked; an uploaded plan keeps its extension so the area reader picks its format."""

@@ -115,6 +115,9 @@ def test_kept_area_reruns_with_the_points_placed(client) -> None:
         "/select", data={"range": "", "altitude": "50"}, files={"area": ("field.geojson", AREA)}
     )
     assert first.status_code == 200 and "Using <b>field.geojson</b> from the last run" in first.text
+    # an emptied field stays empty for the next run (not re-filled with its default)
+    assert field_value(first.text, "range") == "" and field_value(first.text, "altitude") == "50"
+    assert field_value(client.get("/").text, "range") == "1500"
     kept = re.search(r'name="kept-data.area" value="([^"]*)"', first.text).group(1)
     again = client.post(
         "/select",

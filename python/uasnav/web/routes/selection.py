@@ -70,6 +70,8 @@ def selection_page(
         "area_map": result.get("area_map") if result else None,
         "max_upload": MAX_BODY_BYTES,
         "values": values,
+        # a field the operator emptied stays empty (values leave blank fields out)
+        "posted": bool(values),
         "pairs": {
             o.name: forms.pair_values(values.get(o.name))
             for o in select_request.SELECT_OPTIONS
