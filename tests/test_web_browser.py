@@ -115,6 +115,17 @@ def landed(page, landing: str = "results") -> None:  # type: ignore[no-untyped-d
     assert page.evaluate("document.activeElement.id") == landing
 
 
+def assert_route_labels_inside(page) -> None:  # type: ignore[no-untyped-def]
+    """Every waypoint label of the route drawing lies inside it (a label past its edge is cut)."""
+    cut = page.evaluate(
+        """() => { const svg = document.querySelector("#prediction figure.route svg");
+          const w = svg.viewBox.baseVal.width;
+          return [...svg.querySelectorAll("text.wpl")].map((t) => [t.textContent, t.getBBox()])
+            .filter(([, b]) => b.x < 0 || b.x + b.width > w).map(([s]) => s); }"""
+    )
+    assert cut == [], cut
+
+
 def open_advanced(page) -> None:  # type: ignore[no-untyped-def]
     """Unfold the form's "Advanced" part (folded by default)."""
     if page.get_attribute("#advanced", "open") is None:
@@ -320,6 +331,7 @@ def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
         assert low == sum(1 for f in ref.flags if f)
         assert page.locator("svg polyline.seg").count() == len(ref.time_s)
         shot(page, f"trajectory-{tag}")
+        assert_route_labels_inside(page)
         assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
     with page.expect_download() as d:
         page.click("a:has-text('Waypoint times CSV')")
@@ -543,6 +555,7 @@ def test_trajectory_prints_on_one_a4_page(pages, server, tmp_path) -> None:
     page.click("#trajectory-form button[type=submit]")
     landed(page, "prediction")
     times = page.locator("#waypoints td[data-time]").all_inner_texts()
+    assert_route_labels_inside(page)
     page.emulate_media(media="print")
     assert not page.locator("#trajectory-form").is_visible()
     pdf = pypdf.PdfReader(io.BytesIO(page.pdf(format="A4", print_background=True)))
