@@ -1,4 +1,4 @@
-"""Bounded load test of ``uasnav serve`` on loopback (issue 16).
+"""Bounded load test of ``uasnav serve`` on loopback.
 
 Starts the real command (``uasnav serve --port <free port>``), runs CLIENTS concurrent clients
 for DURATION seconds, each posting the thesis' precision-agriculture scenario to

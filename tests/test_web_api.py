@@ -1,4 +1,4 @@
-"""The web application's API and pages through the framework's test client (issue 16): status
+"""The web application's API and pages through the framework's test client: status
 codes, JSON bodies, validation errors naming the field, hostile uploads, Host/Origin guards,
 generic 500s. The same application runs under ``uasnav serve`` (tests/test_web_serve.py,
 tests/test_web_browser.py)."""
@@ -459,7 +459,7 @@ def test_page_downloads_are_what_is_shown(client) -> None:
     assert [row["uas"] for row in csv.DictReader(io.StringIO(uris["ranking.csv"]))] == [
         x["uas"] for x in api["ranking"]
     ]
-    # each configuration with the operation it implies (issue 18: the operation follows the UA)
+    # each configuration with the operation it implies (the operation follows the UA)
     assert [
         (row["visibility"], row["category"]) for row in csv.DictReader(io.StringIO(uris["ranking.csv"]))
     ] == [(x["visibility"], x["category"]) for x in api["ranking"]]
@@ -483,7 +483,7 @@ def test_page_shows_the_operation_of_each_configuration_and_every_operation(clie
 
 
 def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
-    """An option added to the table later (issue 18: an area file, an output summary) appears
+    """An option added to the table later (an area file, an output summary) appears
     in the form and the API without editing the web app; a file option's value is the document
     (bytes or parsed JSON), never a path the server opens; an output path is never a request
     option."""
@@ -534,15 +534,19 @@ def test_new_option_kinds_are_handled_generically(client, monkeypatch) -> None:
 def test_authorisation_summary_is_the_compliance_document(client, tmp_path) -> None:
     """The results page embeds the authorisation summary rendered by ``uasnav.mission.summary``
     (its print view, linked to the same stylesheet), and its downloads are that document: the
-    same bytes as ``uasnav select --summary`` writes. One renderer, one document."""
+    same bytes as ``uasnav select --summary`` writes, in the form's words (the "from" column
+    names the form's fields where the command line names its options). One renderer, one
+    document."""
     import base64
 
     from uasnav.mission.request import run_select
     from uasnav.mission.summary import SUMMARY_CSS, summary_dict, summary_fragment
+    from uasnav.web.context import in_operator_words, plain
 
     r = client.post("/select", data={"range": "300", "top": "4"})
     sel = run_select({"range": 300.0, "top": 4})
-    fragment = summary_fragment(sel)
+    fragment = plain(summary_fragment(sel))
+    assert fragment != summary_fragment(sel) and not re.search(r"--[a-z]", fragment)
     assert fragment in r.text  # rendered once, by the summary module
     assert r.text.count("class='auth-summary'") == 1
     assert '<link rel="stylesheet" href="/summary.css">' in r.text
@@ -562,9 +566,9 @@ def test_authorisation_summary_is_the_compliance_document(client, tmp_path) -> N
     out = tmp_path / "s.html"
     res = CliRunner().invoke(main, ["select", "--range", "300", "--top", "4", "--summary", str(out)])
     assert res.exit_code == 0, res.output
-    assert found["authorisation-summary.html"] == out.read_text()
-    assert fragment in out.read_text()
-    assert json.loads(found["authorisation-summary.json"]) == summary_dict(sel)
+    assert found["authorisation-summary.html"] == plain(out.read_text())
+    assert fragment in plain(out.read_text())
+    assert json.loads(found["authorisation-summary.json"]) == summary_dict(in_operator_words(sel, {}))
 
 
 # A field inside the InterUSS sample zone (Geneva), as in test_mission_authorisation.
@@ -618,7 +622,7 @@ def test_not_authorisable_is_shown_and_nothing_is_flyable(client, shared_data, t
     assert table.group(1).count("withheld</span>") == len(rows)
 
 
-def test_issue18_inputs_by_kind(client, tmp_path) -> None:
+def test_operation_inputs_by_kind(client, tmp_path) -> None:
     """Density, mitigations, datetime as text; a choice whose default is None has an empty
     option (selected, so nothing is submitted); a flag defaulting on is sent as ``false`` when
     unchecked; an uploaded plan keeps its extension so the area reader picks its format."""

@@ -23,6 +23,7 @@ import pytest
 
 from uasnav.io.plans import plan_route, read_plan, write_plan
 from uasnav.trajectory.features import wind_vector
+from uasnav.web.context import plain
 from uasnav.web.default_model import default_model
 from uasnav.web.process import Server, running_server, uasnav_command
 
@@ -104,7 +105,35 @@ def shot(page, name: str) -> None:  # type: ignore[no-untyped-def]
     page.screenshot(path=str(SHOTS / f"{name}.png"), full_page=True)
 
 
+def landed(page, landing: str = "results") -> None:  # type: ignore[no-untyped-def]
+    """Wait for the answer page of a run and assert it landed on ``#landing`` (the focus).
+
+    The page's deferred script (table sorting, the landing focus) has run by DOMContentLoaded;
+    the answer's markup is there before it, so waiting for the element alone races it."""
+    page.wait_for_selector(f"#{landing}")
+    page.wait_for_load_state("domcontentloaded")
+    assert page.evaluate("document.activeElement.id") == landing
+
+
+def assert_route_labels_inside(page) -> None:  # type: ignore[no-untyped-def]
+    """Every waypoint label of the route drawing lies inside it (a label past its edge is cut)."""
+    cut = page.evaluate(
+        """() => { const svg = document.querySelector("#prediction figure.route svg");
+          const w = svg.viewBox.baseVal.width;
+          return [...svg.querySelectorAll("text.wpl")].map((t) => [t.textContent, t.getBBox()])
+            .filter(([, b]) => b.x < 0 || b.x + b.width > w).map(([s]) => s); }"""
+    )
+    assert cut == [], cut
+
+
+def open_advanced(page) -> None:  # type: ignore[no-untyped-def]
+    """Unfold the form's "Advanced" part (folded by default)."""
+    if page.get_attribute("#advanced", "open") is None:
+        page.click("#advanced-toggle")
+
+
 def fill_thesis(page) -> None:  # type: ignore[no-untyped-def]
+    open_advanced(page)
     for name, value in THESIS_SELECTS.items():
         page.select_option(f"#f-{name}", value)
     for name, value in THESIS.items():
@@ -127,7 +156,7 @@ def test_thesis_scenario_matches_the_cli(pages, server) -> None:
         shot(page, f"select-form-{tag}")
         fill_thesis(page)
         page.click("#select-form button[type=submit]")
-        page.wait_for_selector("#results")
+        landed(page)
         # ranked table: every row, in order, as `uasnav select --json` ranks them
         rows = page.locator("#ranking tbody tr")
         got = [
@@ -157,7 +186,7 @@ def test_ranking_sorts_and_downloads(pages, server, tmp_path) -> None:
     page = pages.new()
     page.goto(server.url + "/")
     page.click("#select-form button[type=submit]")
-    page.wait_for_selector("#results")
+    landed(page)
     page.click("#ranking th:has-text('Cost (USD)')")
     costs = [
         float(x.replace(",", "")) for x in page.locator("#ranking tbody tr td:nth-child(7)").all_inner_texts()
@@ -182,7 +211,9 @@ def test_ranking_sorts_and_downloads(pages, server, tmp_path) -> None:
     subprocess.run([*uasnav_command(), *argv], capture_output=True, check=True, timeout=120)
     alone = pages.new()
     alone.set_content(out.read_text())
-    assert " ".join(alone.locator(".auth-summary").inner_text().split()) == " ".join(summary.split())
+    # ... in the form's words: the "from" column names fields where the CLI names its options
+    cli = plain(alone.locator(".auth-summary").inner_text())
+    assert " ".join(cli.split()) == " ".join(summary.split())
 
     # every character of the summary is on the printed page: nothing clipped or pushed off it
     # (the PDF's text comes out in two columns and with ligatures, so compare as multisets)
@@ -211,8 +242,23 @@ def test_bad_value_is_shown_beside_its_field(pages, server) -> None:
 
 
 def test_keyboard_only(pages, server) -> None:
-    """Tab reaches every field in order, typing fills them, Enter submits."""
+    """The run button is a few Tab presses away (the short form; "Advanced" folded); Enter on
+    "Advanced" unfolds it and Tab then reaches every field in order, typing fills them, Enter
+    submits, and the focus lands on the results."""
     page = pages.new()
+    page.goto(server.url + "/")
+    core = page.eval_on_selector_all(
+        "#select-form fieldset.core input:not([type=hidden]), #select-form fieldset.core select",
+        "els => els.map(e => e.id)",
+    )
+    presses = 1
+    page.keyboard.press("Tab")  # the skip link
+    while page.evaluate("document.activeElement.type") != "submit" and presses < 40:
+        page.keyboard.press("Tab")
+        presses += 1
+    # the skip link, the 4 menu links and the 4 data links of the lead, the core fields,
+    # "Advanced", then the button
+    assert presses <= 1 + 4 + 4 + len(core) + 2, f"{presses} Tab presses to the run button"
     page.goto(server.url + "/")
     order = page.eval_on_selector_all(
         "#select-form input:not([type=hidden]), #select-form select, #select-form button",
@@ -232,6 +278,8 @@ def test_keyboard_only(pages, server) -> None:
             page.keyboard.type("3")
         if active == "f-rain":
             page.keyboard.press("Space")
+        if active == "advanced-toggle":
+            page.keyboard.press("Enter")
         if active in order:
             seen.append(active)
         if active == "submit":
@@ -239,7 +287,7 @@ def test_keyboard_only(pages, server) -> None:
     assert seen == order, "Tab order differs from the form's order"
     with page.expect_navigation():
         page.keyboard.press("Enter")
-    page.wait_for_selector("#results")
+    landed(page)
     assert 0 < page.locator("#ranking tbody tr").count() <= 3
     facts = page.locator(".facts").first.inner_text()
     assert "range 800 m" in facts and "rain" in facts
@@ -270,7 +318,7 @@ def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
         page.fill("#t-wind_from", "22.5")
         page.fill("#t-speed", "3.33")
         page.click("#trajectory-form button[type=submit]")
-        page.wait_for_selector("#prediction")
+        landed(page, "prediction")
         times = [
             float(x)
             for x in page.eval_on_selector_all(
@@ -283,6 +331,7 @@ def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
         assert low == sum(1 for f in ref.flags if f)
         assert page.locator("svg polyline.seg").count() == len(ref.time_s)
         shot(page, f"trajectory-{tag}")
+        assert_route_labels_inside(page)
         assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
     with page.expect_download() as d:
         page.click("a:has-text('Waypoint times CSV')")
@@ -339,9 +388,10 @@ def test_not_authorisable_in_the_browser(pages, server, shared_data, tmp_path) -
         page.fill("#f-range", "1500")
         page.set_input_files("#f-zones", str(zones))
         page.set_input_files("#f-area", str(area))
+        open_advanced(page)
         page.uncheck("#f-gnss_autopilot")
         page.click("#select-form button[type=submit]")
-        page.wait_for_selector("#results")
+        landed(page)
         box = page.locator("#not-authorisable")
         assert box.is_visible() and want["authorisation"]["verdict"] in box.inner_text()
         assert page.locator("#ranking").count() == 0
@@ -356,3 +406,159 @@ def test_not_authorisable_in_the_browser(pages, server, shared_data, tmp_path) -
         assert page.locator("#rejections tbody tr").count() == n
         shot(page, f"select-withheld-{tag}")
         assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+
+
+#: A 70 × 55 m field (lon, lat) beside Geneva.
+FIELD_RING = [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
+
+
+def test_area_upload_map_results_downloads(pages, server, tmp_path) -> None:
+    """Upload an area → the offline map → the results (focused) → every download, at desktop and
+    phone widths; at phone width the ranking's priority columns (mass, cost, operation) are shown
+    with a cue to scroll sideways, and the run button is on screen from the start."""
+    area = tmp_path / "field.geojson"
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [FIELD_RING]}))
+    for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
+        page = pages.new(viewport)
+        page.goto(server.url + "/")
+        box = page.locator("#select-form button[type=submit]").bounding_box()
+        assert box and box["y"] + box["height"] <= viewport["height"], "run button below the fold"
+        page.set_input_files("#f-area", str(area))
+        page.fill("#f-range", "")  # with an area, distances come from the area
+        if tag == "phone":  # keyboard only: Tab to the run button, Enter
+            page.focus("#f-range")
+            for _ in range(30):
+                if page.evaluate("document.activeElement.type") == "submit":
+                    break
+                page.keyboard.press("Tab")
+            with page.expect_navigation():
+                page.keyboard.press("Enter")
+        else:
+            page.click("#select-form button[type=submit]")
+        landed(page)
+        svg = page.locator("svg.map")
+        assert svg.is_visible()
+        assert page.locator("svg.map path.area").count() == 1
+        assert page.locator("svg.map g.takeoff").count() == 1
+        assert page.locator("svg.map polyline.survey").count() >= 1
+        assert page.locator("#flights tbody tr").count() >= 1
+        assert page.locator("svg.map g.north").count() == 1 and page.locator("svg.map g.scale").is_visible()
+        head = page.locator("#ranking thead th")
+        for name in ("Mass (g)", "Cost (USD)", "Operation"):
+            assert head.filter(has_text=name).is_visible(), name
+        if tag == "phone":
+            assert page.locator("#ranking th.opt").first.is_hidden()
+            wide = page.evaluate(
+                "(() => { const b = document.querySelector('#ranking').closest('.scroll');"
+                " return b.scrollWidth > b.clientWidth; })()"
+            )
+            cue = page.locator(".scroll-cue").first
+            assert cue.is_visible() == wide
+        shot(page, f"select-area-{tag}")
+        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+        names = []
+        for link in page.locator(".downloads a[download]").all():
+            with page.expect_download() as d:
+                if tag == "phone":  # keyboard only
+                    link.focus()
+                    page.keyboard.press("Enter")
+                else:
+                    link.click()
+            got = tmp_path / f"{tag}-{d.value.suggested_filename}"
+            d.value.save_as(got)
+            assert got.stat().st_size > 0
+            names.append(d.value.suggested_filename)
+        assert {"selection.json", "ranking.csv", "authorisation-summary.html"} <= set(names)
+        # every file the plan writes, and the flight plan reads back
+        want = {"flight-01.plan", "flight-01.waypoints", "flight-01.intent.json", "summary.html"}
+        assert want | {"summary.json", "result.json"} <= set(names)
+        route, _ = plan_route(read_plan(tmp_path / f"{tag}-flight-01.plan"))
+        assert len(route) >= 2
+        result = json.loads((tmp_path / f"{tag}-result.json").read_text())
+        assert result["survey"]["lines"] == page.locator("svg.map polyline.survey").count()
+
+
+def test_map_click_places_takeoff_and_pilot(pages, server, tmp_path) -> None:
+    """A click on the offline map fills the take-off (then the pilot) field with the clicked
+    latitude,longitude and moves its marker; the next run, on the area the page kept, plans
+    from there and draws the points where they were clicked."""
+    area = tmp_path / "field.geojson"
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [FIELD_RING]}))
+    page = pages.new()
+    page.goto(server.url + "/")
+    page.set_input_files("#f-area", str(area))
+    page.fill("#f-range", "")
+    page.click("#select-form button[type=submit]")
+    landed(page)
+    svg = page.locator("svg.map")
+    box = svg.bounding_box()
+    assert box and page.locator("#map-set").is_visible()
+    placed = {}
+    for which, (fx, fy) in (("takeoff", (0.3, 0.75)), ("pilot", (0.7, 0.3))):
+        page.check(f"#map-set input[value={which}]")
+        page.mouse.click(box["x"] + fx * box["width"], box["y"] + fy * box["height"])
+        placed[which] = page.input_value(f"#f-{which}")
+        lat, lon = map(float, placed[which].split(","))
+        assert 46.2 < lat < 46.23 and 6.15 < lon < 6.18, placed[which]
+        assert placed[which] in page.locator("#map-status").inner_text()
+        dot = page.locator(f"svg.map g.pt.{which} circle").bounding_box()
+        assert dot and abs(dot["x"] + dot["width"] / 2 - (box["x"] + fx * box["width"])) < 2
+    assert placed["takeoff"] != placed["pilot"]
+    shot(page, "select-map-placed-desktop")
+    page.click("#select-form button[type=submit]")  # no new upload: the kept area
+    landed(page)
+    assert page.locator("#plan").count() == 1
+    for which, text in placed.items():
+        assert page.input_value(f"#f-{which}") == text
+        lat, lon = map(float, text.split(","))
+        got = page.evaluate(
+            """(which) => {
+              const svg = document.querySelector("svg.map"), c = svg.querySelector(`g.pt.${which} circle`);
+              const n = (s) => s.split(",").map(Number);
+              const [lat0, lon0] = n(svg.dataset.origin), [mLat, mLon] = n(svg.dataset.mPerDeg);
+              const [ox, oy, k, x0, y1] = n(svg.dataset.view);
+              const e = x0 + (c.cx.baseVal.value - ox) / k, no = y1 - (c.cy.baseVal.value - oy) / k;
+              return [lat0 + no / mLat, lon0 + e / mLon];
+            }""",
+            which,
+        )
+        assert abs(got[0] - lat) * 111e3 < 0.5 and abs(got[1] - lon) * 77e3 < 0.5, (which, got, text)
+
+
+def test_oversize_upload_is_refused_beside_the_field(pages, server, tmp_path) -> None:
+    big = tmp_path / "big.geojson"
+    with big.open("wb") as f:
+        f.truncate(17 * 2**20)
+    page = pages.new(PHONE)
+    page.goto(server.url + "/")
+    page.fill("#f-wind", "7")
+    page.set_input_files("#f-area", str(big))
+    assert "over the 16 MB limit" in page.locator("#e-area").inner_text()
+    page.click("#select-form button[type=submit]")
+    assert page.locator("#results").count() == 0 and page.input_value("#f-wind") == "7"
+    assert page.evaluate("document.activeElement.id") == "f-area"
+
+
+def test_trajectory_prints_on_one_a4_page(pages, server, tmp_path) -> None:
+    import pymap3d
+
+    from uasnav.trajectory.simulator import phantom4_plans
+
+    ne = phantom4_plans()["B"]
+    lat, lon, _ = pymap3d.ned2geodetic(ne[:, 0], ne[:, 1], 0.0, 47.3977, 8.5456, 50.0)
+    csv = tmp_path / "b.csv"
+    csv.write_text("lat,lon,alt\n" + "".join(f"{a:.9f},{b:.9f},50\n" for a, b in zip(lat, lon, strict=True)))
+    page = pages.new()
+    page.goto(server.url + "/trajectory")
+    page.set_input_files("#t-plan", str(csv))
+    page.fill("#t-required", ",".join(str(10 * i) for i in range(len(ne))))
+    page.click("#trajectory-form button[type=submit]")
+    landed(page, "prediction")
+    times = page.locator("#waypoints td[data-time]").all_inner_texts()
+    assert_route_labels_inside(page)
+    page.emulate_media(media="print")
+    assert not page.locator("#trajectory-form").is_visible()
+    pdf = pypdf.PdfReader(io.BytesIO(page.pdf(format="A4", print_background=True)))
+    assert len(pdf.pages) == 1
+    printed = pdf.pages[0].extract_text()
+    assert "ETA" in printed and all(t in printed for t in times)  # every waypoint time, none cut

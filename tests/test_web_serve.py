@@ -1,5 +1,4 @@
-"""``uasnav serve`` as an operator starts it: the real command on a loopback port, over real HTTP
-(issue 16)."""
+"""``uasnav serve`` as an operator starts it: the real command on a loopback port, over real HTTP."""
 
 from __future__ import annotations
 

@@ -11,6 +11,8 @@ sources and output paths are never fields.
 
 from __future__ import annotations
 
+import base64
+import binascii
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -25,6 +27,86 @@ FILE_KINDS = frozenset({"file", "input_file", "infile", "upload", "path", "input
 NOT_FIELDS = frozenset({"source", "output", "output_file", "outfile", "output_path", "out"})
 #: Largest uploaded option file (bytes).
 MAX_OPTION_FILE_BYTES = 4 * 2**20
+
+#: The short form an operator fills in; every other field is under "Advanced".
+CORE_FIELDS = (
+    "mission",
+    "area",
+    "resolution",
+    "image_size",
+    "altitude",
+    "imagery",
+    "wind",
+    "range",
+)
+#: Fields that may not be left empty when the form sends them (an absent field takes its
+#: default; an emptied one is a question the operator has not answered). ``range`` is not
+#: needed when an area is uploaded: distances are then measured from the area.
+REQUIRED_FIELDS = (
+    "mission",
+    "range",
+    "resolution",
+    "image_size",
+    "altitude",
+    "imagery",
+    "wind",
+    "jurisdiction",
+)
+
+#: Help in the operator's words (the option table's help speaks the command line's).
+OPERATOR_HELP: dict[str, str] = {
+    "mission": "What the flight is for; it sets the equipment the aircraft must carry.",
+    "range": "How far from take-off the aircraft must fly. With an area uploaded, distances are "
+    "measured from the area instead.",
+    "resolution": "Ground size of one image pixel you need (0.05 m = 5 cm per pixel).",
+    "image_size": "Ground one image must cover, length × width, e.g. 70x70.",
+    "altitude": "Planned height above the ground (the open category allows up to 120 m).",
+    "camera_height": "Height at which the cameras' resolution and field of view are checked: the "
+    "height you fly (planned), or the highest the rules allow (regulatory-max, the thesis' test).",
+    "imagery": "The kind of camera the task needs, or any.",
+    "wind": "Strongest wind expected during the flight.",
+    "rain": "The aircraft must be able to fly in rain.",
+    "speed": "Ground speed the aircraft must hold against the wind; leave empty if none.",
+    "order_by": "What matters most when the configurations are ranked.",
+    "weights": "Your own importance for each parameter, instead of the order above.",
+    "targets": "For each parameter, the value you aim for and the worst you accept (target:limit).",
+    "jurisdiction": "Which rules apply: EASA (Europe) or FAA (United States).",
+    "category": "Leave on default and the category the operation needs is worked out for you.",
+    "gnss_autopilot": "Only aircraft with a GNSS (GPS) autopilot.",
+    "max_distance": "Farthest the pilot will be from the aircraft; empty: worked out from the area "
+    "or the range.",
+    "vlos_distance": "Distance up to which the pilot can still see the aircraft; empty: from each "
+    "aircraft's size.",
+    "observers": "Airspace observers posted along the route, who extend the pilot's sight.",
+    "over_people": "Whether the flight passes over people not involved in it, or over crowds.",
+    "population_density": "People per km² under the flight, or a class: controlled, remote, "
+    "sparsely, lightly (default), suburban, high.",
+    "night": "The flight is at night.",
+    "airspace": "The airspace the flight is in; uncontrolled unless you know otherwise.",
+    "mitigations": "Ground-risk mitigations you can show for the risk assessment, e.g. M1A=low,M2=medium.",
+    "sora_edition": "Edition of the SORA risk assessment to apply.",
+    "residual_arc": "Air-risk class you can claim after strategic mitigations; empty: the initial class.",
+    "area": "The field or route to fly: a GeoJSON or KML file, a QGroundControl plan or a Mission "
+    "Planner waypoints file.",
+    "area_buffer": "Safety margin around the area; empty: none around a field, the flight height "
+    "around a route.",
+    "zones": "Geographical zones from your aviation authority (ED-269 JSON file), to check restrictions.",
+    "ground_elevation": "Height of the ground above sea level, to compare with zone limits given "
+    "above sea level.",
+    "flight_time": "Planned take-off date and time with its time zone, e.g. 2026-05-01T10:00Z.",
+    "flight_duration": "How long the flight lasts; empty: the chosen aircraft's own estimate.",
+    "top": "How many configurations to list.",
+    "takeoff": "Where the aircraft takes off, latitude,longitude in degrees; empty: the first point "
+    "of an uploaded plan, else the middle of the area.",
+    "pilot": "Where you stand, latitude,longitude in degrees; empty: at the take-off point. The "
+    "distance to the area's farthest point is measured from here.",
+}
+
+
+def operator_help(opt: SelectOption) -> str:
+    """``opt``'s help in the operator's words: what the page, ``/api/options`` and the OpenAPI
+    description show (the command line keeps the option table's own)."""
+    return OPERATOR_HELP.get(opt.name, opt.help)
 
 
 def is_field(opt: SelectOption) -> bool:
@@ -57,6 +139,48 @@ class FormField:
     @property
     def name(self) -> str:
         return self.option.name
+
+    @property
+    def help(self) -> str:
+        """The field's help in the operator's words (the option's own help otherwise)."""
+        return operator_help(self.option)
+
+    @property
+    def core(self) -> bool:
+        """Whether the field is in the short form (else under "Advanced")."""
+        return self.name in CORE_FIELDS
+
+    @property
+    def required(self) -> bool:
+        return self.name in REQUIRED_FIELDS
+
+
+#: The survey plan's options that are not selector options (``uasnav plan`` adds them): shown
+#: under "Advanced", used when an area is uploaded. Name → (label, unit, help, widget).
+PLAN_FIELDS: dict[str, tuple[str, str, str, str]] = {
+    "overlap": (
+        "Photo overlap",
+        "%",
+        "Front and side overlap of neighbouring photos, e.g. 75,65 (the default).",
+        "text",
+    ),
+    "intents": (
+        "Other operators' flights",
+        "",
+        "Their operational intents (F3548 JSON or flight-intent YAML), to check for conflicts.",
+        "file",
+    ),
+}
+
+
+def plan_values(form: Mapping[str, Any]) -> dict[str, str]:
+    """The plan's own text fields as typed (blank ones left out: they take defaults)."""
+    out = {}
+    for name, (_, _, _, w) in PLAN_FIELDS.items():
+        v = form.get(name)
+        if w != "file" and isinstance(v, str) and v.strip():
+            out[name] = v.strip()
+    return out
 
 
 def default_text(opt: SelectOption) -> str:
@@ -124,6 +248,46 @@ def values_from_form(form: Mapping[str, Any], getlist: Any) -> dict[str, Any]:
     return values
 
 
+def empty_required(form: Mapping[str, Any], has_area: bool = False) -> dict[str, str]:
+    """Required fields the form sent empty, each with a message in the operator's words."""
+    errors: dict[str, str] = {}
+    for opt in request_options():
+        if opt.name not in REQUIRED_FIELDS or opt.name not in form:
+            continue
+        if opt.name == "range" and has_area:
+            continue
+        v = form.get(opt.name)
+        if isinstance(v, str) and not v.strip():
+            what = (opt.label or opt.name).lower()
+            unit = f" ({opt.unit})" if opt.unit else ""
+            errors[opt.name] = f"{opt.name}: enter the {what}{unit}" + (
+                ", or upload an area" if opt.name == "range" else ""
+            )
+    return errors
+
+
+#: Form fields carrying a document of the last run, by file field: its name and its content.
+KEPT_NAME, KEPT_DATA = "kept-name.{}", "kept-data.{}"
+
+
+def kept_file(filename: str, data: bytes) -> tuple[str, str]:
+    """An uploaded document as the page keeps it for the next run: (file name, base64)."""
+    return filename, base64.b64encode(data).decode("ascii")
+
+
+def read_kept(name: str, form: Mapping[str, Any]) -> tuple[str, bytes] | None:
+    """The document of file field ``name`` kept by the page from the last run, if any."""
+    text = form.get(KEPT_DATA.format(name))
+    if not isinstance(text, str) or not text:
+        return None
+    try:
+        data = base64.b64decode(text, validate=True)
+    except (binascii.Error, ValueError):
+        raise OptionError(name, f"{name}: the kept file is damaged; choose the file again") from None
+    label = form.get(KEPT_NAME.format(name))
+    return (label if isinstance(label, str) and label else name), data
+
+
 def pair_values(text: str | None) -> dict[str, str]:
     """``"range=1,cost=2"`` → {"range": "1", "cost": "2"} for re-filling the sub-fields."""
     out: dict[str, str] = {}
@@ -174,15 +338,24 @@ def file_value(option: str, filename: str, data: bytes) -> Any:
 
 
 __all__ = [
+    "CORE_FIELDS",
     "FILE_KINDS",
     "NOT_FIELDS",
+    "OPERATOR_HELP",
+    "PLAN_FIELDS",
+    "REQUIRED_FIELDS",
     "FormField",
+    "empty_required",
     "field_errors",
     "field_names",
     "file_value",
     "form_fields",
     "is_field",
+    "kept_file",
+    "operator_help",
     "pair_values",
+    "plan_values",
+    "read_kept",
     "values_from_form",
     "widget",
 ]

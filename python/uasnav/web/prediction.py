@@ -327,16 +327,18 @@ def route_drawing(r: RoutePrediction, width: float = 640.0, pad: float = 28.0) -
     labels: dict[tuple[float, float], list[str]] = {}
     for w in r.waypoints:
         labels.setdefault(xy(w["east_m"], w["north_m"]), []).append(f"{w['waypoint']} · {w['time_s']:.1f} s")
+    box_width = max(width_used, 160.0)
     wps = [
-        # labels right of the point, or left of it near the right edge so none is cut off
-        {"x": x, "y": y, "label": " / ".join(texts), "anchor": "end" if x > 0.6 * width else "start"}
+        # labels right of the point, or left of it near the right edge of the drawn box (not
+        # of the nominal width: a tall route is drawn narrower) so none is cut off
+        {"x": x, "y": y, "label": " / ".join(texts), "anchor": "end" if x > 0.6 * box_width else "start"}
         for (x, y), texts in labels.items()
     ]
     target = max(span) / 4
     mag = 10 ** math.floor(math.log10(target))
     bar_m = max(m * mag for m in (1, 2, 5) if m * mag <= target) if target >= mag else mag
     return {
-        "width": round(max(width_used, 160.0), 2),
+        "width": round(box_width, 2),
         "height": round(height, 2),
         "elements": elements,
         "waypoints": wps,

@@ -3,6 +3,103 @@
   "use strict";
   document.documentElement.classList.add("js");
 
+  // After a run, the answer (or the list of fields to correct) takes the focus, so a keyboard
+  // or screen-reader user lands on it rather than at the top of the form. The script lands the
+  // page itself, once, and only if nothing has been focused yet: the forms then post to a URL
+  // without the "#results" fragment they carry for browsers without scripts, whose own
+  // fragment focus comes at a time of the browser's choosing (after the page's render-blocking
+  // resources) and would take the focus back from whatever the user had moved it to.
+  document.querySelectorAll("form[data-lands]").forEach(function (form) {
+    form.setAttribute("action", form.getAttribute("action").split("#")[0]);
+  });
+  var landing = document.getElementById("form-error") || document.getElementById("results") ||
+    document.getElementById("prediction");
+  var untouched = !document.activeElement || document.activeElement === document.body;
+  if (landing && untouched) {
+    if (!landing.hasAttribute("tabindex")) landing.tabIndex = -1;
+    landing.focus();
+  }
+
+  // Uploads: a file over the server's limit is refused here, beside its field, with the form
+  // kept (the server would refuse the whole request).
+  document.querySelectorAll("form[data-max-upload]").forEach(function (form) {
+    var limit = Number(form.dataset.maxUpload);
+    var check = function (input) {
+      var msg = document.getElementById("e-" + input.name) || document.getElementById("te-" + input.name);
+      var size = 0;
+      Array.prototype.forEach.call(input.files || [], function (f) { size += f.size; });
+      var err = size > limit ? input.name + ": this file is " + (size / 1048576).toFixed(1) +
+        " MB, over the " + Math.round(limit / 1048576) + " MB limit: choose a smaller file" : "";
+      if (msg) msg.textContent = err;
+      input.closest(".field").classList.toggle("invalid", err !== "");
+      if (err) input.setAttribute("aria-invalid", "true"); else input.removeAttribute("aria-invalid");
+      return err === "";
+    };
+    var files = form.querySelectorAll("input[type=file]");
+    files.forEach(function (input) { input.addEventListener("change", function () { check(input); }); });
+    form.addEventListener("submit", function (e) {
+      var bad = null, total = 0;
+      files.forEach(function (input) {
+        if (!check(input) && !bad) bad = input;
+        Array.prototype.forEach.call(input.files || [], function (f) { total += f.size; });
+      });
+      if (!bad && total > limit && files.length) { bad = files[0]; check(bad); }
+      if (bad) { e.preventDefault(); bad.focus(); }
+    });
+  });
+
+  // Wide tables: the "scroll sideways" cue only when the table is wider than its box.
+  var cues = function () {
+    document.querySelectorAll(".scroll").forEach(function (box) {
+      var cue = box.previousElementSibling;
+      if (cue && cue.classList.contains("scroll-cue")) {
+        cue.classList.toggle("shown", box.scrollWidth > box.clientWidth + 1);
+      }
+    });
+  };
+  cues();
+  window.addEventListener("resize", cues);
+
+  // The offline map: a click or tap places the take-off point or the pilot's position (the
+  // latitude,longitude fields under "Advanced" stay the keyboard's way); the next run uses them.
+  // The drawing's georeference is on the svg (uasnav.web.area_map).
+  var map = document.querySelector("svg.map[data-view]"), chooser = document.getElementById("map-set");
+  if (map && chooser) {
+    chooser.hidden = false;
+    var nums = function (s) { return s.split(",").map(Number); };
+    var origin = nums(map.dataset.origin), perDeg = nums(map.dataset.mPerDeg), view = nums(map.dataset.view);
+    var status = document.getElementById("map-status");
+    var NS = "http://www.w3.org/2000/svg";
+    var marker = function (which, x, y) {
+      var g = map.querySelector("g.pt." + which);
+      if (!g) {
+        g = document.createElementNS(NS, "g");
+        g.setAttribute("class", "pt " + which);
+        g.appendChild(document.createElementNS(NS, "circle")).setAttribute("r", "6");
+        g.appendChild(document.createElementNS(NS, "text")).textContent = which === "pilot" ? "pilot" : "take-off";
+        map.insertBefore(g, map.querySelector("g.scale"));
+      }
+      g.querySelector("circle").setAttribute("cx", x.toFixed(1));
+      g.querySelector("circle").setAttribute("cy", y.toFixed(1));
+      g.querySelector("text").setAttribute("x", (x + 9).toFixed(1));
+      g.querySelector("text").setAttribute("y", (y + 4).toFixed(1));
+    };
+    map.addEventListener("click", function (ev) {
+      var pt = map.createSVGPoint();
+      pt.x = ev.clientX; pt.y = ev.clientY;
+      var p = pt.matrixTransform(map.getScreenCTM().inverse());
+      var east = view[3] + (p.x - view[0]) / view[2], north = view[4] - (p.y - view[1]) / view[2];
+      var lat = origin[0] + north / perDeg[0], lon = origin[1] + east / perDeg[1];
+      var which = chooser.querySelector("input[name=map-point]:checked").value;
+      var field = document.getElementById("f-" + which);
+      if (!field) return;
+      field.value = lat.toFixed(6) + "," + lon.toFixed(6);
+      marker(which, p.x, p.y);
+      status.textContent = (which === "pilot" ? "Your position" : "Take-off point") + " set to " +
+        field.value + ". Run again to plan from it.";
+    });
+  }
+
   // Print buttons.
   document.querySelectorAll("[data-print]").forEach(function (b) {
     b.addEventListener("click", function () { window.print(); });
