@@ -233,7 +233,7 @@ def test_bad_value_is_shown_beside_its_field(pages, server) -> None:
     assert page.locator("#e-altitude").inner_text().startswith("altitude:")
     page.click("#select-form button[type=submit]")
     page.wait_for_selector(".field.invalid")
-    assert page.locator("#e-range").inner_text() == "range: -5 is not > 0"
+    assert page.locator("#e-range").inner_text() == "range: -5 is not >= 1"
     assert page.locator("#e-altitude").inner_text().startswith("altitude: ")
     assert page.locator("#f-range").input_value() == "-5"
     assert page.locator("#results").count() == 0
@@ -412,6 +412,21 @@ def test_not_authorisable_in_the_browser(pages, server, shared_data, tmp_path) -
 FIELD_RING = [[6.1680, 46.2160], [6.1689, 46.2160], [6.1689, 46.2165], [6.1680, 46.2165], [6.1680, 46.2160]]
 
 
+#: Downloads started per page visit (Chromium holds the eleventh in quick succession).
+DOWNLOADS_PER_VISIT = 6
+
+
+def run_by_keyboard(page) -> None:  # type: ignore[no-untyped-def]
+    """Tab from the Range field to the run button and press Enter, as a keyboard user does."""
+    page.focus("#f-range")
+    for _ in range(30):
+        if page.evaluate("document.activeElement.type") == "submit":
+            break
+        page.keyboard.press("Tab")
+    with page.expect_navigation():
+        page.keyboard.press("Enter")
+
+
 def test_area_upload_map_results_downloads(pages, server, tmp_path) -> None:
     """Upload an area → the offline map → the results (focused) → every download, at desktop and
     phone widths; at phone width the ranking's priority columns (mass, cost, operation) are shown
@@ -426,13 +441,7 @@ def test_area_upload_map_results_downloads(pages, server, tmp_path) -> None:
         page.set_input_files("#f-area", str(area))
         page.fill("#f-range", "")  # with an area, distances come from the area
         if tag == "phone":  # keyboard only: Tab to the run button, Enter
-            page.focus("#f-range")
-            for _ in range(30):
-                if page.evaluate("document.activeElement.type") == "submit":
-                    break
-                page.keyboard.press("Tab")
-            with page.expect_navigation():
-                page.keyboard.press("Enter")
+            run_by_keyboard(page)
         else:
             page.click("#select-form button[type=submit]")
         landed(page)
@@ -457,7 +466,19 @@ def test_area_upload_map_results_downloads(pages, server, tmp_path) -> None:
         shot(page, f"select-area-{tag}")
         assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
         names = []
-        for link in page.locator(".downloads a[download]").all():
+        links = page.locator(".downloads a[download]")
+        for i in range(links.count()):
+            if i and i % DOWNLOADS_PER_VISIT == 0:
+                # Chromium holds a page's eleventh download in quick succession behind its
+                # "download multiple files" permission (headless: refused): the user runs the
+                # page again (it keeps the uploaded area) and goes on from the same link
+                if tag == "phone":
+                    run_by_keyboard(page)
+                else:
+                    with page.expect_navigation():
+                        page.click("#select-form button[type=submit]")
+                landed(page)
+            link = links.nth(i)
             with page.expect_download() as d:
                 if tag == "phone":  # keyboard only
                     link.focus()
