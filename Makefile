@@ -35,7 +35,7 @@ rust-checks:
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
 	cargo test --workspace --exclude py-uasnav --release
-	cargo build -p nav-core --no-default-features
+	cargo build -p uasnav-core --no-default-features
 	cargo bench --workspace --no-run
 
 py-checks: setup

@@ -7,8 +7,8 @@ from typing import Any
 
 import click
 
+from uasnav._extras import require
 from uasnav.errors import InputError
-from uasnav.web.security import LOOPBACK_HOSTS
 
 
 def is_loopback(host: str) -> bool:
@@ -47,9 +47,11 @@ def command(
     The documents are loaded once, at start; requests never name a file or URL. Requests whose
     Host is not this server, or cross-site form posts, are refused (DNS rebinding, CSRF).
     """
+    require("web", "uasnav serve")
     import uvicorn
 
     from uasnav.web.app import create_app, load_documents
+    from uasnav.web.security import LOOPBACK_HOSTS
     from uasnav.web.server_limits import harden, uvicorn_settings
 
     settings = uvicorn_settings()  # invalid deadlines in the environment: refused first
