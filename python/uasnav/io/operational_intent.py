@@ -48,7 +48,7 @@ ALTITUDE_RANGE_M = (-8000.0, 100_000.0)
 
 
 def _api() -> Any:
-    require("utm", "ASTM F3548 operational intents")
+    require("utm", "reading or writing ASTM F3548 operational intents")
     from uas_standards.astm.f3548.v21 import api
 
     return api
