@@ -199,7 +199,7 @@ def create_app(docs: Documents | None = None, allowed_hosts: tuple[str, ...] = (
             "ranking": _data_uri("text/csv", selection_view.ranking_csv(sel)),
             "rejections": _data_uri("text/csv", selection_view.rejections_csv(sel)),
         }
-        # the authorisation summary (issue 18) is the page's print view: one document, one renderer
+        # the authorisation summary is the page's print view: one document, one renderer
         downloads["summary_html"] = _data_uri("text/html", summary.summary_html(selection))
         downloads["summary_json"] = _data_uri(
             "application/json", json.dumps(summary.summary_dict(selection), ensure_ascii=False, indent=2)
