@@ -64,7 +64,7 @@ dist: wheel
 # The documentation site (mkdocs-material, offline: no web fonts, no CDN), warnings as errors.
 docs: setup
 	$(BIN)/python docs/gen_reference.py
-	$(BIN)/mkdocs build --strict -q -d build/site
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -q -d build/site
 	$(BIN)/python docs/check_offline.py build/site
 
 # The core crate as crates.io would receive it, and its docs without warnings.
@@ -82,8 +82,8 @@ rust-checks:
 	cargo bench --workspace --no-run
 
 py-checks: setup
-	$(BIN)/ruff check python tests benches scripts
-	$(BIN)/ruff format --check python tests benches scripts
+	$(BIN)/ruff check python tests benches scripts docs
+	$(BIN)/ruff format --check python tests benches scripts docs
 	$(BIN)/python -m mypy.stubtest uasnav._core
 	$(BIN)/python -m pytest -q
 
