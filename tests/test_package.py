@@ -111,18 +111,15 @@ def test_base_install_runs_help_allan_and_nav(venv: Venv, tmp_path: Path) -> Non
 FIELD = '{"type":"Polygon","coordinates":[[[8.54,47.37],[8.544,47.37],[8.544,47.3725],[8.54,47.37]]]}'
 
 
-@pytest.mark.parametrize(
-    ("command", "extra"),
-    [
-        ("uasnav serve --port 8765", "web"),
-        (
-            "uasnav fleet simulate --vehicles 1 --flights 1 --out f\nuasnav fleet scan f --out s",
-            "fleet",
-        ),
-        (f"printf '%s' '{FIELD}' > a.geojson\nuasnav plan --area a.geojson --out p", "utm"),
-    ],
-)
-def test_missing_extra_names_the_install_line(venv: Venv, tmp_path: Path, command: str, extra: str) -> None:
+NEEDS_EXTRA = {
+    "web": "uasnav serve --port 8765",
+    "fleet": "uasnav fleet simulate --vehicles 1 --flights 1 --out f\nuasnav fleet scan f --out s.parquet",
+    "utm": f"printf '%s' '{FIELD}' > a.geojson\nuasnav plan --area a.geojson --out p",
+}
+
+
+@pytest.mark.parametrize(("extra", "command"), sorted(NEEDS_EXTRA.items()))
+def test_missing_extra_names_the_install_line(venv: Venv, tmp_path: Path, extra: str, command: str) -> None:
     p = venv.run(command, tmp_path)
     assert p.returncode == 1, (p.stdout, p.stderr)
     lines = p.stderr.strip().splitlines()
