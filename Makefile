@@ -82,8 +82,8 @@ rust-checks:
 	cargo bench --workspace --no-run
 
 py-checks: setup
-	$(BIN)/ruff check python tests benches scripts docs
-	$(BIN)/ruff format --check python tests benches scripts docs
+	$(BIN)/ruff check python tests benches scripts docs/*.py
+	$(BIN)/ruff format --check python tests benches scripts docs/*.py
 	$(BIN)/python -m mypy.stubtest uasnav._core
 	$(BIN)/python -m pytest -q
 
