@@ -57,7 +57,7 @@ dist: wheel
 	rustup target add aarch64-unknown-linux-gnu
 	rm -f $(DIST)/uasnav-*aarch64*.whl $(DIST)/uasnav-*.tar.gz
 	$(MATURIN_BUILD) --target aarch64-unknown-linux-gnu --out $(DIST)
-	$(BIN)/maturin sdist -q --out $(DIST)
+	$(BIN)/maturin sdist --out $(DIST)
 	for w in $(DIST)/uasnav-*.whl; do $(BIN)/auditwheel show $$w | tr '\n' ' ' | grep -q 'manylinux_2_17' || { echo "error: $$w is not manylinux2014"; exit 1; }; done
 	ls -l $(DIST)
 
