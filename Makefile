@@ -1,19 +1,26 @@
 # uasnav: `make demo` runs the main job, `make test` runs every check. Both start from nothing:
 # they create .venv, install the Python dependencies and build the Rust extension with maturin.
+# `make demo` installs what the report needs (the base install + the utm and fleet extras);
+# `make test` adds the test and docs tools and Chromium for the browser tests.
 SHELL := /bin/bash
 PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
-EXTRAS ?= test
+EXTRAS ?= test,docs
+DEMO_EXTRAS := utm,fleet
 RUST_SRC := $(shell find crates -name '*.rs' -o -name Cargo.toml) Cargo.toml Cargo.lock
 PY_SRC := pyproject.toml
+DIST := build/dist
+# maturin finds zig (the ziglang wheel) through the venv's python on PATH
+ZIG_ENV := PATH="$(CURDIR)/$(BIN):$$PATH"
+MATURIN_BUILD := $(ZIG_ENV) $(BIN)/maturin build --release --strip --zig --compatibility manylinux2014 -q
 
-.PHONY: demo test setup browser rust-checks py-checks bench bench-python clean
+.PHONY: demo test setup browser rust-checks py-checks bench bench-python clean wheel dist docs publish-check
 
-demo: setup
+demo: $(VENV)/.built-demo
 	$(BIN)/uasnav report --out build/report
 
-test: setup rust-checks py-checks embedded
+test: setup rust-checks wheel py-checks embedded docs publish-check
 
 setup: $(VENV)/.built browser
 
@@ -31,16 +38,52 @@ $(VENV)/.built: $(BIN)/python $(RUST_SRC) $(PY_SRC)
 	$(BIN)/python -c 'import uasnav._core'
 	touch $@
 
+$(VENV)/.built-demo: $(BIN)/python $(RUST_SRC) $(PY_SRC)
+	$(BIN)/maturin develop --release --extras $(DEMO_EXTRAS) -q
+	$(BIN)/python -c 'import uasnav._core'
+	touch $@
+
+# The x86_64 wheel (abi3, manylinux2014 through zig), built once and installed by the package
+# tests (tests/test_package.py) in fresh virtual environments.
+wheel: $(DIST)/.x86_64
+
+$(DIST)/.x86_64: $(VENV)/.built $(RUST_SRC) $(PY_SRC) $(shell find python -name '*.py' -o -name '*.pyi')
+	rm -f $(DIST)/uasnav-*x86_64*.whl
+	$(MATURIN_BUILD) --target x86_64-unknown-linux-gnu --out $(DIST)
+	touch $@
+
+# Everything to publish: the x86_64 and aarch64 wheels and the sdist, each checked.
+dist: wheel
+	rustup target add aarch64-unknown-linux-gnu
+	rm -f $(DIST)/uasnav-*aarch64*.whl $(DIST)/uasnav-*.tar.gz
+	$(MATURIN_BUILD) --target aarch64-unknown-linux-gnu --out $(DIST)
+	$(BIN)/maturin sdist --out $(DIST)
+	for w in $(DIST)/uasnav-*.whl; do $(BIN)/auditwheel show $$w | tr '\n' ' ' | grep -q 'manylinux_2_17' || { echo "error: $$w is not manylinux2014"; exit 1; }; done
+	ls -l $(DIST)
+
+# The documentation site (mkdocs-material, offline: no web fonts, no CDN), warnings as errors.
+docs: setup
+	$(BIN)/python docs/gen_reference.py
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -q -d build/site
+	$(BIN)/python docs/check_offline.py build/site
+
+# The core crate as crates.io would receive it, and its docs without warnings.
+publish-check:
+	RUSTDOCFLAGS="-D warnings" cargo doc -p uasnav-core --no-deps -q
+	cargo publish --dry-run -p uasnav-core --allow-dirty -q
+	cargo run -q -p uasnav-core --example zupt_loop
+	cargo run -q -p uasnav-core --example allan_no_alloc
+
 rust-checks:
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
 	cargo test --workspace --exclude py-uasnav --release
-	cargo build -p nav-core --no-default-features
+	cargo build -p uasnav-core --no-default-features
 	cargo bench --workspace --no-run
 
 py-checks: setup
-	$(BIN)/ruff check python tests benches scripts
-	$(BIN)/ruff format --check python tests benches scripts
+	$(BIN)/ruff check python tests benches scripts docs/*.py
+	$(BIN)/ruff format --check python tests benches scripts docs/*.py
 	$(BIN)/python -m mypy.stubtest uasnav._core
 	$(BIN)/python -m pytest -q
 

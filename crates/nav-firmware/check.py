@@ -587,7 +587,7 @@ def print_sizes(args: argparse.Namespace) -> None:
         by_owner: dict[str, dict[str, set]] = defaultdict(lambda: defaultdict(set))
         for func, kind in sites:
             name = re.sub(r"::h[0-9a-f]{16}$", "", func).replace("$LT$", "<").replace("$GT$", ">")
-            m = re.match(r"nav_core::(\w+)", name)
+            m = re.match(r"(?:uasnav_)?nav_core::(\w+)", name)
             owner = f"nav-core {m.group(1)}" if m else next((o for o in ("libm", "nalgebra", "nav_firmware", "core") if o in name), "other")
             by_owner[owner][kind.split("::")[-1].split("<")[0]].add(name)
         for owner, kinds in sorted(by_owner.items()):

@@ -257,7 +257,7 @@ def redundancy_wahba(
 ) -> NDArray[np.float64]:
     """Rotation C (3, 3), reference → sensor, with v_sensor ≈ C·v_ref."""
 
-# --- utm (issue 17): the utm-index crate --------------------------------------------------
+# --- utm: the utm-index crate -----------------------------------------------------------
 
 def utm_encounters(
     intent: NDArray[np.uint32],
@@ -288,7 +288,7 @@ def utm_earliest_delays(
     with every other intent, NaN where none within ``max_delay_s``."""
 
 __all__ += ["utm_earliest_delays", "utm_encounters"]
-# ---- GNSS/INS (issue 15) ----------------------------------------------------------------
+# ---- GNSS/INS ---------------------------------------------------------------------------
 
 def ins_run(
     imu_t: NDArray[np.float64],

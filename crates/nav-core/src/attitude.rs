@@ -11,7 +11,7 @@
 //! The drift tools reproduce the thesis' free-inertial study (§4.2.5.3, eq. 35–36, Tables 7,
 //! 8 and 15): integrate a residual rate profile, report the rotation angle `θ(t)` of the
 //! attitude error and the first time it exceeds each threshold.
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 

@@ -6,7 +6,7 @@
 //! Groves (2013), *Principles of GNSS, Inertial, and Multisensor Integrated Navigation*,
 //! eqs. (2.134) and (2.139); the centrifugal part is included (it is "gravity", not
 //! "gravitation"), so a static accelerometer reads `−g` along the local down axis.
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use nalgebra::Vector3;
 

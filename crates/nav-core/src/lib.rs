@@ -1,4 +1,4 @@
-//! # nav-core — embeddable navigation numerics for small unmanned aircraft
+//! # uasnav-core — embeddable navigation numerics for small unmanned aircraft
 //!
 //! Conventions, stated once and tested (`attitude::tests`):
 //!
@@ -36,3 +36,8 @@ pub mod zupt;
 
 pub use error::NavError;
 pub use scalar::Real;
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

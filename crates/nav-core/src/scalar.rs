@@ -1,6 +1,6 @@
 //! The float trait every algorithm is generic over (f32 for Cortex-M class targets, f64 by
 //! default) and small numeric helpers shared by the modules.
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use nalgebra::RealField;
 

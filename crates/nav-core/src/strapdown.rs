@@ -27,7 +27,7 @@
 //! multiply-adds instead of two dense 15×15 products, 6750); the second-order `Φ = I + F·Ts + (F·Ts)²/2` is the dense reference path.
 //! The measurement update is the Joseph form for any `M×15` measurement matrix, with a
 //! Cholesky factorisation of the innovation covariance (failure → `NotPositiveDefinite`).
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use nalgebra::{Matrix3, Quaternion, SMatrix, SVector, UnitQuaternion, Vector3};
 

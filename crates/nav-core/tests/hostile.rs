@@ -1,23 +1,23 @@
-//! Issue #20 class 8: every entry point the Python binding calls survives hostile input —
+//! Every entry point the Python binding calls survives hostile input —
 //! empty, mismatched and non-finite — with an `Err`, never a panic, and never turns finite
 //! input into a silent NaN. Property tests (proptest), kept small so `cargo test` stays fast.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
 use nalgebra::{Matrix3, Vector3};
-use nav_core::allan::{self, AllanPoint, TauSpacing};
-use nav_core::attitude::{self as att, AttitudePropagator, PropagatorConfig};
-use nav_core::mlp::json::load_thermal_model;
-use nav_core::noise;
-use nav_core::redundancy::alignment;
-use nav_core::redundancy::chi2;
-use nav_core::redundancy::fusion::parity_residuals;
-use nav_core::redundancy::kalman::{BiasKalman, BiasKalmanConfig};
-use nav_core::redundancy::{AxisKind, FdiConfig, FdiFuser, Polyhedron, SensorArray};
-use nav_core::zupt::{
+use proptest::prelude::*;
+use uasnav_core::allan::{self, AllanPoint, TauSpacing};
+use uasnav_core::attitude::{self as att, AttitudePropagator, PropagatorConfig};
+use uasnav_core::mlp::json::load_thermal_model;
+use uasnav_core::noise;
+use uasnav_core::redundancy::alignment;
+use uasnav_core::redundancy::chi2;
+use uasnav_core::redundancy::fusion::parity_residuals;
+use uasnav_core::redundancy::kalman::{BiasKalman, BiasKalmanConfig};
+use uasnav_core::redundancy::{AxisKind, FdiConfig, FdiFuser, Polyhedron, SensorArray};
+use uasnav_core::zupt::{
     detect_static, BatchInput, BatchOutput, HeadingSource, NoDerivative, StationarityConfig,
     ZuptConfig, ZuptFilter, N_STATES,
 };
-use proptest::prelude::*;
 
 const CASES: u32 = 256;
 

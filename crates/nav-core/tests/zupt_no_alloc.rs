@@ -1,12 +1,12 @@
 //! The per-sample ZUPT step (predict + update, ZUPT and TCZUPT, both discretisations) and the
 //! batch runner, and the GNSS/INS filter's predict, updates and batch runner, never touch the heap: counted with an instrumented global allocator.
 use nalgebra::{UnitQuaternion, Vector3};
-use nav_core::zupt::{
+use stats_alloc::{Region, StatsAlloc, INSTRUMENTED_SYSTEM};
+use std::alloc::System;
+use uasnav_core::zupt::{
     BatchInput, BatchOutput, Discretisation, HeadingSource, Mode, NoDerivative, ZuptConfig,
     ZuptFilter,
 };
-use stats_alloc::{Region, StatsAlloc, INSTRUMENTED_SYSTEM};
-use std::alloc::System;
 
 #[global_allocator]
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
@@ -89,7 +89,9 @@ fn per_sample_step_and_batch_do_not_allocate() {
 }
 
 fn ins_step_updates_and_batch_do_not_allocate() {
-    use nav_core::ins::{InsBatchInput, InsBatchOutput, InsConfig, InsFilter, MagnetometerAiding};
+    use uasnav_core::ins::{
+        InsBatchInput, InsBatchOutput, InsConfig, InsFilter, MagnetometerAiding,
+    };
     let q = UnitQuaternion::from_euler_angles(0.01, -0.02, 0.5);
     let acc: [f64; 3] = (q.inverse() * Vector3::new(0.0, 0.0, -9.806)).into();
     let n = 2_000;

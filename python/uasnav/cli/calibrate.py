@@ -133,7 +133,7 @@ def _test(model_path: str, test_path: str, as_json: bool) -> None:
         "residual": ev.residual.to_dict(),
     }
     if ev.thermal_error_vs_truth is not None:
-        # Not truth − model itself: that includes the training log's turn-on bias (issue 14).
+        # Not truth − model itself: that includes the training log's turn-on bias.
         d = ev.thermal_error_vs_truth.to_dict()
         del d["mean"]  # zero by construction; the removed mean is "offset"
         out["thermal_error_vs_truth"] = {"truth": ev.truth_key, "offset": ev.truth_offset, **d}

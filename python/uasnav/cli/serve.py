@@ -7,6 +7,7 @@ from typing import Any
 
 import click
 
+from uasnav._extras import require
 from uasnav.errors import InputError
 
 
@@ -69,6 +70,7 @@ def command(
         raise click.UsageError("--live-intent needs --live CONNECTION")
     if live_connection and not live_intents:
         raise click.UsageError("--live needs at least one --live-intent INTENT.json")
+    require("web", "uasnav serve")
     import uvicorn
 
     from uasnav.web.app import create_app, load_documents

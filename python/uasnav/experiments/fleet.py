@@ -1,5 +1,5 @@
 """Fleet experiment: a simulated fleet's IMU health computed on a local Dask cluster, and the
-faulty IMUs the fleet-relative anomaly score finds (issue 19).
+faulty IMUs the fleet-relative anomaly score finds.
 
 The fleet is :func:`uasnav.fleet.simulate_fleet` (5 vehicles × 4 flights of 120 s, one or two
 faulty IMUs, a corrupt file; ``quick``: 3 × 2 flights of 40 s, processed in this process to stay

@@ -150,7 +150,7 @@ class MissionResult:
     figure74: Figure74
     #: Every Table 20 disagreement with its kind and reason (:func:`explain_table20`).
     table20_explained: tuple[dict, ...] = ()
-    #: The thesis case before issue 18: necessary items from the mission type alone.
+    #: The thesis' own case: necessary items from the mission type alone.
     before_necessary: tuple[str, ...] = ()
     #: The thesis' requirements flown at 300 m: VLOS, open category.
     vlos: Selection | None = None

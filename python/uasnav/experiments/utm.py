@@ -1,4 +1,4 @@
-"""UTM experiment (issue 17): calibrated time bounds, an operational intent of a 3D mission, and
+"""UTM experiment: calibrated time bounds, an operational intent of a 3D mission, and
 a deconfliction example with a resolved conflict.
 
 1. **Time bounds.** The trajectory predictor of the Phantom-4 experiment is calibrated by

@@ -1,4 +1,4 @@
-"""Stated rules for every verdict the report prints, computed from the numbers (issue 14).
+"""Stated rules for every verdict the report prints, computed from the numbers.
 
 A verdict is one of :data:`CONFIRMED`, :data:`PARTLY`, :data:`NOT_CONFIRMED` (or, for a change
 between two numbers, a word such as ``"grows"``) together with the rule that produced it and the

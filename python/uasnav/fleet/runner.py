@@ -54,6 +54,7 @@ from typing import Any
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from uasnav._extras import require
 from uasnav.errors import InputError
 from uasnav.fleet.output import (
     ERRORS_SCHEMA,
@@ -364,6 +365,7 @@ def _prepare_out(out: Path, resume: bool) -> None:
 def local_cluster(workers: int | None = None, memory_limit: str | float = "auto") -> Any:
     """A ``distributed.LocalCluster`` of ``workers`` processes (default one per core), one thread
     each, no dashboard, quiet logs."""
+    require("fleet", "fleet processing on a Dask cluster")
     from distributed import LocalCluster
 
     n = workers or os.cpu_count() or 1
@@ -610,6 +612,7 @@ def _run_distributed(
     fetch: dict[str, Any],
     memory_limit: str | int = "auto",
 ) -> None:
+    require("fleet", "fleet processing on a Dask cluster")
     from distributed import Client, as_completed
 
     cluster = None

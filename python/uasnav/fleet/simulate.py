@@ -1,8 +1,7 @@
 """``uasnav fleet simulate``: a synthetic fleet of flight logs with known faults and corrupt files.
 
-N vehicles × M flights, each flight one CSV v1 IMU log (the flight format of the GNSS/INS
-issue does not exist yet; when it does, the same generator should write it beside these), made
-with :func:`uasnav.sim.simulate`:
+N vehicles × M flights, each flight one CSV v1 IMU log (IMU only: the fleet's health numbers
+need no GNSS), made with :func:`uasnav.sim.simulate`:
 
 - every vehicle carries one IMU part (``lsm6dsm`` or ``ax1``, alternating), with its own
   hardware (turn-on biases from the vehicle's seed) and a white-noise level scaled by a

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from uasnav import jsoncheck as jc
+from uasnav._extras import require
 from uasnav.atomicfile import atomic_write_text
 from uasnav.errors import DataFormatError, InputError
 
@@ -47,6 +48,7 @@ ALTITUDE_RANGE_M = (-8000.0, 100_000.0)
 
 
 def _api() -> Any:
+    require("utm", "reading or writing ASTM F3548 operational intents")
     from uas_standards.astm.f3548.v21 import api
 
     return api

@@ -354,11 +354,11 @@ PDRA_G03_MAX_HEIGHT_M = 30.0
 PDRA_SOURCES = {
     "STS-01": (
         "(EU) 2019/947 Annex Appendix 1, UAS.STS-01.010/020, inserted by (EU) 2020/639 (OJ L 150, "
-        "13.5.2020); primary text not reached (sessions 23-24), no page"
+        "13.5.2020); not verified against a primary text, no page"
     ),
     "STS-02": (
         "(EU) 2019/947 Annex Appendix 1, UAS.STS-02.010/020, inserted by (EU) 2020/639 (OJ L 150, "
-        "13.5.2020); primary text not reached (sessions 23-24), no page"
+        "13.5.2020); not verified against a primary text, no page"
     ),
     "PDRA-G01": (
         "AMC2 Article 11 of (EU) 2019/947, PDRA-G01 v1.3 (edition September 2023, ED Decision "

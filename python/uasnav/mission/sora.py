@@ -7,7 +7,7 @@ check every table boundary against the values below.
 
 Sources
 -------
-``[AMC-2.5]`` — SORA 2.5, checked against its primary text in session 23:
+``[AMC-2.5]`` — SORA 2.5, checked against its primary text:
     EASA, "Acceptable Means of Compliance and Guidance Material to Regulation (EU) 2019/947 —
     Issue 1, Amendment 3", Annex to ED Decision 2025/018/R; AMC1 Article 11 "Specific
     operations risk assessment (SORA) (source: JARUS SORA v2.5)", edition September 2025.
@@ -33,32 +33,22 @@ Sources
 ``[SORA-2.0]`` — SORA 2.0: JARUS, "JARUS guidelines on SORA", edition 2.0, JAR-DEL-WG6-D.04,
     30 January 2019 (the basis of EASA's earlier AMC1 Article 11, ED Decision 2019/021/R):
     Table 2 (iGRC), Table 3 (mitigations), Figure 4 (ARC), Table 4 (TMPR), Table 5 (SAIL),
-    Table 6 (OSOs). **The tables' primary text could not be reached** (sessions 23 and 24), so no
-    page numbers are given for 2.0: the values are the earlier transcription, unchanged, and
-    where 2.0 and 2.5 share a table (SAIL, TMPR, the OSOs other than #04) they agree with
-    ``[AMC-2.5]``. What session 24 did reach, and why it is not enough:
-
-    * JARUS's publication page "JAR doc 06 SORA (package)", 6 March 2019
-      (jarus-rpas.org/content/jar-doc-06-sora-package): the main body is edition 2.0, Annexes B–E
-      edition 1.0 — it confirms the edition, not the tables;
-    * JARUS SORA Annex C, "Strategic Mitigation Collision Risk Assessment", JAR-DEL-WG6-D.04
-      edition 1.0, 30.01.2019 (public copy on pdfslide.us): title page and contents only;
-    * EASA Easy Access Rules online, "Annex C to AMC1 to Article 11", ED Decision 2023/012/R (the
-      SORA-2.0-based AMC): sections C.1–C.3 only (HTML, no pages).
-    The search tool returns the beginning of a stored page and the GitHub index holds no text of
-    the 2.0 main body or of EASA's 2019–2024 AMC1 Article 11 — only secondary encodings, which
-    disagree with each other and are not used. Unverified 2.0 tables: Table 2 (iGRC, incl. the
-    700 J / 34 kJ / 1084 kJ columns), Table 3 (M1/M2/M3 and the column floor), Figure 4 (ARC),
-    Table 4 (TMPR), Table 5 (SAIL), Table 6 (OSO robustness).
+    Table 6 (OSOs). The 2.0 tables are not verified against a primary text, so no page numbers
+    are given for 2.0; where 2.0 and 2.5 share a table (SAIL, TMPR, the OSOs other than #04)
+    they agree with ``[AMC-2.5]``. Secondary encodings disagree with each other and are not
+    used. The edition is confirmed by JARUS's publication page "JAR doc 06 SORA (package)",
+    6 March 2019 (main body edition 2.0, Annexes B–E edition 1.0). Unverified 2.0 tables:
+    Table 2 (iGRC, incl. the 700 J / 34 kJ / 1084 kJ columns), Table 3 (M1/M2/M3 and the column
+    floor), Figure 4 (ARC), Table 4 (TMPR), Table 5 (SAIL), Table 6 (OSO robustness).
 
 ARC height split: 500 ft AGL (152.4 m). ``[AMC-2.5]`` Figure 6 could not be read, but the same
 text speaks of "operations below 500 ft AGL" for the low TMPR (S.4.6.4(c), p. 36) and pairs
 500 ft with 152 m in its grid-size Table 4 (p. 28); some secondary encodings use 150 m for 2.5
-(JARUS Annex C Table C.1, not reached). The two differ by 2.4 m. ED Decision 2025/018/R carries
-no Annex C of its own (checked in session 24: its Annex B ends on p. 95 and Annex E begins on
-p. 96), so the EU adoption of 2.5 gives no strategic-mitigation table to check the 150 m value
-or the Annex C reduction limits against; ``residual_arc_of`` labels any claim beyond S.4.5.4 an
-Annex C claim to be substantiated.
+(JARUS Annex C Table C.1, not verified). The two differ by 2.4 m. ED Decision 2025/018/R carries
+no Annex C of its own (its Annex B ends on p. 95 and Annex E begins on p. 96), so the EU
+adoption of 2.5 gives no strategic-mitigation table to check the 150 m value or the Annex C
+reduction limits against; ``residual_arc_of`` labels any claim beyond S.4.5.4 an Annex C claim
+to be substantiated.
 
 The flow is the SORA's steps: #2 iGRC → #3 final GRC (mitigations, floor = the column's
 controlled-ground-area value) → #4 initial ARC → #5 residual ARC (strategic mitigations: given
@@ -132,7 +122,7 @@ MITIGATIONS25: dict[str, dict[str, int | None]] = {
 # --- SORA 2.0 ------------------------------------------------------------------------------
 
 #: SORA 2.0 Table 2 columns: (max characteristic dimension m, typical kinetic energy J)
-#: — [SORA-2.0] (primary text not reached in sessions 23-24: no page).
+#: — [SORA-2.0] (not verified against a primary text: no page).
 IGRC20_COLUMNS: tuple[tuple[float, float], ...] = (
     (1.0, 700.0),
     (3.0, 34e3),
@@ -140,7 +130,7 @@ IGRC20_COLUMNS: tuple[tuple[float, float], ...] = (
     (math.inf, math.inf),
 )
 #: SORA 2.0 Table 2 rows: operational scenario → iGRC per column (None = grey, not SORA)
-#: — [SORA-2.0] (no page: not reached).
+#: — [SORA-2.0] (no page: not verified against a primary text).
 IGRC20_ROWS: dict[str, tuple[int | None, ...]] = {
     "controlled": (1, 2, 3, 4),
     "vlos-sparsely": (2, 3, 4, 5),
@@ -151,7 +141,7 @@ IGRC20_ROWS: dict[str, tuple[int | None, ...]] = {
     "bvlos-assemblies": (8, None, None, None),
 }
 #: SORA 2.0 Table 3: GRC correction per mitigation and robustness (M3: ERP, +1 if absent/low)
-#: — [SORA-2.0] (no page: not reached).
+#: — [SORA-2.0] (no page: not verified against a primary text).
 MITIGATIONS20: dict[str, dict[str, int | None]] = {
     "M1": {"none": 0, "low": -1, "medium": -2, "high": -4},
     "M2": {"none": 0, "low": 0, "medium": -1, "high": -2},
@@ -165,8 +155,8 @@ SPARSE_LIMIT_20 = 500.0
 # --- both editions -------------------------------------------------------------------------
 
 #: SAIL from final GRC (rows ≤2, 3, 4, 5, 6, 7) and residual ARC (columns a–d): [AMC-2.5]
-#: p. 38 (JARUS 2.5 Table 7). 2.0's Table 5 holds the same cells ([SORA-2.0], not re-read this
-#: session); GRC > 7 is the certified category.
+#: p. 38 (JARUS 2.5 Table 7). 2.0's Table 5 holds the same cells ([SORA-2.0], not verified
+#: against a primary text); GRC > 7 is the certified category.
 SAIL_TABLE: dict[int, tuple[str, str, str, str]] = {
     2: ("I", "II", "IV", "VI"),
     3: ("II", "II", "IV", "VI"),
@@ -183,7 +173,7 @@ TMPR: dict[str, str] = {"a": "none", "b": "low", "c": "medium", "d": "high"}
 SAILS = ("I", "II", "III", "IV", "V", "VI")
 # OSO robustness per SAIL I..VI: O optional (2.0) / not required (2.5 "NR"), L low, M medium,
 # H high.
-#: SORA 2.0 Table 6 (24 OSOs) — [SORA-2.0] (primary text not reached in sessions 23-24: no page).
+#: SORA 2.0 Table 6 (24 OSOs) — [SORA-2.0] (not verified against a primary text: no page).
 OSO20: dict[str, tuple[str, str]] = {
     "OSO#01": ("Operator is competent and/or proven", "OLMHHH"),
     "OSO#02": ("UAS manufactured by competent and/or proven entity", "OOLMHH"),
@@ -456,8 +446,7 @@ def residual_arc_of(
     False) may lower the initial ARC by one class but never to ARC-a ([AMC-2.5] S.4.5.4,
     p. 34). Any other lower claim is an Annex C strategic-mitigation claim (operational
     restrictions or airspace structure) the operator must substantiate: it is accepted and
-    labelled so; Annex C's own reduction limits were not reached (sessions 23-24) and are not
-    checked.
+    labelled so; Annex C's own reduction limits are not checked.
     """
     if initial not in ARCS:
         raise InputError(f"unknown initial ARC {initial!r}")

@@ -3,7 +3,7 @@
 The simulator produces healthy sensors; :func:`inject_fault` turns one sensor of a stacked
 array output (one column per sensor axis, ``uasnav.redundancy.stack_logs`` layout) faulty
 from a given sample on. The kinds are the ones a fault detection and isolation scheme must
-handle (issue 6): a bias step, a stuck output, a noise burst, saturation and a dropout.
+handle: a bias step, a stuck output, a noise burst, saturation and a dropout.
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@
 //! the file's bytes with its own hex value replaced by 64 `0`s, so both loaders verify it
 //! byte-exactly without re-serialising.
 //!
-//! # Validation (issue #20)
+//! # Validation
 //!
 //! A file is validated fully at load, as Python's `uasnav.thermal.load_model` does, and every
 //! error names the JSON key at fault (`models[1].input_norm.scale: …`): checksum, format and
@@ -35,7 +35,7 @@
 //! Deliberately wider than Python: a network may have one or two hidden layers and any of the
 //! activations of [`Activation::from_name`] (tanh, logistic, linear), so hand-made or firmware
 //! networks load here; Python writes and reads only the 1-n-n-1 tanh/tanh/linear layout.
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use super::{Activation, Affine, LayerSpec, Mlp};
 use serde::Deserialize;

@@ -7,7 +7,7 @@
 //! (series / continued fraction as in Press et al., *Numerical Recipes*, §6.2), giving
 //! ~1e-10 relative accuracy (tested against scipy in `tests/test_redundancy.py`). The normal
 //! quantile is Acklam's rational approximation (relative error < 1.2·10⁻⁹).
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use crate::scalar::{from_usize, lit};
 use crate::{NavError, Real};

@@ -15,7 +15,7 @@
 //! `E[T] ≈ (2σ²_{n,a})/σ_a² + (3σ²_{n,ω} + ‖b_ω‖²)/σ_ω²` (σ_n per-sample noise, b_ω the gyro
 //! bias), i.e. ≈ 2–3 for a consumer MEMS IMU at rest; motion drives `T` to 10²–10⁴. Raise
 //! `σ_a`, `σ_ω` for noisier sensors (the known failure: noisy IMUs never detected as static).
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use crate::scalar::from_usize;
 use crate::{NavError, Real};

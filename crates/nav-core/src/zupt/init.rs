@@ -1,6 +1,6 @@
 //! Initial alignment of a stationary unit: coarse levelling from averaged accelerometers and
 //! heading from an input or from a levelled magnetometer with declination (thesis eq. 3).
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use nalgebra::{UnitQuaternion, Vector3};
 

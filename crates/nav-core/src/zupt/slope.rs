@@ -7,7 +7,7 @@
 //! `Σiy ← Σiy − (Σy − y_0)`), and `Σi`, `Σi²` are closed forms of `n`. To stop rounding error
 //! from accumulating, the sums are recomputed from the buffer once per `capacity` pushes
 //! (O(1) amortised) and the values are stored relative to the first sample.
-// No unchecked indexing in library code (issue #20); a proven index carries an `allow`.
+// No unchecked indexing in library code; a proven index carries an `allow`.
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 use crate::scalar::{from_usize, lit};
 use crate::Real;

@@ -252,7 +252,7 @@ SECTION = Section("mission", "Mission selector: matrices, database, feasibility,
 
 
 def _operation_section(w: SectionWriter, res) -> None:
-    """Issue 18: the operation, its category and equipment; the VLOS variant; the BVLOS SORA."""
+    """The operation, its category and equipment; the VLOS variant; the BVLOS SORA."""
     sel, vlos = res.selection, res.vlos
     op = sel.operation
     w.heading("Operation, category and equipment — the thesis case before and after")

@@ -1,4 +1,4 @@
-"""Report section: a simulated fleet processed on a local Dask cluster, the outliers found (issue 19).
+"""Report section: a simulated fleet processed on a local Dask cluster, the outliers found.
 
 Renders :func:`uasnav.experiments.fleet.run`.
 """
@@ -74,4 +74,4 @@ def build(w: SectionWriter) -> None:
     }
 
 
-SECTION = Section("fleet", "Fleet scale: IMU health of a simulated fleet on Dask (issue 19)", 90, build)
+SECTION = Section("fleet", "Fleet scale: IMU health of a simulated fleet on Dask", 90, build)

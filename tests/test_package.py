@@ -1,0 +1,190 @@
+"""The package as users get it: the x86_64 wheel installed alone in a fresh virtual environment
+(no Rust toolchain on PATH, no source tree), then the README's quick starts run exactly as
+written, and the wheel's tags, licences and version.
+
+The wheel is the one `make wheel` builds (`build/dist`, manylinux2014 through zig); when it is
+missing or older than the sources, this module builds it. One environment serves the module:
+the base install is checked first, then each quick start's own `pip install` adds its extra.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DIST = ROOT / "build" / "dist"
+README = ROOT / "README.md"
+
+pytestmark = pytest.mark.slow
+
+
+def _wheel() -> Path:
+    """The x86_64 wheel, built by `make wheel` when missing or stale."""
+    subprocess.run(["make", "-s", "wheel"], cwd=ROOT, check=True, capture_output=True, timeout=1800)
+    wheels = sorted(DIST.glob("uasnav-*-manylinux*x86_64*.whl"))
+    assert len(wheels) == 1, wheels
+    return wheels[0]
+
+
+@pytest.fixture(scope="module")
+def wheel() -> Path:
+    return _wheel()
+
+
+class Venv:
+    def __init__(self, path: Path, wheel: Path) -> None:
+        self.path = path
+        self.wheel = wheel
+        self.bin = path / "bin"
+        # the user's machine: this venv and the system, no cargo/rustc, no source tree
+        self.env = {
+            k: v for k, v in os.environ.items() if not k.startswith(("VIRTUAL_ENV", "PYTHON", "CARGO"))
+        }
+        self.env["PATH"] = f"{self.bin}:/usr/local/bin:/usr/bin:/bin"
+        self.env["HOME"] = os.environ.get("HOME", str(path))
+
+    def run(self, script: str, cwd: Path, timeout: float = 600) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            ["bash", "-euo", "pipefail", "-c", script],
+            cwd=cwd,
+            env=self.env,
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            check=False,
+        )
+
+    def pip_install(self, spec: str) -> None:
+        p = subprocess.run(
+            [str(self.bin / "python"), "-m", "pip", "install", "-q", spec],
+            env=self.env,
+            capture_output=True,
+            text=True,
+            timeout=1200,
+            check=False,
+        )
+        assert p.returncode == 0, p.stderr[-3000:]
+
+
+@pytest.fixture(scope="module")
+def venv(tmp_path_factory: pytest.TempPathFactory, wheel: Path) -> Venv:
+    path = tmp_path_factory.mktemp("fresh") / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(path)], check=True, timeout=300)
+    v = Venv(path, wheel)
+    v.pip_install(str(wheel))
+    return v
+
+
+def test_base_install_runs_help_allan_and_nav(venv: Venv, tmp_path: Path) -> None:
+    assert venv.run("command -v cargo || command -v rustc", tmp_path).returncode != 0
+    p = venv.run(
+        "python -c 'import uasnav, uasnav._core; print(uasnav.__file__)'\n"
+        "uasnav --help\n"
+        "uasnav simulate --preset lsm6dsm --profile static --duration 120 --out static.csv\n"
+        "uasnav allan static.csv --json > allan.json\n"
+        "uasnav simulate --profile flight --seed 3 --out flight.csv\n"
+        "uasnav nav flight.csv --gnss flight_gnss.csv --gnss-outage 60+20 --json > nav.json\n",
+        tmp_path,
+    )
+    assert p.returncode == 0, p.stderr[-3000:]
+    assert str(venv.path) in p.stdout.splitlines()[0]  # the installed package, not the tree
+    assert "allan" in p.stdout and "nav" in p.stdout
+    import json
+
+    allan = json.loads((tmp_path / "allan.json").read_text())
+    nav = json.loads((tmp_path / "nav.json").read_text())
+    assert allan and nav
+    # the base install holds none of the extras
+    p = venv.run("python -c 'import fastapi'", tmp_path)
+    assert p.returncode != 0
+    for mod in ("distributed", "uas_standards"):
+        assert venv.run(f"python -c 'import {mod}'", tmp_path).returncode != 0
+
+
+FIELD = '{"type":"Polygon","coordinates":[[[8.54,47.37],[8.544,47.37],[8.544,47.3725],[8.54,47.37]]]}'
+
+
+NEEDS_EXTRA = {
+    "web": "uasnav serve --port 8765",
+    "fleet": "uasnav fleet simulate --vehicles 1 --flights 1 --out f\nuasnav fleet scan f --out s.parquet",
+    "utm": f"printf '%s' '{FIELD}' > a.geojson\nuasnav plan --area a.geojson --out p",
+}
+
+
+@pytest.mark.parametrize(("extra", "command"), sorted(NEEDS_EXTRA.items()))
+def test_missing_extra_names_the_install_line(venv: Venv, tmp_path: Path, extra: str, command: str) -> None:
+    p = venv.run(command, tmp_path)
+    assert p.returncode == 1, (p.stdout, p.stderr)
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), p.stderr
+    assert f"pip install 'uasnav[{extra}]'" in lines[0]
+    assert "Traceback" not in p.stderr
+
+
+def quick_starts(text: str) -> list[tuple[str, str]]:
+    """(title, bash block) of every quick start in the README."""
+    section = text.split("## Quick starts", 1)[1].split("\n## ", 1)[0]
+    found = []
+    for part in section.split("\n### ")[1:]:
+        title = part.splitlines()[0]
+        blocks = re.findall(r"```bash\n(.*?)```", part, flags=re.S)
+        assert len(blocks) == 1, title
+        found.append((title, blocks[0]))
+    return found
+
+
+def test_readme_is_short_and_has_a_quick_start_per_user() -> None:
+    text = README.read_text()
+    assert len(text.splitlines()) <= 150
+    titles = [t for t, _ in quick_starts(text)]
+    assert len(titles) == 5
+    for who in ("Navigation engineer", "IMU lab", "Operator", "UTM service", "Fleet analyst"):
+        assert any(t.startswith(who) for t in titles), titles
+    # the two commands first; CI runs exactly the second
+    first = re.search(r"```bash\n(.*?)```", text, flags=re.S)
+    assert first is not None
+    commands = [line.split("#")[0].strip() for line in first.group(1).splitlines()]
+    assert commands == ["make demo", "make test"]
+    ci = (ROOT / ".ci" / "run").read_text()
+    assert [ln for ln in ci.splitlines() if ln.startswith("make")] == ["make test"]
+
+
+@pytest.mark.parametrize("index", range(5))
+def test_readme_quick_start_runs_as_written(venv: Venv, tmp_path: Path, index: int) -> None:
+    title, block = quick_starts(README.read_text())[index]
+    # `pip install 'uasnav[x]'` takes the extra from the wheel under test, dependencies from PyPI
+    script = re.sub(
+        r"pip install 'uasnav\[(\w+)\]'", lambda m: f"pip install -q '{venv.wheel}[{m.group(1)}]'", block
+    )
+    p = venv.run(script, tmp_path, timeout=900)
+    assert p.returncode == 0, f"{title}\n{p.stdout[-2000:]}\n{p.stderr[-3000:]}"
+    assert "error:" not in p.stderr, p.stderr
+
+
+def test_wheel_is_portable_abi3_with_licences_and_one_version(wheel: Path) -> None:
+    name = wheel.name
+    assert "-cp310-abi3-" in name and "manylinux2014_x86_64" in name, name
+    cargo = (ROOT / "Cargo.toml").read_text()
+    version = re.search(r'\[workspace\.package\][^\[]*?\nversion = "([^"]+)"', cargo, flags=re.S).group(1)
+    assert name.startswith(f"uasnav-{version}-")
+    with zipfile.ZipFile(wheel) as z:
+        names = z.namelist()
+        meta = z.read(f"uasnav-{version}.dist-info/METADATA").decode()
+    for lic in ("LICENSE-MIT", "LICENSE-APACHE"):
+        assert f"uasnav-{version}.dist-info/licenses/{lic}" in names
+    assert re.search(r"^Version: " + re.escape(version) + "$", meta, flags=re.M)
+    assert re.search(r"^License-Expression: MIT OR Apache-2.0$", meta, flags=re.M)
+    # the base requirements hold none of the extras' libraries
+    base = [ln for ln in meta.splitlines() if ln.startswith("Requires-Dist:") and "extra ==" not in ln]
+    for heavy in ("fastapi", "uvicorn", "dask", "uas-standards", "playwright"):
+        assert not any(heavy in ln for ln in base), heavy
+    auditwheel = Path(sys.executable).parent / "auditwheel"
+    p = subprocess.run([str(auditwheel), "show", str(wheel)], capture_output=True, text=True, check=True)
+    assert '"manylinux_2_17_x86_64"' in " ".join(p.stdout.split()), p.stdout
