@@ -50,8 +50,8 @@ SUBCOMMANDS: Mapping[str, tuple[str, str]] = {
     "monitor": (
         "uasnav.cli.monitor",
         "Follow each vehicle on CONNECTION (udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT, "
-        "tcpin:HOST:PORT, /dev/ttyX,BAUD) and report its F3548 conformance state changes (Accepted, Activated, "
-        "Nonconforming, Contingent, Ended) and telemetry losses.",
+        "tcpin:HOST:PORT, /dev/ttyX,BAUD) and report its F3548 conformance state changes "
+        "(Accepted, Activated, Nonconforming, Contingent, Ended) and telemetry losses.",
     ),
     "nav": (
         "uasnav.cli.nav",

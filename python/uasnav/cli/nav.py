@@ -48,8 +48,8 @@ def _durations(text: str | None) -> list[float]:
     "--live",
     "live",
     metavar="CONNECTION",
-    help="Run causally on a live MAVLink stream (udpin:HOST:PORT, tcp:HOST:PORT, tcpin:HOST:PORT, /dev/ttyX,BAUD) "
-    "instead of LOG, writing --out as it goes and a status line per second.",
+    help="Run causally on a live MAVLink stream (udpin:HOST:PORT, tcp:HOST:PORT, tcpin:HOST:PORT, "
+    "/dev/ttyX,BAUD) instead of LOG, writing --out as it goes and a status line per second.",
 )
 @click.option(
     "--causal",
