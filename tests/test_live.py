@@ -146,18 +146,15 @@ def flown(shared_data):
 def intent(shared_data, flown, tmp_path_factory):
     """An intent for the tlog's plan departing at the second flight's arming, from a model
     trained on the tlog's own runs (its autopilot limits and speed), with the climb and descent
-    speeds its runs achieved. The plan's first waypoint
-    lies 2.8 m from home (shorter than a predictor segment, which ``trajectory intent``
-    refuses): it is left out, the take-off climb covers it."""
-    import dataclasses
-
+    speeds its runs achieved. The whole plan is filed, including its first waypoint 2.8 m from
+    home (``trajectory intent`` merges such short legs into their neighbours)."""
     from uasnav.io.plans import read_plan, write_plan
 
     d = tmp_path_factory.mktemp("live")
     model, out, plan = d / "model.json", d / "phoenix.json", d / "phoenix.plan"
     tlog = str(shared_data / TLOG)
     p = read_plan(tlog)
-    write_plan(dataclasses.replace(p, items=(p.items[0], *p.items[2:])), plan)
+    write_plan(p, plan)
     r = CliRunner().invoke(main, ["trajectory", "train", tlog, "--out", str(model)])
     assert r.exit_code == 0, r.output
     start = flown["utc"].isoformat().replace("+00:00", "Z")
