@@ -53,3 +53,15 @@ def test_warnings_after_success_shows_them_once_the_block_succeeded(capsys) -> N
         assert shown == []
     finally:
         warnings.showwarning = old
+
+
+def test_folded_warnings_name_each_file_once() -> None:
+    """A warning about the file the error already names drops its prefix; others keep theirs."""
+    from uasnav.cli import _with_warnings
+
+    line = _with_warnings(
+        "log.bin, column 'GPS.Status': fewer than 2 fixes",
+        ["log.bin: corrupt data skipped: 1 record dropped", "other.csv: 3 rows skipped"],
+    )
+    assert line.count("log.bin") == 1
+    assert line.endswith("(warnings: corrupt data skipped: 1 record dropped; other.csv: 3 rows skipped)")

@@ -276,9 +276,20 @@ class _Group(click.Group):
                 f"(run again with {DEBUG_ENV}=1 for the traceback)"
             )
         if held:
-            message = f"{message} (warnings: {'; '.join(held)})"
+            message = _with_warnings(message, held)
         click.echo(f"error: {_one_line(message)}", err=True)
         ctx.exit(1)
+
+
+def _with_warnings(message: str, held: list[str]) -> str:
+    """The error line with the warnings held back during the run; a warning that starts with
+    what the error already names (``log.bin: corrupt data skipped …``) drops that prefix, so
+    each file is named once."""
+    parts = []
+    for w in held:
+        head, sep, rest = w.partition(": ")
+        parts.append(rest if sep and head and head in message else w)
+    return f"{message} (warnings: {'; '.join(parts)})"
 
 
 @click.group(
