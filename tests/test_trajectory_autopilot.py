@@ -103,7 +103,7 @@ def test_corner_speeds() -> None:
 
 
 # --- defaults against their citations -------------------------------------------------------
-_UNIT_SCALE = {"cm/s²": 0.01, "cm/s": 0.01, "cm": 0.01, "ms": 0.001}
+_UNIT_SCALE = {"cm/s²": 0.01, "cm/s": 0.01, "cm": 0.01, "ms": 0.001, "cd/s": 0.01}
 
 
 @pytest.mark.parametrize(
@@ -112,7 +112,9 @@ _UNIT_SCALE = {"cm/s²": 0.01, "cm/s": 0.01, "cm": 0.01, "ms": 0.001}
 def test_defaults_match_their_cited_source(table: dict[str, ap.Default]) -> None:
     for name, d in table.items():
         # "<file> <version>: <NAME> <number> <unit>": the number, in the firmware's unit, is the value
-        m = re.search(r":\s*[A-Z_0-9]+ (−?[\d.]+)\s*(cm/s²|cm/s|cm|ms|m/s³|m/s²|m/s|m|s|°/s|°)?", d.source)
+        m = re.search(
+            r":\s*[A-Z_0-9]+ (−?[\d.]+)\s*(cm/s²|cm/s|cm|ms|cd/s|m/s³|m/s²|m/s|m|s|°/s|°)?", d.source
+        )
         assert m is not None, d.source
         number = float(m.group(1).replace("−", "-"))
         assert d.value == pytest.approx(number * _UNIT_SCALE.get(m.group(2) or "", 1.0)), (name, d.source)
@@ -273,6 +275,94 @@ def test_arducopter_4x_rtl_closed_form_and_final_altitude_hover() -> None:
     hover = ap.mission_params("arducopter", "4.5.7", {"RTL_ALT_FINAL": 500.0})
     h = ap.predict_mission(_plan(items), hover)
     assert not h.landed and h.eta_s - h.arrive_s[1] == pytest.approx(t_leg + 5.0 + 15 / 1.5, rel=2e-3)
+
+
+def test_arducopter_rtl_cone_closed_form() -> None:
+    """``ModeRTL::compute_return_target``: the return height is RTL_ALT limited by the cone
+    d·RTL_CONE_SLOPE around home, never below the current height."""
+    p4 = ap.mission_params("arducopter", "4.5.7")  # RTL_ALT 15 m, slope 3, RTL_CLIMB_MIN 0
+    assert ap.arducopter_rtl_altitude(p4, 5.0, 100.0) == 15.0  # far: RTL_ALT
+    assert ap.arducopter_rtl_altitude(p4, 5.0, 3.0) == pytest.approx(9.0)  # 3 m × 3
+    assert ap.arducopter_rtl_altitude(p4, 5.0, 1.0) == 5.0  # inside the cone: no climb
+    assert ap.arducopter_rtl_altitude(p4, 20.0, 1.0) == 20.0  # never descends
+    flat = ap.mission_params("arducopter", "4.5.7", {"RTL_CONE_SLOPE": 0.4})  # below 0.5: off
+    assert ap.arducopter_rtl_altitude(flat, 5.0, 1.0) == 15.0
+    climb = ap.mission_params("arducopter", "4.5.7", {"RTL_CLIMB_MIN": 300.0})  # 3 m, in cm
+    assert ap.arducopter_rtl_altitude(climb, 5.0, 1.0) == pytest.approx(8.0)
+    # 3.5–3.6: inside the cone it still climbs RTL_ABS_MIN_CLIMB (2.5 m) up to RTL_ALT
+    p3 = ap.mission_params("arducopter", "3.6.12")
+    assert ap.arducopter_rtl_altitude(p3, 5.0, 1.0) == pytest.approx(7.5)
+    assert ap.arducopter_rtl_altitude(p3, 5.0, 3.0) == pytest.approx(9.0)
+    assert ap.arducopter_rtl_altitude(p3, 14.0, 1.0) == pytest.approx(15.0)
+    # 3.3 has no cone: up to RTL_ALT
+    assert ap.arducopter_rtl_altitude(ap.mission_params("arducopter", "3.3.3"), 5.0, 1.0) == 15.0
+
+
+def test_arducopter_rtl_near_home_climbs_only_to_the_cone() -> None:
+    # RTL 3 m from home at 5 m: climbs 4 m (to 3 m × 3) instead of 10 m, then returns
+    items = [
+        MissionItem(22, 3, alt_m=5.0),
+        MissionItem(16, 3, lat_deg=_north(3.0), lon_deg=8.0, alt_m=5.0),
+        MissionItem(20, 2),
+    ]
+    p = ap.mission_params("arducopter", "4.5.7")
+    r = ap.predict_mission(_plan(items), p)
+    t_climb = ap.leg_time(4.0, 2.5, 1.0)[0]
+    t_back = ap.leg_time(3.0, 10.0, 2.5, 1.0)[0]
+    t_land = 9.0 / 0.5  # all of it below LAND_ALT_LOW
+    assert r.eta_s - r.arrive_s[1] == pytest.approx(t_climb + t_back + 5.0 + t_land, rel=2e-3)
+    no_cone = ap.mission_params("arducopter", "4.5.7", {"RTL_CONE_SLOPE": 0.0})
+    r0 = ap.predict_mission(_plan(items), no_cone)
+    t_climb0 = ap.leg_time(10.0, 2.5, 1.0)[0]
+    t_land0 = 5.0 / 1.5 + 10.0 / 0.5
+    assert r0.eta_s - r0.arrive_s[1] == pytest.approx(t_climb0 + t_back + 5.0 + t_land0, rel=2e-3)
+
+
+def test_arducopter_rtl_turns_back_to_the_armed_heading() -> None:
+    """WP_YAW_BEHAVIOR 1/3 point the nose home on the way back; over home the loiter ends
+    once RTL_LOIT_TIME has passed and the heading is within 2° of the armed heading."""
+    items = [
+        MissionItem(22, 3, alt_m=20.0),
+        MissionItem(16, 3, lat_deg=_north(100.0), lon_deg=8.0, alt_m=20.0),
+        MissionItem(20, 2),
+    ]
+    # armed facing north; the way home is south: a 180° turn at ATC_SLEW_YAW 60°/s = 2.97 s
+    p_hold = ap.mission_params("arducopter", "4.5.7", {"RTL_LOIT_TIME": 1000.0})  # 1 s
+    p_look = ap.mission_params("arducopter", "4.5.7", {"RTL_LOIT_TIME": 1000.0, "WP_YAW_BEHAVIOR": 1})
+    r_hold = ap.predict_mission(_plan(items), p_hold, armed_heading_deg=0.0)
+    r_look = ap.predict_mission(_plan(items), p_look, armed_heading_deg=0.0)
+    assert r_look.eta_s - r_hold.eta_s == pytest.approx((180.0 - 2.0) / 60.0 - 1.0, abs=1e-6)
+    # a loiter longer than the turn hides it; WP_YAW_BEHAVIOR 2 (the default) holds the heading
+    p_long = ap.mission_params("arducopter", "4.5.7", {"WP_YAW_BEHAVIOR": 3})
+    base = ap.predict_mission(_plan(items), ap.mission_params("arducopter", "4.5.7"), armed_heading_deg=0.0)
+    assert ap.predict_mission(_plan(items), p_long, armed_heading_deg=0.0).eta_s == pytest.approx(base.eta_s)
+    # unknown armed heading: no turn is timed
+    assert ap.predict_mission(_plan(items), p_look).eta_s == pytest.approx(r_hold.eta_s)
+    # armed facing south (the way home): nothing to turn
+    assert ap.predict_mission(_plan(items), p_look, armed_heading_deg=180.0).eta_s == pytest.approx(
+        r_hold.eta_s
+    )
+
+
+def test_arducopter_yaw_behaviour_costs_no_time_in_auto() -> None:
+    """ModeAuto::wp_run points the nose while it flies; verify_nav_wp has no heading
+    condition: a square flown with any WP_YAW_BEHAVIOR takes the same time."""
+    items = [
+        MissionItem(22, 3, alt_m=10.0),
+        MissionItem(16, 3, lat_deg=_north(50.0), lon_deg=8.0, alt_m=10.0),
+        MissionItem(16, 3, lat_deg=_north(50.0), lon_deg=8.0 + 50.0 / 75_800.0, alt_m=10.0),
+        MissionItem(16, 3, lat_deg=_north(0.0), lon_deg=8.0 + 50.0 / 75_800.0, alt_m=10.0),
+        MissionItem(21, 3, alt_m=0.0),
+    ]
+    times = {
+        b: ap.predict_mission(
+            _plan(items),
+            ap.mission_params("arducopter", "4.5.7", {"WP_YAW_BEHAVIOR": b}),
+            armed_heading_deg=90.0,
+        ).eta_s
+        for b in (0, 1, 2, 3)
+    }
+    assert max(times.values()) == pytest.approx(min(times.values()))
 
 
 def test_time_bounds_from_the_vehicles_own_flights(shared_data: Path) -> None:

@@ -26,9 +26,16 @@ straight lines (no jerk limit; its target slows down at 2·``WPNAV_ACCEL``, the
 a "fast waypoint" passed at full speed); 4.x plans S-curves (``WPNAV_JERK``) and rounds corners
 within ``WPNAV_RADIUS`` at the lateral acceleration ``WPNAV_ACCEL_C`` (0: 2·``WPNAV_ACCEL``).
 Take-off climbs vertically; LAND descends at ``LAND_SPEED_HIGH`` (0: ``WPNAV_SPEED_DN``) down
-to ``LAND_ALT_LOW`` and at ``LAND_SPEED`` below; RTL climbs to ``RTL_ALT``, returns at
-``RTL_SPEED`` (0: ``WPNAV_SPEED``), loiters ``RTL_LOIT_TIME`` and lands (or descends to
-``RTL_ALT_FINAL`` and hovers when it is non-zero).
+to ``LAND_ALT_LOW`` and at ``LAND_SPEED`` below; RTL climbs to ``RTL_ALT`` limited by the
+cone ``RTL_CONE_SLOPE`` (:func:`arducopter_rtl_altitude`), returns at ``RTL_SPEED``
+(0: ``WPNAV_SPEED``), loiters ``RTL_LOIT_TIME`` — longer when ``WP_YAW_BEHAVIOR`` 1 or 3 turned
+the nose home and it must turn back to the armed heading (:func:`arducopter_rtl_yaw_wait`) —
+and lands (or descends to ``RTL_ALT_FINAL`` and hovers when it is non-zero). ArduCopter never
+waits for its heading before or along a leg: ``ModeAuto::wp_run`` flies the waypoint
+controller and points the nose at the same time, and ``verify_nav_wp`` completes on
+``reached_wp_destination`` and the hold alone (``ArduCopter/mode_auto.cpp`` at ArduPilot
+00132531; ``AC_WPNav::advance_wp_target_along_track`` of 3.x reaches a waypoint on the track
+and ``WPNAV_RADIUS`` alone), so ``WP_YAW_BEHAVIOR`` costs no time in AUTO.
 
 PX4 multicopter (``FlightTaskAuto`` + ``PositionSmoothing``): ``MPC_XY_CRUISE``,
 ``MPC_ACC_HOR``, ``MPC_JERK_AUTO``, ``MPC_Z_V_AUTO_UP/DN`` (before 1.12: ``MPC_Z_VEL_MAX_UP/DN``),
@@ -303,6 +310,23 @@ _AC4_WPNAV = "AC_WPNav.cpp with ACCEL_C and the SCurve legs (Copter 4.x var_info
 _AC_CONFIG = "ArduCopter/config.h (LAND_SPEED 50, RTL_ALT 1500, RTL_LOITER_TIME 5000, RTL_ALT_FINAL 0)"
 _AC36_PARAMS = "ArduCopter/Parameters.cpp with Copter::ModeFlowHold (3.6): ParametersG2 LAND_ALT_LOW 1000"
 _AC45_PARAMS = "ArduCopter/Parameters.cpp with rtl_speed_cms/land_speed_high_cms (4.5+)"
+_AC45_CONFIG = (
+    "ArduCopter/config.h at HoodTechMech/ardupilot_4p5 0c1b263c (Copter 4.5: RTL_CONE_SLOPE_DEFAULT 3.0, "
+    "RTL_MIN_CONE_SLOPE 0.5, RTL_ALT_MIN 30, RTL_CLIMB_MIN_DEFAULT 0, "
+    "WP_YAW_BEHAVIOR_DEFAULT LOOK_AT_NEXT_WP_EXCEPT_RTL)"
+)
+_AC36_RTL = (
+    "ArduCopter/control_rtl.cpp of the 3.5–3.6 layout (Location_Class): rtl_compute_return_target "
+    "applies RTL_CONE_SLOPE with RTL_ABS_MIN_CLIMB"
+)
+_AC3_CONFIG_YAW = (
+    "ArduCopter/config.h of Copter 3.x (AUTO_YAW_SLEW_RATE 60 deg/s, "
+    "WP_YAW_BEHAVIOR_DEFAULT LOOK_AT_NEXT_WP_EXCEPT_RTL)"
+)
+_ATC_SLEW = (
+    "libraries/AC_AttitudeControl/AC_AttitudeControl.h (AC_ATTITUDE_CONTROL_SLEW_YAW_DEFAULT_CDS 6000 "
+    "→ ATC_SLEW_YAW)"
+)
 _PX4_111 = "mc_pos_control_params.c of the v1.11 layout (defines MPC_SPOOLUP_TIME; no MPC_Z_V_AUTO_*)"
 _PX4_112 = "mc_pos_control_params.c of the v1.12–1.13 layout (defines MPC_Z_V_AUTO_*, SYS_VEHICLE_RESP)"
 _PX4_114 = "multicopter_autonomous_params.c at 456c5516 (v1.14 split layout)"
@@ -344,6 +368,18 @@ ARDUCOPTER_DEFAULTS: dict[str, dict[str, Default]] = {
         ),
         "RTL_LOIT_TIME": Default(5.0, "ArduCopter/config.h Copter-3.6: RTL_LOITER_TIME 5000 ms", _AC_CONFIG),
         "RTL_ALT_FINAL": Default(0.0, "ArduCopter/config.h Copter-3.6: RTL_ALT_FINAL 0", _AC_CONFIG),
+        "RTL_CONE_SLOPE": Default(
+            3.0, "ArduCopter/config.h Copter-3.6: RTL_CONE_SLOPE_DEFAULT 3.0", f"{_AC36_RTL}; {_AC45_CONFIG}"
+        ),
+        "RTL_CLIMB_MIN": Default(
+            0.0, "ArduCopter/config.h Copter-3.6: RTL_CLIMB_MIN_DEFAULT 0 cm", f"{_AC36_RTL}; {_AC45_CONFIG}"
+        ),
+        "WP_YAW_BEHAVIOR": Default(
+            2.0, "ArduCopter/config.h Copter-3.6: WP_YAW_BEHAVIOR_DEFAULT 2 (except RTL)", _AC3_CONFIG_YAW
+        ),
+        "ATC_SLEW_YAW": Default(
+            60.0, "ArduCopter/config.h Copter-3.6: AUTO_YAW_SLEW_RATE 60 °/s", _AC3_CONFIG_YAW
+        ),
     },
     "4": {
         "WPNAV_SPEED": Default(10.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_SPEED 1000 cm/s", _AC4_WPNAV),
@@ -369,6 +405,18 @@ ARDUCOPTER_DEFAULTS: dict[str, dict[str, Default]] = {
         ),
         "RTL_LOIT_TIME": Default(5.0, "ArduCopter/config.h Copter-4.5: RTL_LOITER_TIME 5000 ms", _AC_CONFIG),
         "RTL_ALT_FINAL": Default(0.0, "ArduCopter/config.h Copter-4.5: RTL_ALT_FINAL 0", _AC_CONFIG),
+        "RTL_CONE_SLOPE": Default(
+            3.0, "ArduCopter/config.h Copter-4.5: RTL_CONE_SLOPE_DEFAULT 3.0", _AC45_CONFIG
+        ),
+        "RTL_CLIMB_MIN": Default(
+            0.0, "ArduCopter/config.h Copter-4.5: RTL_CLIMB_MIN_DEFAULT 0 cm", _AC45_CONFIG
+        ),
+        "WP_YAW_BEHAVIOR": Default(
+            2.0, "ArduCopter/config.h Copter-4.5: WP_YAW_BEHAVIOR_DEFAULT 2 (except RTL)", _AC45_CONFIG
+        ),
+        "ATC_SLEW_YAW": Default(
+            60.0, "AC_AttitudeControl.h Copter-4.5: SLEW_YAW_DEFAULT_CDS 6000 cd/s", _ATC_SLEW
+        ),
     },
 }
 #: ArduCopter parameters logged in cm, cm/s, cm/s² or ms (→ SI by these factors).
@@ -376,7 +424,8 @@ _AC_SCALE = {
     "WPNAV_SPEED": 0.01, "WPNAV_ACCEL": 0.01, "WPNAV_SPEED_UP": 0.01, "WPNAV_SPEED_DN": 0.01,
     "WPNAV_ACCEL_Z": 0.01, "WPNAV_RADIUS": 0.01, "WPNAV_ACCEL_C": 0.01, "LAND_SPEED": 0.01,
     "LAND_SPEED_HIGH": 0.01, "LAND_ALT_LOW": 0.01, "RTL_ALT": 0.01, "RTL_SPEED": 0.01,
-    "RTL_LOIT_TIME": 0.001, "RTL_ALT_FINAL": 0.01, "WPNAV_JERK": 1.0,
+    "RTL_LOIT_TIME": 0.001, "RTL_ALT_FINAL": 0.01, "WPNAV_JERK": 1.0, "RTL_CONE_SLOPE": 1.0,
+    "RTL_CLIMB_MIN": 0.01, "WP_YAW_BEHAVIOR": 1.0, "ATC_SLEW_YAW": 0.01,
 }  # fmt: skip
 
 #: PX4 multicopter defaults (SI). Sources: PX4-Autopilot
@@ -498,7 +547,8 @@ class ModelOptions:
         ``MIS_YAW_ERR`` (``Mission::is_mission_item_reached``).
     yaw_before_move : bool
         Turn to face the next leg before flying it where the firmware waits for the heading:
-        PX4 with ``MPC_YAW_MODE`` 4 ("towards waypoint, yaw first"); ArduCopter never waits.
+        PX4 with ``MPC_YAW_MODE`` 4 ("towards waypoint, yaw first"); ArduCopter never waits
+        (``ModeAuto::wp_run``/``verify_nav_wp`` have no heading condition).
     """
 
     ac3_slowdown_factor: float = 2.0
@@ -672,6 +722,7 @@ class _State:
     airborne: bool = False
     heading: float = math.nan  # rad from north (NaN: unknown)
     vdir: np.ndarray | None = None  # unit vector of the horizontal motion (north, east)
+    armed_heading: float = math.nan  # rad from north at arming (NaN: unknown)
 
 
 def _local(plan: MissionPlan, origin: tuple[float, float]) -> dict[int, np.ndarray]:
@@ -749,6 +800,7 @@ def predict_mission(
     start_ne: tuple[float, float] | None = None,
     start_height_m: float = 0.0,
     origin: tuple[float, float] | None = None,
+    armed_heading_deg: float | None = None,
 ) -> MissionPrediction:
     """When each item of ``plan`` is reached and when the mission ends, as the autopilot
     family of ``params`` flies it (see the module docs).
@@ -765,6 +817,10 @@ def predict_mission(
         ``origin`` and height above home (default: at home, on the ground).
     origin : (lat, lon), optional
         The local frame's origin (default home, else the first positioned item).
+    armed_heading_deg : float, optional
+        The vehicle's heading at arming and at the start (degrees from true north); ArduCopter
+        turns back to it over home in RTL when ``WP_YAW_BEHAVIOR`` is 1 or 3. Unknown: no
+        turn is timed.
 
     Raises
     ------
@@ -788,6 +844,8 @@ def predict_mission(
     home_ne = np.zeros(2) if home is not None else (pos[first] if first is not None else np.zeros(2))
     s = _State(np.array(start_ne if start_ne is not None else home_ne, dtype=float), float(start_height_m))
     s.airborne = start_height_m > 0.5
+    if armed_heading_deg is not None and math.isfinite(armed_heading_deg):
+        s.heading = s.armed_heading = math.radians(armed_heading_deg)
     cruise = p.cruise_ms
     out_items: list[int] = []
     out_cmds: list[int] = []
@@ -886,7 +944,10 @@ def _yaw_first(p: MissionParams) -> bool:
     """Whether the firmware holds the vehicle until it faces the next waypoint: PX4 with
     ``MPC_YAW_MODE`` 4 (``FlightTaskAuto``: ``should_wait_for_yaw_align`` zeroes the velocity
     setpoint while the rate-limited yaw setpoint is not aligned). ArduCopter turns while it
-    flies (``WP_YAW_BEHAVIOR`` only chooses where the nose points), so it never waits."""
+    flies (``WP_YAW_BEHAVIOR`` only chooses where the nose points): ``ModeAuto::wp_run``
+    runs ``update_wpnav`` and the heading together and ``verify_nav_wp`` waits for
+    ``reached_wp_destination`` and the hold only (``mode_auto.cpp`` at ArduPilot 00132531),
+    so it never waits."""
     return p.family == "px4-mc" and p.options.yaw_before_move and p.values.get("MPC_YAW_MODE", 0.0) == 4.0
 
 
@@ -1045,11 +1106,78 @@ def _land_time(p: MissionParams, h: float, *, vtol: bool) -> float:
     return banded_descent_time(h, p["Q_WP_SPEED_DN"], p["Q_LAND_SPEED"], p["Q_LAND_FINAL_ALT"])
 
 
+#: ArduCopter RTL constants (``ArduCopter/config.h``): the lowest return altitude
+#: ``RTL_ALT_MIN`` (30 cm in 4.5), the shallowest cone that is applied ``RTL_MIN_CONE_SLOPE``
+#: (0.5), and the 3.5–4.x cone's minimum climb ``RTL_ABS_MIN_CLIMB`` (250 cm).
+AC_RTL_ALT_MIN_M = 0.3
+AC_RTL_MIN_CONE_SLOPE = 0.5
+AC_RTL_ABS_MIN_CLIMB_M = 2.5
+#: ArduCopter's ``RESET_TO_ARMED_YAW`` ends the loiter at home once the heading is within 2°
+#: of the heading at arming (``ModeRTL::loiterathome_run``).
+AC_RTL_YAW_TOLERANCE_DEG = 2.0
+
+
+def arducopter_rtl_altitude(p: MissionParams, height_m: float, distance_m: float) -> float:
+    """The height above home (m) ArduCopter returns at from ``height_m`` m, ``distance_m`` m
+    (horizontal) from home (``ModeRTL::compute_return_target``).
+
+    With h the current height, d the distance, s = ``RTL_CONE_SLOPE``, c = ``RTL_CLIMB_MIN``:
+
+    * 4.x: m = max(``RTL_ALT_MIN``, h + c); H = max(``RTL_ALT``, m); when s ≥ 0.5,
+      H = min(H, max(d·s, m)); never below h;
+    * 3.5–3.6: H = max(h + c, ``RTL_ALT``); when s ≥ 0.5,
+      H = max(h, min(H, max(d·s, h + ``RTL_ABS_MIN_CLIMB``)));
+    * before 3.5 (no cone): max(h + c, ``RTL_ALT``).
+
+    ``RTL_ALT`` 0 keeps the current height.
+
+    >>> p = mission_params("arducopter", "4.5.7")
+    >>> arducopter_rtl_altitude(p, 5.0, 100.0), arducopter_rtl_altitude(p, 5.0, 3.0)
+    (15.0, 9.0)
+    """
+    h, d = max(height_m, 0.0), max(distance_m, 0.0)
+    rtl_alt = p["RTL_ALT"] if p["RTL_ALT"] > 0 else h
+    climb_min = max(p.values.get("RTL_CLIMB_MIN", 0.0), 0.0)
+    slope = p.values.get("RTL_CONE_SLOPE", 0.0)
+    major, minor = p.major or 4, p.minor
+    if major >= 4:
+        m = max(AC_RTL_ALT_MIN_M, h + climb_min)
+        target = max(rtl_alt, m)
+        if slope >= AC_RTL_MIN_CONE_SLOPE:
+            target = min(target, max(d * slope, m))
+        return max(target, h)
+    target = max(h + climb_min, rtl_alt)
+    if (major, minor) >= (3, 5) and slope >= AC_RTL_MIN_CONE_SLOPE:
+        target = max(h, min(target, max(d * slope, h + AC_RTL_ABS_MIN_CLIMB_M)))
+    return max(target, h)
+
+
+def arducopter_rtl_yaw_wait(p: MissionParams, heading_rad: float, armed_heading_rad: float) -> float:
+    """Extra time (s) beyond ``RTL_LOIT_TIME`` ArduCopter loiters at home to turn back to the
+    heading it was armed at: only when ``WP_YAW_BEHAVIOR`` points the nose on the way home
+    (1 "next waypoint" or 3 "ground course"; 0 and 2 hold the heading in RTL, so
+    ``loiterathome_start`` chooses ``HOLD``). The turn runs at ``ATC_SLEW_YAW`` (3.x:
+    ``AUTO_YAW_SLEW_RATE``) from the start of the loiter and ends within 2°, so the wait is
+    max(0, (|Δψ| − 2°)/rate − ``RTL_LOIT_TIME``). An unknown heading waits nothing.
+
+    >>> p = mission_params("arducopter", "4.5.7", {"WP_YAW_BEHAVIOR": 1, "RTL_LOIT_TIME": 0})
+    >>> round(arducopter_rtl_yaw_wait(p, math.pi, 0.0), 3)  # (180° − 2°) at 60°/s
+    2.967
+    """
+    if int(p.values.get("WP_YAW_BEHAVIOR", 2.0)) not in (1, 3):
+        return 0.0
+    if not (math.isfinite(heading_rad) and math.isfinite(armed_heading_rad)):
+        return 0.0
+    err = abs(_wrap(armed_heading_rad - heading_rad)) - math.radians(AC_RTL_YAW_TOLERANCE_DEG)
+    rate = math.radians(max(p.values.get("ATC_SLEW_YAW", 60.0), 1e-3))
+    return max(err / rate - p["RTL_LOIT_TIME"], 0.0)
+
+
 def _rtl(p: MissionParams, s: _State, home_ne: np.ndarray, cruise: float) -> bool:
     """Return to launch from the state (updating it); whether it ends on the ground."""
     up, _, az = _vertical_limits(p)
     if p.family == "arducopter":
-        rtl_alt = p["RTL_ALT"]
+        rtl_alt = arducopter_rtl_altitude(p, s.h, float(np.hypot(*(np.asarray(home_ne) - s.ne))))
         v = p["RTL_SPEED"] or p["WPNAV_SPEED"]
         loiter, final = p["RTL_LOIT_TIME"], p["RTL_ALT_FINAL"]
     elif p.family == "px4-mc":
@@ -1063,7 +1191,17 @@ def _rtl(p: MissionParams, s: _State, home_ne: np.ndarray, cruise: float) -> boo
         s.t += leg_time(rtl_alt - s.h, up, az)[0]
         s.h = rtl_alt
     s.v = 0.0
+    heading_before = s.heading
     _leg(p, s, home_ne, s.h, v, 0.0, accept=False)
+    if p.family == "arducopter":
+        if int(p.values.get("WP_YAW_BEHAVIOR", 2.0)) in (1, 3):
+            # the nose points home on the way (LOOK_AT_NEXT_WP / LOOK_AHEAD) and turns back
+            # to the armed heading over home
+            loiter += arducopter_rtl_yaw_wait(p, s.heading, s.armed_heading)
+            if math.isfinite(s.armed_heading):
+                s.heading = s.armed_heading
+        else:
+            s.heading = heading_before  # HOLD: the heading the vehicle had when RTL began
     s.t += loiter
     s.ne, s.v = home_ne.copy(), 0.0
     if p.family == "px4-mc" and s.h > p["RTL_DESCEND_ALT"]:
@@ -1165,6 +1303,8 @@ __all__ = [
     "MissionParams",
     "MissionPrediction",
     "ModelOptions",
+    "arducopter_rtl_altitude",
+    "arducopter_rtl_yaw_wait",
     "banded_descent_time",
     "corner_speed",
     "distance_over_speed_time",
