@@ -423,3 +423,22 @@ def test_web_prediction_takes_the_dalby_plan_with_its_short_vtol_leg(shared_data
     r = predict_plan(default_model(), up.route_ne, up.origin, 3.0, 0.0, 20.0, "default")
     times = [w["time_s"] for w in r.waypoints]
     assert len(times) == len(up.route_ne) and np.all(np.diff(times) >= 0) and r.eta_s > 0
+
+
+@pytest.mark.parametrize(
+    ("log", "why"),
+    [
+        ("flights/alfa_carbonz_engine_failure", "carries no plan"),
+        ("logs/ardupilot_log171.bin", "only a home position"),
+        ("logs/px4_sample_log_small.ulg", "empty mission"),
+    ],
+)
+def test_evaluate_names_why_a_log_without_a_mission_cannot_be_scored(
+    shared_data: Path, log: str, why: str
+) -> None:
+    # an ALFA folder is a log like any other; each evaluation says why it does not apply
+    r = CliRunner().invoke(main, ["trajectory", "evaluate", str(shared_data / log)])
+    assert r.exit_code == 1
+    lines = r.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: mission model: ") and why in lines[0], r.output
+    assert "element methods: " in lines[0] and "Traceback" not in r.output

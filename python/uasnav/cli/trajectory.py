@@ -332,7 +332,7 @@ def _log_limits(flights: Sequence[str], logs: Any) -> tuple[AutopilotLimits, str
 
 
 @command.command("evaluate")
-@click.argument("flights", nargs=-1, type=click.Path(dir_okay=False))
+@click.argument("flights", nargs=-1, type=click.Path())
 @_apply(_common_opts)
 @click.option("--simulated", is_flag=True, help="Run the simulated Phantom-4 experiment (Table 17) instead.")
 @click.option("--seed", type=SEED, default=0, show_default=True)
@@ -439,7 +439,7 @@ def _evaluate_flights(
     # one decoding pass per log serves both evaluations
     opened: list[Any] = [
         open_log(f, need=(*MISSION_VIEWS, "limits"))
-        if Path(f).suffix.lower() in (".tlog", ".bin", ".ulg") and Path(f).is_file()
+        if (Path(f).suffix.lower() in (".tlog", ".bin", ".ulg") and Path(f).is_file()) or Path(f).is_dir()
         else f
         for f in flights
     ]
@@ -482,6 +482,9 @@ def _evaluate_flights(
             errors = leave_one_run_out(fs, segment, random_state=seed, accel_ms2=limits.accel_ms2 or 1.0)
         except InputError as why:
             if mission is None:
+                if mission_error is not None and mission_error != str(why):
+                    # neither evaluation applies: say why for both
+                    raise InputError(f"mission model: {mission_error}; element methods: {why}") from why
                 raise
             element_error = "; ".join(dict.fromkeys(x for x in (element_error, str(why)) if x))
             errors, fs = [], None

@@ -292,6 +292,7 @@ def evaluate_logs(logs: Sequence[Any]) -> dict[str, Any]:
     for item in logs:
         log = item if isinstance(item, LogFile) else open_log(item, need=MISSION_VIEWS)
         path = str(log.path)
+        log.plan  # noqa: B018 - a log without a mission is refused for that, before its parameters
         p = log_mission_params(log)
         stacks[path] = f"{p.family} {p.version or ''}".strip()
         sources[path] = {k: {"value": p.values[k], "source": p.sources[k]} for k in p.values}
