@@ -442,3 +442,23 @@ def test_evaluate_names_why_a_log_without_a_mission_cannot_be_scored(
     lines = r.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: mission model: ") and why in lines[0], r.output
     assert "element methods: " in lines[0] and "Traceback" not in r.output
+
+
+def test_web_page_predicts_the_dalby_plan(shared_data: Path) -> None:
+    """The trajectory page itself (form post, no JavaScript) takes the real QuadPlane plan
+    with its 1.85 m VTOL landing leg and draws every waypoint."""
+    import warnings
+
+    from uasnav.web import create_app
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        from fastapi.testclient import TestClient
+
+    data = (shared_data / "missions" / "ardupilot_autotest_dalby_obc2016.waypoints").read_bytes()
+    client = TestClient(create_app(), base_url="http://127.0.0.1:8000", raise_server_exceptions=False)
+    r = client.post("/trajectory", files={"plan": ("dalby.waypoints", data)})
+    assert r.status_code == 200 and 'id="prediction"' in r.text, r.text[-2000:]
+    assert "shorter than" not in r.text
+    # every distinct waypoint of the route is drawn (the start marked apart)
+    assert r.text.count('<circle class="wp') >= 29
