@@ -102,6 +102,93 @@ def test_corner_speeds() -> None:
     assert ap.corner_speed(ac3, math.pi / 2, 5.0) == 5.0  # a 3.x fast waypoint
 
 
+# --- ArduCopter 4.x S-curve against the firmware's own segment equations ---------------------
+def _raised_cosine_speed_change(
+    dv: float, a_max: float, j_max: float, tj: float, dt: float = 2e-5
+) -> tuple[float, float, float]:
+    """Integrate SCurve's jerk profile numerically from rest: a raised-cosine jerk rise over
+    tj (J = ½·Jm·(1 − cos(π·t/tj))), constant jerk Jm for t2 = Am/Jm − tj, a raised-cosine
+    fall, constant acceleration, and the mirror image down to zero acceleration at v = Δv
+    (``SCurve::add_segments_jerk``). Returns (duration, speed reached, distance)."""
+    t2 = a_max / j_max - tj
+    a_ramp_dv = a_max * (t2 + 2 * tj)  # speed gained by the rise and the fall of the acceleration
+    t4 = (dv - a_ramp_dv) / a_max
+    assert t2 >= 0 and t4 >= 0
+
+    def jerk_up(t: float) -> float:  # one rise of the acceleration from 0 to Am
+        if t < tj:
+            return 0.5 * j_max * (1 - math.cos(math.pi * t / tj))
+        if t < tj + t2:
+            return j_max
+        if t < 2 * tj + t2:
+            return 0.5 * j_max * (1 - math.cos(math.pi * (t - tj - t2) / tj + math.pi))
+        return 0.0
+
+    t_rise = 2 * tj + t2
+    total = 2 * t_rise + t4
+    ts = np.arange(0.0, total, dt)
+    jerk = np.array(
+        [jerk_up(t) if t < t_rise else (0.0 if t < t_rise + t4 else -jerk_up(t - t_rise - t4)) for t in ts]
+    )
+    acc = np.cumsum(jerk) * dt
+    vel = np.cumsum(acc) * dt
+    return total, float(vel[-1]), float(np.sum(vel) * dt)
+
+
+def test_scurve_raised_cosine_segment_matches_the_firmware_closed_forms() -> None:
+    """``SCurve::add_segment_incr_jerk`` ends a raised-cosine jerk segment of length tj at
+    A = Jm·tj/2, V = Jm/2·(tj²/2 − 2·tj²/π²), P = Jm/2·(tj³/6 − tj³/π²) (from rest): the same
+    numbers as integrating the jerk numerically."""
+    jm, tj, dt = 1.0, 0.3, 1e-6
+    ts = np.arange(0.0, tj, dt)
+    acc = np.cumsum(0.5 * jm * (1 - np.cos(np.pi * ts / tj))) * dt
+    vel = np.cumsum(acc) * dt
+    pos = np.sum(vel) * dt
+    beta = math.pi / tj
+    assert acc[-1] == pytest.approx(0.5 * jm * tj, rel=1e-4)
+    assert vel[-1] == pytest.approx(0.5 * jm * (tj * tj / 2 - 2 / beta**2), rel=1e-3)
+    assert pos == pytest.approx(0.5 * jm * (-tj / beta**2 + tj**3 / 6), rel=2e-3)
+
+
+@pytest.mark.parametrize(
+    ("dv", "a_max", "j_max", "tc"), [(10.0, 2.5, 1.0, 0.15), (5.0, 1.0, 1.0, 0.15), (8.0, 2.0, 2.5, 0.3)]
+)
+def test_arducopter_4x_speed_change_is_the_scurve_profile(
+    dv: float, a_max: float, j_max: float, tc: float
+) -> None:
+    """The 4.x speed change (:func:`speed_change_time` with t_j = 2·ATC_INPUT_TC) equals the
+    duration of SCurve's 7-segment raised-cosine profile, and covers (v₀ + v₁)/2 · T."""
+    p = ap.mission_params(
+        "arducopter", "4.5.7", {"ATC_INPUT_TC": tc, "WPNAV_ACCEL": a_max * 100, "WPNAV_JERK": j_max}
+    )
+    tj = ap.arducopter_jerk_time(p)
+    assert tj == pytest.approx(2 * tc)
+    # AC_WPNav::calc_scurve_jerk_and_snap: S = ½·j·π/(2·tc); SCurve::calculate_path: tj = j·π/(2·S)
+    snap = 0.5 * j_max * math.pi / (2 * max(tc, 0.1))
+    assert tj == pytest.approx(j_max * math.pi / (2 * snap))
+    total, v_end, dist = _raised_cosine_speed_change(dv, a_max, j_max, tj)
+    assert v_end == pytest.approx(dv, rel=1e-3)
+    assert ap.speed_change_time(dv, a_max, j_max, tj) == pytest.approx(total, rel=1e-6)
+    assert dist == pytest.approx(0.5 * dv * total, rel=1e-3)
+    # a whole rest-to-rest leg long enough to cruise: two such changes and the cruise between
+    d = 200.0
+    t_leg, _ = ap.leg_time(d, dv, a_max, j_max, jerk_time=tj)
+    assert t_leg == pytest.approx(2 * total + (d - dv * total) / dv, rel=1e-6)
+    # 3.x has no S-curve
+    assert ap.arducopter_jerk_time(ap.mission_params("arducopter", "3.6.12")) == 0.0
+
+
+def test_short_scurve_speed_changes_are_continuous() -> None:
+    # across the branches (acceleration limit reached / not reached / jerk lowered) the time
+    # grows continuously with Δv and reduces to the constant-jerk law when t_j = 0
+    a, j, tj = 2.5, 1.0, 0.3
+    dvs = np.linspace(1e-4, 12.0, 4001)
+    ts = np.array([ap.speed_change_time(x, a, j, tj) for x in dvs])
+    assert np.all(np.diff(ts) >= -1e-12) and np.max(np.abs(np.diff(ts))) < 0.05
+    for x in (0.05, 1.0, 7.0):
+        assert ap.speed_change_time(x, a, j, 0.0) == ap.speed_change_time(x, a, j)
+
+
 # --- defaults against their citations -------------------------------------------------------
 _UNIT_SCALE = {"cm/s²": 0.01, "cm/s": 0.01, "cm": 0.01, "ms": 0.001, "cd/s": 0.01}
 
@@ -268,7 +355,8 @@ def test_arducopter_4x_rtl_closed_form_and_final_altitude_hover() -> None:
     ]
     p = ap.mission_params("arducopter", "4.5.7")  # 10 m/s, 2.5 m/s², jerk 1 m/s³; RTL_ALT 15 m
     r = ap.predict_mission(_plan(items), p)
-    t_leg = ap.leg_time(100.0, 10.0, 2.5, 1.0)[0]
+    # the S-curve's raised-cosine jerk lasts 2·ATC_INPUT_TC = 0.3 s
+    t_leg = ap.leg_time(100.0, 10.0, 2.5, 1.0, jerk_time=0.3)[0]
     # already above RTL_ALT: back at WPNAV_SPEED, RTL_LOIT_TIME 5 s, land 10 m at 1.5 + 10 m at 0.5
     assert r.eta_s - r.arrive_s[1] == pytest.approx(t_leg + 5.0 + 10 / 1.5 + 10 / 0.5, rel=2e-3)
     assert r.landed
@@ -308,7 +396,7 @@ def test_arducopter_rtl_near_home_climbs_only_to_the_cone() -> None:
     p = ap.mission_params("arducopter", "4.5.7")
     r = ap.predict_mission(_plan(items), p)
     t_climb = ap.leg_time(4.0, 2.5, 1.0)[0]
-    t_back = ap.leg_time(3.0, 10.0, 2.5, 1.0)[0]
+    t_back = ap.leg_time(3.0, 10.0, 2.5, 1.0, jerk_time=0.3)[0]
     t_land = 9.0 / 0.5  # all of it below LAND_ALT_LOW
     assert r.eta_s - r.arrive_s[1] == pytest.approx(t_climb + t_back + 5.0 + t_land, rel=2e-3)
     no_cone = ap.mission_params("arducopter", "4.5.7", {"RTL_CONE_SLOPE": 0.0})

@@ -11,7 +11,9 @@ A leg of length d flown from speed v₀ to speed v₁ under the speed limit v an
 limit a (and jerk limit j where the firmware has one) takes
 
 * speed change Δv: T(Δv) = Δv/a + a/j if Δv ≥ a²/j, else 2·√(Δv/j) (jerk-limited, symmetric
-  S-curve; without a jerk limit T = Δv/a), covering (v₀ + v₁)/2 · T;
+  S-curve; without a jerk limit T = Δv/a), covering (v₀ + v₁)/2 · T; ArduCopter 4.x's
+  ``SCurve`` shapes the jerk itself as a raised cosine of duration t_j, adding t_j
+  (:func:`speed_change_time`, :func:`arducopter_jerk_time`);
 * the peak speed v_p ≤ v is the largest one whose speed-up and slow-down fit in d; the rest is
   flown at v_p.
 
@@ -91,28 +93,52 @@ FAMILIES = ("arducopter", "px4-mc", "plane")
 
 
 # --------------------------------------------------------------------------- kinematics
-def speed_change_time(dv: float, accel: float, jerk: float | None = None) -> float:
+def speed_change_time(dv: float, accel: float, jerk: float | None = None, jerk_time: float = 0.0) -> float:
     """Time (s) to change speed by ``dv`` (m/s) at acceleration limit ``accel`` (m/s²) and, when
     given, jerk limit ``jerk`` (m/s³): Δv/a + a/j when the acceleration limit is reached
     (Δv ≥ a²/j), else 2·√(Δv/j); Δv/a without a jerk limit.
+
+    With ``jerk_time`` t_j > 0 the jerk itself rises and falls as a raised cosine over t_j
+    (ArduPilot's ``SCurve``: the snap limit), so the acceleration ramps take t₂ + 2·t_j with
+    t₂ = a/j − t_j at constant jerk: T = Δv/a + a/j + t_j when a is reached
+    (Δv ≥ a·(a/j + t_j)); below, the peak acceleration A solves A²/j + A·t_j = Δv and
+    T = 2·(A/j + t_j); below Δv = 2·j·t_j² the jerk is lowered at fixed t_j and T = 4·t_j.
+    Every profile is point-symmetric about its middle, so it covers (v₀ + v₁)/2 · T.
 
     >>> speed_change_time(5.0, 1.0)
     5.0
     >>> speed_change_time(5.0, 1.0, 1.0)
     6.0
+    >>> speed_change_time(5.0, 1.0, 1.0, 0.3)
+    6.3
     """
     dv = abs(dv)
     if dv == 0.0:
         return 0.0
     if jerk is None or not math.isfinite(jerk) or jerk <= 0:
         return dv / accel
+    tj = max(jerk_time, 0.0) if math.isfinite(jerk_time) else 0.0
+    if tj > 0.0:
+        if accel < jerk * tj:
+            # the raised cosine alone would exceed the acceleration limit: SCurve shortens it
+            # to t_j' = √(a·t_j/j) at the same snap (j' = j·t_j'/t_j), so that a = j'·t_j'
+            tj_short = math.sqrt(accel * tj / jerk)
+            jerk, tj = jerk * tj_short / tj, tj_short
+        if dv >= accel * (accel / jerk + tj):
+            return dv / accel + accel / jerk + tj
+        if dv >= 2.0 * jerk * tj * tj:
+            a_peak = 0.5 * jerk * (-tj + math.sqrt(tj * tj + 4.0 * dv / jerk))
+            return 2.0 * (a_peak / jerk + tj)
+        return 4.0 * tj
     if dv >= accel * accel / jerk:
         return dv / accel + accel / jerk
     return 2.0 * math.sqrt(dv / jerk)
 
 
-def _change(v0: float, v1: float, accel: float, jerk: float | None) -> tuple[float, float]:
-    t = speed_change_time(v1 - v0, accel, jerk)
+def _change(
+    v0: float, v1: float, accel: float, jerk: float | None, jerk_time: float = 0.0
+) -> tuple[float, float]:
+    t = speed_change_time(v1 - v0, accel, jerk, jerk_time)
     return t, 0.5 * (v0 + v1) * t
 
 
@@ -124,10 +150,12 @@ def leg_time(
     v0: float = 0.0,
     v1: float = 0.0,
     decel: float | None = None,
+    jerk_time: float = 0.0,
 ) -> tuple[float, float]:
     """Time (s) to fly ``d`` m from speed ``v0`` to ``v1`` under ``v_max``, the acceleration
-    ``accel`` (``decel`` for slowing down, default the same) and the jerk limit; and the speed
-    the leg actually ends at (lower than ``v1`` when the leg is too short to reach it).
+    ``accel`` (``decel`` for slowing down, default the same), the jerk limit and the raised-cosine
+    jerk time ``jerk_time`` (:func:`speed_change_time`); and the speed the leg actually ends at
+    (lower than ``v1`` when the leg is too short to reach it).
 
     >>> leg_time(100.0, 5.0, 1.0)  # trapezoid: 100/5 + 5/1
     (25.0, 0.0)
@@ -138,7 +166,7 @@ def leg_time(
     v0 = min(v0, v_max)
     v1 = min(v1, v_max)
     # the end speed reachable from v0 within d
-    _, d01 = _change(v0, v1, accel if v1 > v0 else dec, jerk)
+    _, d01 = _change(v0, v1, accel if v1 > v0 else dec, jerk, jerk_time)
     if d01 > d:
         if v1 > v0:  # cannot reach v1: accelerate all the way
             vb = math.sqrt(v0 * v0 + 2.0 * accel * d)
@@ -148,8 +176,8 @@ def leg_time(
         return 2.0 * d / max(v0 + vb, 1e-9), vb
 
     def dist(vp: float) -> tuple[float, float]:
-        ta, da = _change(v0, vp, accel, jerk)
-        tb, db = _change(vp, v1, dec, jerk)
+        ta, da = _change(v0, vp, accel, jerk, jerk_time)
+        tb, db = _change(vp, v1, dec, jerk, jerk_time)
         return ta + tb, da + db
 
     lo, hi = max(v0, v1), v_max
@@ -323,6 +351,10 @@ _AC3_CONFIG_YAW = (
     "ArduCopter/config.h of Copter 3.x (AUTO_YAW_SLEW_RATE 60 deg/s, "
     "WP_YAW_BEHAVIOR_DEFAULT LOOK_AT_NEXT_WP_EXCEPT_RTL)"
 )
+_ATC_TC = (
+    "libraries/AC_AttitudeControl/AC_AttitudeControl.cpp (Copter and Sub: "
+    "AC_ATTITUDE_CONTROL_INPUT_TC_DEFAULT 0.15f 'Medium'); AC_WPNav.cpp calc_scurve_jerk_and_snap"
+)
 _ATC_SLEW = (
     "libraries/AC_AttitudeControl/AC_AttitudeControl.h (AC_ATTITUDE_CONTROL_SLEW_YAW_DEFAULT_CDS 6000 "
     "→ ATC_SLEW_YAW)"
@@ -392,6 +424,9 @@ ARDUCOPTER_DEFAULTS: dict[str, dict[str, Default]] = {
         "WPNAV_RADIUS": Default(2.0, "AC_WPNav.cpp Copter-4.5: WPNAV_WP_RADIUS 200 cm", _AC4_WPNAV),
         "WPNAV_JERK": Default(1.0, "AC_WPNav.cpp Copter-4.5: JERK 1 m/s³", _AC4_WPNAV),
         "WPNAV_ACCEL_C": Default(0.0, "AC_WPNav.cpp Copter-4.5: ACCEL_C 0 (2×WPNAV_ACCEL)", _AC4_WPNAV),
+        "ATC_INPUT_TC": Default(
+            0.15, "AC_AttitudeControl.cpp Copter-4.5: AC_ATTITUDE_CONTROL_INPUT_TC_DEFAULT 0.15 s", _ATC_TC
+        ),
         "LAND_SPEED": Default(0.5, "ArduCopter/config.h Copter-4.5: LAND_SPEED 50 cm/s", _AC_CONFIG),
         "LAND_SPEED_HIGH": Default(
             0.0, "ArduCopter/Parameters.cpp Copter-4.5: LAND_SPEED_HIGH 0", _AC45_PARAMS
@@ -425,7 +460,7 @@ _AC_SCALE = {
     "WPNAV_ACCEL_Z": 0.01, "WPNAV_RADIUS": 0.01, "WPNAV_ACCEL_C": 0.01, "LAND_SPEED": 0.01,
     "LAND_SPEED_HIGH": 0.01, "LAND_ALT_LOW": 0.01, "RTL_ALT": 0.01, "RTL_SPEED": 0.01,
     "RTL_LOIT_TIME": 0.001, "RTL_ALT_FINAL": 0.01, "WPNAV_JERK": 1.0, "RTL_CONE_SLOPE": 1.0,
-    "RTL_CLIMB_MIN": 0.01, "WP_YAW_BEHAVIOR": 1.0, "ATC_SLEW_YAW": 0.01,
+    "RTL_CLIMB_MIN": 0.01, "WP_YAW_BEHAVIOR": 1.0, "ATC_SLEW_YAW": 0.01, "ATC_INPUT_TC": 1.0,
 }  # fmt: skip
 
 #: PX4 multicopter defaults (SI). Sources: PX4-Autopilot
@@ -792,6 +827,18 @@ def corner_speed(p: MissionParams, theta: float, v: float) -> float:
     return v
 
 
+def arducopter_jerk_time(p: MissionParams) -> float:
+    """The raised-cosine jerk time t_j (s) of ArduCopter 4.x's S-curves: ``SCurve`` takes
+    t_j = j·π/(2·S) with the snap S = ½·j·π/(2·max(``ATC_INPUT_TC``, 0.1 s))
+    (``AC_WPNav::calc_scurve_jerk_and_snap``; the attitude controller's own acceleration limit
+    ``ATC_ACCEL_R/P_MAX`` binds only far below its defaults), so t_j = 2·max(``ATC_INPUT_TC``,
+    0.1 s): 0.3 s by default. 3.x has no S-curve (0).
+    """
+    if p.family != "arducopter" or (p.major or 4) <= 3:
+        return 0.0
+    return 2.0 * max(p.values.get("ATC_INPUT_TC", 0.15), 0.1)
+
+
 def predict_mission(
     plan: MissionPlan,
     params: MissionParams,
@@ -1040,7 +1087,7 @@ def _leg(
             a = p.options.ac3_slowdown_factor * a
             t_h, v_end = leg_time(d, cruise, p["WPNAV_ACCEL"], None, v0, v_out, decel=a)
         else:
-            t_h, v_end = leg_time(d, cruise, a, p["WPNAV_JERK"], v0, v_out)
+            t_h, v_end = leg_time(d, cruise, a, p["WPNAV_JERK"], v0, v_out, jerk_time=arducopter_jerk_time(p))
     else:
         a, j = p["MPC_ACC_HOR"], p["MPC_JERK_AUTO"]
         if accept:
@@ -1303,6 +1350,7 @@ __all__ = [
     "MissionParams",
     "MissionPrediction",
     "ModelOptions",
+    "arducopter_jerk_time",
     "arducopter_rtl_altitude",
     "arducopter_rtl_yaw_wait",
     "banded_descent_time",
