@@ -189,6 +189,36 @@ def test_short_scurve_speed_changes_are_continuous() -> None:
         assert ap.speed_change_time(x, a, j, 0.0) == ap.speed_change_time(x, a, j)
 
 
+# --- PX4 jerk-limited speed changes against VelocitySmoothing's own durations ----------------
+def _px4_velocity_smoothing(v0: float, v1: float, a_max: float, j_max: float) -> tuple[float, float]:
+    """PX4 ``VelocitySmoothing::updateDurationsMinimizeTotalTime`` from zero acceleration:
+    T1 = (½·√(4·j·Δv))/j saturated so that j·T1 ≤ a_max (``computeT1``,
+    ``saturateT1ForAccel``), T3 = T1 (``computeT3`` with a₀ = 0), T2 =
+    (Δv − j·T1² ·½ − j·T1·T3 + j·T3²·½)/(j·T1) (``computeT2``); the distance from
+    ``evaluatePoly`` over the three phases. Returns (T1 + T2 + T3, distance)."""
+    dv = v1 - v0
+    t1 = min(0.5 * math.sqrt(4 * j_max * dv) / j_max, a_max / j_max)
+    t3 = t1
+    t2 = max((-0.5 * t1 * t1 * j_max - t1 * t3 * j_max + 0.5 * t3 * t3 * j_max + dv) / (j_max * t1), 0.0)
+
+    def poly(j: float, a: float, v: float, x: float, t: float) -> tuple[float, float, float]:
+        return a + j * t, v + a * t + 0.5 * j * t * t, x + v * t + 0.5 * a * t * t + j * t**3 / 6
+
+    a, v, x = poly(j_max, 0.0, v0, 0.0, t1)
+    a, v, x = poly(0.0, a, v, x, t2)
+    a, v, x = poly(-j_max, a, v, x, t3)
+    assert v == pytest.approx(v1, abs=1e-9) and a == pytest.approx(0.0, abs=1e-9)
+    return t1 + t2 + t3, x
+
+
+@pytest.mark.parametrize(("v0", "v1"), [(0.0, 5.0), (0.0, 1.0), (2.0, 12.0), (1.0, 1.5)])
+def test_px4_speed_change_is_velocity_smoothing(v0: float, v1: float) -> None:
+    a, j = 3.0, 4.0  # MPC_ACC_HOR, MPC_JERK_AUTO defaults
+    total, dist = _px4_velocity_smoothing(v0, v1, a, j)
+    assert ap.speed_change_time(v1 - v0, a, j) == pytest.approx(total, rel=1e-9)
+    assert ap._change(v0, v1, a, j)[1] == pytest.approx(dist, rel=1e-9)
+
+
 # --- defaults against their citations -------------------------------------------------------
 _UNIT_SCALE = {"cm/s²": 0.01, "cm/s": 0.01, "cm": 0.01, "ms": 0.001, "cd/s": 0.01}
 
