@@ -580,3 +580,17 @@ def test_web_page_predicts_the_dalby_plan(shared_data: Path) -> None:
     assert "shorter than" not in r.text
     # every distinct waypoint of the route is drawn (the start marked apart)
     assert r.text.count('<circle class="wp') >= 29
+
+
+def test_run_start_heading_is_the_nearest_attitude_sample() -> None:
+    from types import SimpleNamespace
+
+    from uasnav.trajectory.mission_runs import _heading_at
+
+    ref = SimpleNamespace(
+        t=np.array([0.0, 1.0, 2.0]), euler_deg=np.array([[0, 0, 179.0], [0, 0, -179.0], [0, 0, 10.0]])
+    )
+    # nearest sample, never an interpolation through 0° across the ±180° wrap
+    assert _heading_at(SimpleNamespace(reference=ref), 0.6) == -179.0
+    assert _heading_at(SimpleNamespace(reference=None), 0.6) is None
+    assert _heading_at(SimpleNamespace(reference=SimpleNamespace(t=ref.t, euler_deg=None)), 0.6) is None

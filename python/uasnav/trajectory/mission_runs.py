@@ -67,6 +67,10 @@ class MissionRun:
         Height above home at the start (0 on the ground).
     start_ne : tuple of float
         North, east (m) from home at the start.
+    start_heading_deg : float or None
+        The autopilot's heading (degrees from true north) at the start, taken as the heading it
+        was armed at (ArduCopter turns back to it over home in RTL); None when the log has no
+        attitude.
     """
 
     source: str
@@ -76,6 +80,7 @@ class MissionRun:
     reached: tuple[tuple[int, float], ...]
     start_height_m: float
     start_ne: tuple[float, float]
+    start_heading_deg: float | None = None
 
     @property
     def duration_s(self) -> float:
@@ -117,6 +122,18 @@ def _touchdown(t: np.ndarray, alt: np.ndarray, after: float, until: float, groun
     if j >= 0:
         t_td = min(t_td, float(t[j]))
     return t_td if t_td <= until + 1e-9 else None
+
+
+def _heading_at(fl: Any, t: float) -> float | None:
+    """The autopilot's yaw (degrees) at the sample nearest ``t`` (no interpolation across the
+    ±180° wrap), or None without an attitude."""
+    ref = getattr(fl, "reference", None)
+    euler = getattr(ref, "euler_deg", None) if ref is not None else None
+    if euler is None or len(ref.t) == 0:
+        return None
+    k = int(np.argmin(np.abs(np.asarray(ref.t) - t)))
+    yaw = float(euler[k, 2])
+    return yaw if math.isfinite(yaw) else None
 
 
 def mission_runs(log: Any, plan: MissionPlan | None = None) -> list[MissionRun]:
@@ -195,6 +212,7 @@ def mission_runs(log: Any, plan: MissionPlan | None = None) -> list[MissionRun]:
                 reached=tuple((seq_to_item[s], t - start_t) for t, s in events if t >= start_t),
                 start_height_m=0.0 if on_ground else float(a0 - ground_ref),
                 start_ne=(float(p0[0]), float(p0[1])),
+                start_heading_deg=_heading_at(fl, start_t),
             )
         )
     if not runs:
@@ -252,7 +270,7 @@ def score_runs(log: Any, params: MissionParams | None = None) -> list[RunScore]:
     for run in mission_runs(log, plan):
         pred = predict_mission(
             plan, p, home_amsl_m=home_amsl, start_ne=run.start_ne if run.start_height_m > 0.5 else None,
-            start_height_m=run.start_height_m,
+            start_height_m=run.start_height_m, armed_heading_deg=run.start_heading_deg,
         )  # fmt: skip
         qgc = qgc_mission_time(plan, p.cruise_ms, home_amsl)
         naive = distance_over_speed_time(plan, p.cruise_ms, home_amsl)
