@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -251,7 +252,15 @@ def test_cli_plan_writes_outputs_and_prints_result_json(tmp_path) -> None:
 def test_a_resolution_no_camera_reaches_is_said_as_such() -> None:
     res = uasnav.plan(area=rect(10, 10, 70, 70), resolution=0.0005, start=START)
     assert res["survey"] is None and not res["authorisation"]["authorisable"]
-    assert res["authorisation"]["verdict"].startswith("no camera in the database meets resolution")
+    verdict = res["authorisation"]["verdict"]
+    assert verdict.startswith("no camera in the database meets resolution")
+    # what was asked, in the option's own unit, then where the finest camera falls short
+    assert "--resolution 0.0005 m/px (0.5 mm per pixel) asked" in verdict, verdict
+    assert "asked at" not in verdict
+    finest = re.search(r"the finest, ([^,]+), gives ([\d.]+) m/px \(([\d.]+) mm per pixel\) at 10 m, "
+                       r"the lowest height a survey flies", verdict)  # fmt: skip
+    assert finest, verdict
+    assert float(finest.group(2)) * 1000 == pytest.approx(float(finest.group(3)), rel=0.05)
     assert set(res.files) == {"result.json"}
 
 
@@ -439,3 +448,25 @@ def test_camera_timing_comes_from_the_database_where_it_is_known(tmp_path) -> No
     expected = min(sp.trigger_m / 2.5, DEFAULT_BLUR_PX * sp.gsd_m / 0.004, 30.0)
     assert sp.speed_ms == pytest.approx(expected, rel=1e-9)
     assert any(cam.timing_source in a for a in sp.assumptions)
+
+
+def test_pilot_distance_reads_in_whole_metres_in_the_cli_and_the_summary(tmp_path) -> None:
+    """The CLI summary, summary.html and summary.json give the pilot distance in whole metres,
+    the same number everywhere; result.json keeps the measured value."""
+    area = tmp_path / "f.geojson"
+    area.write_text(json.dumps(rect(10, 10, 70, 70)))
+    out = tmp_path / "out"
+    r = CliRunner().invoke(
+        main, ["plan", "--area", str(area), "--takeoff", f"{LAT0},{LON0}", "--resolution", "0.05",
+               "--start", START, "--out", str(out)],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    exact = json.loads((out / "result.json").read_text())["distances"]["pilot_distance_m"]
+    assert exact == pytest.approx(80 * math.sqrt(2), rel=1e-3)
+    texts = [r.stdout, (out / "summary.html").read_text(), (out / "summary.json").read_text()]
+    for text in texts:
+        shown = re.findall(r"(\d[\d.]*) m from the (?:pilot|farthest point)", text)
+        assert shown and set(shown) == {"113"}, shown
+    for text in texts[:2]:  # the JSON's numbers keep their precision, its sentences do not
+        assert "113.1" not in text
+    assert "113.1" not in "".join(json.loads(texts[2])["notes"])

@@ -11,6 +11,7 @@ from uasnav.cli._common import OutputPath, Real, echo_json
 from uasnav.cli.select import _USAGE_KINDS, _options
 from uasnav.errors import InputError
 from uasnav.mission.planner import PLAN_OPTIONS
+from uasnav.mission.readable import metres
 from uasnav.mission.request import SELECT_OPTIONS, OptionError, read_file_option
 
 
@@ -104,7 +105,7 @@ def command(
     if op:
         click.echo(
             f"Operation: {op['visibility']}, {op['category']}; pilot "
-            f"{d.get('pilot_distance_m', 0):.0f} m from the farthest point of the area "
+            f"{metres(d.get('pilot_distance_m', 0))} from the farthest point of the area "
             f"({d.get('pilot_from')})"
         )
     click.echo(f"Survey: {s['altitude_m']:.1f} m {s['altitude_datum']} — {s['height_reason']}")
