@@ -192,17 +192,23 @@ def _enu(pts: list[tuple[float, float]], lon0: float, lat0: float) -> list[tuple
     return list(zip(np.atleast_1d(e).tolist(), np.atleast_1d(n).tolist(), strict=True))
 
 
+def _area_text(data: bytes, where: str, *, limit: int = MAX_BYTES, what: str = "area file") -> str:
+    """An area document's bytes as text: at most ``limit`` bytes of UTF-8 (a BOM dropped), else
+    one error naming ``where``."""
+    if len(data) > limit:
+        raise DataFormatError(f"{what} larger than {limit} bytes", path=where)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise DataFormatError("not a UTF-8 text file", path=where) from None
+
+
 def parse_area(data: bytes | str | dict, where: str = "area", *, buffer_m: float = 0.0) -> MissionArea:
     """The mission area from GeoJSON (bytes, text or a parsed object); see the module doc."""
     if not math.isfinite(buffer_m) or buffer_m < 0:
         raise InputError(f"area buffer {buffer_m} m: must be finite and >= 0")
     if isinstance(data, bytes):
-        if len(data) > MAX_BYTES:
-            raise DataFormatError(f"area file larger than {MAX_BYTES} bytes", path=where)
-        try:
-            data = data.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise DataFormatError("not a UTF-8 text file", path=where) from None
+        data = _area_text(data, where)
     with jc.reraise_in(where):
         doc = jc.parse(data, "not a GeoJSON area (not valid JSON)") if isinstance(data, str) else data
         parts = _geom(doc, "area", buffer_m)
@@ -311,12 +317,7 @@ def parse_area_document(data: bytes | str | dict, where: str = "area", *, buffer
 
         text = json.dumps(data)
     elif isinstance(data, bytes):
-        if len(data) > MAX_PLAN_BYTES:
-            raise DataFormatError(f"plan larger than {MAX_PLAN_BYTES} bytes", path=where)
-        try:
-            text = data.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise DataFormatError("not a UTF-8 text file", path=where) from None
+        text = _area_text(data, where, limit=MAX_PLAN_BYTES, what="plan")
     else:
         text = data
     return area_from_plan(parser(text, where), where, buffer_m=buffer_m)
@@ -477,12 +478,7 @@ def kml_area_geojson(data: bytes | str, where: str = "area.kml") -> dict[str, An
     from uasnav.io.plan_formats import kml
 
     if isinstance(data, bytes):
-        if len(data) > MAX_BYTES:
-            raise DataFormatError(f"area file larger than {MAX_BYTES} bytes", path=where)
-        try:
-            data = data.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise DataFormatError("not a UTF-8 text file", path=where) from None
+        data = _area_text(data, where)
     root = kml._parse(data, where)
     geoms: list[dict[str, Any]] = []
     for poly in kml._find(root, "Polygon"):
