@@ -359,7 +359,7 @@ def test_ground_elevation_shifts_every_intent_altitude_by_itself() -> None:
     assert a["ground"]["assumed"] and a["ground"]["elevation_m"] == 0.0
     assert "assumed" in a["ground"]["source"]
     assert any("give --ground-elevation" in x for x in a["survey"]["assumptions"])
-    assert not any("ground elevation not given" in x for x in b["survey"]["assumptions"])
+    assert not any("ground elevation not known" in x for x in b["survey"]["assumptions"])
     za = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(a)]
     zb = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(b)]
     assert len(za) == len(zb) > 0
@@ -470,3 +470,94 @@ def test_pilot_distance_reads_in_whole_metres_in_the_cli_and_the_summary(tmp_pat
     for text in texts[:2]:  # the JSON's numbers keep their precision, its sentences do not
         assert "113.1" not in text
     assert "113.1" not in "".join(json.loads(texts[2])["notes"])
+
+
+@pytest.mark.parametrize(
+    ("home_alt", "said"), [(0.0, "altitude 0 m"), (None, "no altitude")], ids=["zero", "null"]
+)
+def test_a_plan_home_at_0_m_or_without_altitude_is_no_ground(large, tmp_path, home_alt, said) -> None:
+    """QGroundControl writes 0 m (or null) for a planned home it could not place on terrain:
+    the ground is then assumed, said so in the ground block, the survey and the CLI warning."""
+    _res, out = large
+    doc = json.loads((out / "flight-01.plan").read_text())
+    doc["mission"]["plannedHomePosition"][2] = home_alt
+    area = tmp_path / "home.plan"
+    area.write_text(json.dumps(doc))
+    res = uasnav.plan(area=str(area), resolution=0.05, start=START)
+    g = res["ground"]
+    assert g["assumed"] and g["elevation_m"] == 0.0
+    assert said in g["source"] and "QGroundControl" in g["source"]
+    assert any(said in a and "give --ground-elevation" in a for a in res["survey"]["assumptions"])
+    r = CliRunner().invoke(
+        main,
+        ["plan", "--area", str(area), "--resolution", "0.05", "--start", START, "--out", str(tmp_path / "o")],
+    )
+    assert r.exit_code == 0, r.output
+    warning = [x for x in r.stderr.splitlines() if x.startswith("warning: ")]
+    assert len(warning) == 1 and said in warning[0], r.stderr
+    # a real home altitude is the ground, as before
+    doc["mission"]["plannedHomePosition"][2] = 488.9
+    area.write_text(json.dumps(doc))
+    g = uasnav.plan(area=str(area), resolution=0.05, start=START)["ground"]
+    assert g["elevation_m"] == 488.9 and not g["assumed"]
+
+
+def _with_heights(geom: dict, h) -> dict:
+    """``geom`` with a third coordinate on every position: ``h(lon, lat)`` m."""
+    ring = [[lon, lat, float(h(lon, lat))] for lon, lat in geom["coordinates"][0]]
+    return {"type": "Polygon", "coordinates": [ring]}
+
+
+def test_geojson_heights_are_ellipsoidal_and_give_the_ground_in_amsl() -> None:
+    """RFC 7946 heights are above the WGS-84 ellipsoid: the ground is each height less the EGM96
+    geoid height there, and the intents stand on it (h_W84 = H + height + N)."""
+    from uasnav.geo.geoid import geoid_height
+
+    field = rect(10, 10, 70, 70)
+    amsl = 450.0
+    res = uasnav.plan(
+        area=_with_heights(field, lambda lon, lat: amsl + geoid_height(lat, lon)),
+        takeoff=f"{LAT0},{LON0}",
+        resolution=0.05,
+        start=START,
+    )
+    g = res["ground"]
+    assert not g["assumed"] and g["elevation_m"] == pytest.approx(amsl, abs=1e-6)
+    assert "RFC 7946" in g["source"] and "geoid" in g["source"]
+    assert g["spread_m"] == pytest.approx(0.0, abs=1e-6)
+    given = uasnav.plan(
+        area=field, takeoff=f"{LAT0},{LON0}", resolution=0.05, start=START, ground_elevation=amsl
+    )
+    za = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(res)]
+    zb = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(given)]
+    assert np.allclose(za, zb, atol=1e-6)
+    # the operator's elevation wins over the file's
+    assert (
+        uasnav.plan(
+            area=_with_heights(field, lambda lon, lat: 999.0), takeoff=f"{LAT0},{LON0}", resolution=0.05,
+            start=START, ground_elevation=amsl,
+        )["ground"]["elevation_m"]
+        == amsl
+    )  # fmt: skip
+
+
+def test_geojson_heights_that_cannot_be_the_ground_are_said_why() -> None:
+    field = rect(10, 10, 70, 70)
+    zeros = uasnav.plan(area=_with_heights(field, lambda lon, lat: 0.0), resolution=0.05, start=START)
+    assert zeros["ground"]["assumed"] and "all 0" in zeros["ground"]["source"]
+    far = uasnav.plan(
+        area=_with_heights(rect(1500, 0, 70, 70), lambda lon, lat: 300.0),
+        takeoff=f"{LAT0},{LON0}",
+        resolution=0.05,
+        start=START,
+    )
+    assert far["ground"]["assumed"] and "from area" in far["ground"]["source"]
+    # a sloping field: its mean is taken, and the flat-field assumption is flagged with the span
+    slope = uasnav.plan(
+        area=_with_heights(field, lambda lon, lat: 300.0 + (lat - LAT0) * 111e3 * 0.5),
+        takeoff=f"{LAT0},{LON0}",
+        resolution=0.05,
+        start=START,
+    )
+    assert slope["ground"]["spread_m"] == pytest.approx(35.0, abs=0.5)
+    assert any("span 35 m" in a for a in slope["survey"]["assumptions"])

@@ -145,6 +145,7 @@ def _warn_assumed_ground(g: dict[str, Any]) -> None:
     if g["assumed"]:
         click.echo(
             f"warning: the intents' WGS-84 altitudes assume the take-off ground at {g['elevation_m']:g} m "
-            "AMSL: give --ground-elevation (m AMSL) before filing them",
+            f"AMSL ({g['source'].removeprefix('assumed: ')}): give --ground-elevation (m AMSL) before "
+            "filing them",
             err=True,
         )

@@ -282,6 +282,16 @@ def _ground_rows(g: dict[str, Any] | None) -> list[list[str]]:
             f"{g['geoid_height_m']:.2f} m, {g['geoid']}: ground {g['ellipsoidal_height_m']:.1f} m "
             "above the ellipsoid",
         ],
+        *(
+            [
+                [
+                    "Ground heights over the area",
+                    f"span {g['spread_m']:.1f} m (heights above the take-off point)",
+                ]
+            ]
+            if "spread_m" in g
+            else []
+        ),
     ]
 
 
