@@ -63,7 +63,11 @@ def test_small_field_beside_takeoff_is_vlos_open() -> None:
     assert res["operation"]["visibility"] == "VLOS"
     assert res["operation"]["category"] == "open"
     assert res["authorisation"]["authorisable"]
-    assert res["distances"]["pilot_distance_m"] < 150
+    d = res["distances"]
+    assert d["area_pilot_distance_m"] < 150
+    # the run-outs carry the UA past the field: the operation's distance is the route's
+    assert d["pilot_distance_m"] == d["route_pilot_distance_m"] > d["area_pilot_distance_m"]
+    assert d["pilot_distance_m"] == pytest.approx(res["operation"]["max_distance_m"])
     s = res["survey"]
     assert s["gsd_m"] <= 0.05 and s["photos"] >= 1 and s["flights"] == 1
     assert set(res.keys()) >= {
@@ -461,15 +465,17 @@ def test_pilot_distance_reads_in_whole_metres_in_the_cli_and_the_summary(tmp_pat
                "--start", START, "--out", str(out)],
     )  # fmt: skip
     assert r.exit_code == 0, r.output
-    exact = json.loads((out / "result.json").read_text())["distances"]["pilot_distance_m"]
-    assert exact == pytest.approx(80 * math.sqrt(2), rel=1e-3)
+    d = json.loads((out / "result.json").read_text())["distances"]
+    assert d["area_pilot_distance_m"] == pytest.approx(80 * math.sqrt(2), rel=1e-3)
+    exact = d["pilot_distance_m"]
+    assert exact != round(exact)
     texts = [r.stdout, (out / "summary.html").read_text(), (out / "summary.json").read_text()]
     for text in texts:
         shown = re.findall(r"(\d[\d.]*) m from the (?:pilot|farthest point)", text)
-        assert shown and set(shown) == {"113"}, shown
+        assert shown and set(shown) == {f"{exact:.0f}"}, shown
     for text in texts[:2]:  # the JSON's numbers keep their precision, its sentences do not
-        assert "113.1" not in text
-    assert "113.1" not in "".join(json.loads(texts[2])["notes"])
+        assert f"{exact:.1f}" not in text
+    assert f"{exact:.1f}" not in "".join(json.loads(texts[2])["notes"])
 
 
 @pytest.mark.parametrize(
@@ -561,3 +567,48 @@ def test_geojson_heights_that_cannot_be_the_ground_are_said_why() -> None:
     )
     assert slope["ground"]["spread_m"] == pytest.approx(35.0, abs=0.5)
     assert any("span 35 m" in a for a in slope["survey"]["assumptions"])
+
+
+def test_the_large_field_is_flown_by_a_rotorcraft_and_the_fixed_wings_are_said_why(large) -> None:
+    """The survey's lines are a rotorcraft pattern (stop and turn one swath away): a fixed wing,
+    which turns on a circle of 2·v²/(g·tan 30°) at its cruise speed, is not ranked for it, and
+    the answer says which ones and why."""
+    from uasnav.mission.feasibility import HOVERING_TYPES
+
+    res, _out = large
+    db = res.selection.database.uas
+    chosen = db.ids.index(res["configuration"]["uas_id"])
+    assert db.types[chosen] in HOVERING_TYPES
+    spacing = res["survey"]["line_spacing_m"]
+    disco = next(
+        r for r in res.selection.rejections if r.item == "parrot-disco" and r.test == "survey-pattern"
+    )
+    v = 0.7 * 22.0  # the cruise fraction of the Disco's 22 m/s
+    assert disco.value == pytest.approx(2 * v**2 / (9.80665 * math.tan(math.radians(30.0))), rel=1e-9)
+    assert disco.value > spacing  # 84 m across: wider than the lines are apart
+    assert "cannot hover" in disco.message and f"{disco.value:.0f} m across" in disco.message
+    note = next(n for n in res["notes"] if n.startswith("survey: "))
+    assert "Parrot Disco" in note and "cannot hover" in note
+    # rotorcraft are never held back by the pattern
+    assert not any(
+        r.test == "survey-pattern" and db.types[db.ids.index(r.item)] in HOVERING_TYPES
+        for r in res.selection.rejections
+        if r.kind == "uas"
+    )
+
+
+def test_the_pilot_distance_covers_the_route_the_plans_fly(large) -> None:
+    """The operation's pilot distance is the farthest point the written flights reach (run-ins
+    and run-outs past the field included), measured on the .plan files themselves."""
+    res, out = large
+    farthest = 0.0
+    for f in res["flights"]:
+        plan = read_plan(out / f"{f['name']}.plan")
+        pos = [(it.lat_deg, it.lon_deg) for it in plan.items if it.has_position]
+        farthest = max(farthest, float(np.hypot(*_local(*zip(*pos, strict=True)).T).max()))
+    d, op = res["distances"], res["operation"]
+    assert d["pilot_distance_on"].startswith("the planned route")
+    assert d["pilot_distance_m"] == pytest.approx(farthest, abs=0.5)
+    assert d["pilot_distance_m"] > d["area_pilot_distance_m"] == pytest.approx(math.hypot(420, 320), abs=1)
+    assert op["max_distance_m"] == pytest.approx(d["pilot_distance_m"])
+    assert (op["visibility"] == "VLOS") == (op["max_distance_m"] <= op["vlos_distance_m"])

@@ -104,9 +104,9 @@ def command(
     click.echo(f"Configuration: {c['uas']} + {c['camera']} (score {c['score']:.2f})")
     if op:
         click.echo(
-            f"Operation: {op['visibility']}, {op['category']}; pilot "
-            f"{metres(d.get('pilot_distance_m', 0))} from the farthest point of the area "
-            f"({d.get('pilot_from')})"
+            f"Operation: {op['visibility']}, {op['category']}; the pilot ({d.get('pilot_from')}) is "
+            f"{metres(d.get('pilot_distance_m', 0))} from the farthest point of "
+            f"{d.get('pilot_distance_on', 'the area')}"
         )
     click.echo(f"Survey: {s['altitude_m']:.1f} m {s['altitude_datum']} — {s['height_reason']}")
     click.echo(

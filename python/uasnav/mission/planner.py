@@ -396,6 +396,15 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
         if request.zones is not None
         else {}
     )
+    # The UA flies past the area on its run-ins and run-outs: the operation's distances are the
+    # route's when it reaches farther than the area (unless the operator typed them).
+    distances, farther = route_distances(sp, request.distances, lat0, lon0)
+    if req.max_distance_m != request.distances["pilot_distance_m"]:
+        farther.pop("max_distance_m", None)
+    if req.range_m != request.distances["range_m"]:
+        farther.pop("range_m", None)
+    if farther:
+        req = replace(req, **farther)
     flown = replace(
         req, altitude_m=math.ceil(sp.altitude_m * 10.0) / 10.0, flight_duration_s=max(total_s, 1.0)
     )
@@ -412,8 +421,43 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
         sel.flight_window["from"] = "predicted flight time of the survey (upper bounds, turnarounds included)"
     conflicts = _deconflict(flights, _read_intents(list(intents_in), dt.datetime.now(dt.timezone.utc)))
     result = _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap, ground_info)
+    result["distances"] = distances
     files = _files(sel, sp, flights, result)
     return PlanResult(result, files, sel, sp, flights)
+
+
+def route_distances(
+    sp: SurveyPlan, area_distances: dict[str, Any], lat0: float, lon0: float
+) -> tuple[dict[str, Any], dict[str, float]]:
+    """The distances of the flown survey: the farthest any line point (run-in and run-out ends
+    included) is from the pilot and from the take-off point (``lat0``, ``lon0``, the survey's
+    origin), against the area's (:func:`uasnav.mission.request.area_distances`).
+
+    Returns the ``distances`` block of the result — the area's, with ``route_pilot_distance_m``,
+    ``route_range_m``, ``area_pilot_distance_m``, and ``pilot_distance_m``/``range_m`` the larger
+    of the two, ``pilot_distance_on`` naming which — and the requirement changes
+    (``max_distance_m``, ``range_m``) where the route reaches farther than the area.
+    """
+    from uasnav.geo import frames
+
+    pts = np.array([p for ln in sp.lines for p in (ln.run_in_en, ln.start_en, ln.end_en, ln.run_out_en)])
+    pe, pn, _ = frames.geodetic_to_enu(
+        area_distances["pilot"][0], area_distances["pilot"][1], 0.0, lat0, lon0, 0.0
+    )
+    to_pilot = float(np.hypot(pts[:, 0] - float(pe), pts[:, 1] - float(pn)).max()) if len(pts) else 0.0
+    to_takeoff = float(np.hypot(pts[:, 0], pts[:, 1]).max()) if len(pts) else 0.0
+    out = dict(area_distances)
+    out["area_pilot_distance_m"] = area_distances["pilot_distance_m"]
+    out["route_pilot_distance_m"] = to_pilot
+    out["route_range_m"] = to_takeoff
+    changes: dict[str, float] = {}
+    on_route = to_pilot > area_distances["pilot_distance_m"]
+    out["pilot_distance_on"] = "the planned route (run-ins and run-outs included)" if on_route else "the area"
+    if on_route:
+        out["pilot_distance_m"] = changes["max_distance_m"] = to_pilot
+    if to_takeoff > area_distances["range_m"]:
+        out["range_m"] = changes["range_m"] = to_takeoff
+    return out, changes
 
 
 def _legal_height(regs: Any, req: Any) -> float:

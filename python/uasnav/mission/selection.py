@@ -718,6 +718,17 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
         uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids, members
     )
     rejections += rej
+    if req.mosaic:
+        # UAS kept out of a survey by its pattern alone: said once, beside the ranking
+        failed: dict[str, set[str]] = {}
+        for r in rej:
+            failed.setdefault(r.item, set()).add(r.test)
+        only = [u.label(k) for k, uid in enumerate(u.ids) if failed.get(uid) == {"survey-pattern"}]
+        if only:
+            notes.append(
+                f"survey: {', '.join(only)} would qualify but cannot hover; the survey's lines are a "
+                "rotorcraft pattern (stop and turn at each line's end), so they are not ranked for it"
+            )
     cam_ok, rej = _reject(camera_tests(c, req, h_cam), "camera", c.label, c.ids)
     rejections += rej
     pair_ok = uas_ok[:, None] & cam_ok[None, :] & mission_ok
