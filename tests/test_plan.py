@@ -612,3 +612,7 @@ def test_the_pilot_distance_covers_the_route_the_plans_fly(large) -> None:
     assert d["pilot_distance_m"] > d["area_pilot_distance_m"] == pytest.approx(math.hypot(420, 320), abs=1)
     assert op["max_distance_m"] == pytest.approx(d["pilot_distance_m"])
     assert (op["visibility"] == "VLOS") == (op["max_distance_m"] <= op["vlos_distance_m"])
+    # the derivation names where the distance was measured, not an option nobody typed
+    seen = next(f for f in res.selection.operation.derivation if f.name == "visibility")
+    assert seen.requirement.startswith("the planned route's farthest point from the pilot position = ")
+    assert "--max-distance" not in seen.requirement

@@ -130,6 +130,9 @@ class Requirements:
     flight_duration_s: float | None = None
     #: Where ``altitude_m`` came from when not ``--altitude`` (a plan flying higher), else None.
     altitude_source: str | None = None
+    #: Where ``max_distance_m`` was measured when not ``--max-distance`` (the area or the planned
+    #: route, from the pilot's position), else None.
+    max_distance_source: str | None = None
     camera_height: str = "planned"
     mosaic: bool = False
 

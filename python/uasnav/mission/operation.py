@@ -181,7 +181,11 @@ def derive_operation(req: Requirements, *, vlos_default: tuple[float, str] | Non
     """
     facts: list[Fact] = []
     dist = req.max_distance_m if req.max_distance_m is not None else req.range_m
-    dist_req = "--max-distance" if req.max_distance_m is not None else "--range (no --max-distance given)"
+    dist_req = (
+        (req.max_distance_source or "--max-distance")
+        if req.max_distance_m is not None
+        else "--range (no --max-distance given)"
+    )
     if req.vlos_distance_m is not None:
         vlos_d, vlos_src = req.vlos_distance_m, "--vlos-distance"
     elif vlos_default is not None:

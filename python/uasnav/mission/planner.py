@@ -398,13 +398,12 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     )
     # The UA flies past the area on its run-ins and run-outs: the operation's distances are the
     # route's when it reaches farther than the area (unless the operator typed them).
+    assert request.distances is not None
     distances, farther = route_distances(sp, request.distances, lat0, lon0)
-    if req.max_distance_m != request.distances["pilot_distance_m"]:
-        farther.pop("max_distance_m", None)
-    if req.range_m != request.distances["range_m"]:
-        farther.pop("range_m", None)
-    if farther:
-        req = replace(req, **farther)
+    if "max_distance_m" in farther and req.max_distance_m == request.distances["pilot_distance_m"]:
+        req = replace(req, max_distance_m=farther["max_distance_m"], max_distance_source=ROUTE_DISTANCE_WORDS)
+    if "range_m" in farther and req.range_m == request.distances["range_m"]:
+        req = replace(req, range_m=farther["range_m"])
     flown = replace(
         req, altitude_m=math.ceil(sp.altitude_m * 10.0) / 10.0, flight_duration_s=max(total_s, 1.0)
     )
@@ -424,6 +423,10 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     result["distances"] = distances
     files = _files(sel, sp, flights, result)
     return PlanResult(result, files, sel, sp, flights)
+
+
+#: Where the operation's pilot distance comes from when the flown route reaches past the area.
+ROUTE_DISTANCE_WORDS = "the planned route's farthest point from the pilot position"
 
 
 def route_distances(
