@@ -241,3 +241,48 @@ def test_zones_by_url_are_checked_before_caching(sample, tmp_path) -> None:
     finally:
         srv.shutdown()
         srv.server_close()
+
+
+@pytest.mark.parametrize("reader", ["geojson", "kml", "plan"])
+def test_area_bytes_are_bounded_utf8_text_for_every_reader(reader) -> None:
+    """GeoJSON, KML and plan areas read their bytes the same way: UTF-8 (a BOM dropped), at
+    most the reader's size, else one error naming the file."""
+    from uasnav.io.ed269 import MAX_BYTES
+    from uasnav.io.plan_formats.source import MAX_PLAN_BYTES
+    from uasnav.mission.zones import kml_area_geojson, parse_area_document
+
+    where, limit, read = {
+        "geojson": ("a.geojson", MAX_BYTES, lambda d, w: parse_area(d, w)),
+        "kml": ("a.kml", MAX_BYTES, kml_area_geojson),
+        "plan": ("a.plan", MAX_PLAN_BYTES, lambda d, w: parse_area_document(d, w, buffer_m=10.0)),
+    }[reader]
+    with pytest.raises(DataFormatError, match=rf"^{where}: not a UTF-8 text file"):
+        read(b"\xff\xfe{", where)
+    with pytest.raises(DataFormatError, match=rf"^{where}: .* larger than {limit} bytes"):
+        read(b" " * (limit + 1), where)
+    good = {
+        "geojson": json.dumps(INSIDE),
+        "kml": "<kml xmlns='http://www.opengis.net/kml/2.2'><Placemark><Polygon><outerBoundaryIs>"
+        "<LinearRing><coordinates>6.168,46.216 6.1689,46.216 6.1689,46.2165 6.168,46.216</coordinates>"
+        "</LinearRing></outerBoundaryIs></Polygon></Placemark></kml>",
+        "plan": json.dumps(_qgc_plan([46.216, 6.168, 400], [(46.2162, 6.1685), (46.2162, 6.1688)])),
+    }[reader]  # fmt: skip
+    assert read("\ufeff".encode() + good.encode(), where)  # a BOM is dropped
+
+
+def _qgc_plan(home: list, points: list[tuple[float, float]], alt_m: float = 30.0) -> dict:
+    """A QGroundControl plan: ``home`` [lat, lon, alt AMSL], waypoints at ``alt_m`` above home."""
+    items = [
+        {"type": "SimpleItem", "command": 16, "frame": 3, "autoContinue": True, "doJumpId": k + 1,
+         "params": [0, 0, 0, None, lat, lon, alt_m]}
+        for k, (lat, lon) in enumerate(points)
+    ]  # fmt: skip
+    mission = {"version": 2, "firmwareType": 12, "vehicleType": 2, "cruiseSpeed": 15, "hoverSpeed": 5}
+    return {
+        "fileType": "Plan",
+        "version": 1,
+        "groundStation": "QGroundControl",
+        "geoFence": {"circles": [], "polygons": [], "version": 2},
+        "rallyPoints": {"points": [], "version": 2},
+        "mission": {**mission, "plannedHomePosition": home, "items": items},
+    }

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -62,7 +63,11 @@ def test_small_field_beside_takeoff_is_vlos_open() -> None:
     assert res["operation"]["visibility"] == "VLOS"
     assert res["operation"]["category"] == "open"
     assert res["authorisation"]["authorisable"]
-    assert res["distances"]["pilot_distance_m"] < 150
+    d = res["distances"]
+    assert d["area_pilot_distance_m"] < 150
+    # the run-outs carry the UA past the field: the operation's distance is the route's
+    assert d["pilot_distance_m"] == d["route_pilot_distance_m"] > d["area_pilot_distance_m"]
+    assert d["pilot_distance_m"] == pytest.approx(res["operation"]["max_distance_m"])
     s = res["survey"]
     assert s["gsd_m"] <= 0.05 and s["photos"] >= 1 and s["flights"] == 1
     assert set(res.keys()) >= {
@@ -251,7 +256,15 @@ def test_cli_plan_writes_outputs_and_prints_result_json(tmp_path) -> None:
 def test_a_resolution_no_camera_reaches_is_said_as_such() -> None:
     res = uasnav.plan(area=rect(10, 10, 70, 70), resolution=0.0005, start=START)
     assert res["survey"] is None and not res["authorisation"]["authorisable"]
-    assert res["authorisation"]["verdict"].startswith("no camera in the database meets resolution")
+    verdict = res["authorisation"]["verdict"]
+    assert verdict.startswith("no camera in the database meets resolution")
+    # what was asked, in the option's own unit, then where the finest camera falls short
+    assert "--resolution 0.0005 m/px (0.5 mm per pixel) asked" in verdict, verdict
+    assert "asked at" not in verdict
+    finest = re.search(r"the finest, ([^,]+), gives ([\d.]+) m/px \(([\d.]+) mm per pixel\) at 10 m, "
+                       r"the lowest height a survey flies", verdict)  # fmt: skip
+    assert finest, verdict
+    assert float(finest.group(2)) * 1000 == pytest.approx(float(finest.group(3)), rel=0.05)
     assert set(res.files) == {"result.json"}
 
 
@@ -350,7 +363,7 @@ def test_ground_elevation_shifts_every_intent_altitude_by_itself() -> None:
     assert a["ground"]["assumed"] and a["ground"]["elevation_m"] == 0.0
     assert "assumed" in a["ground"]["source"]
     assert any("give --ground-elevation" in x for x in a["survey"]["assumptions"])
-    assert not any("ground elevation not given" in x for x in b["survey"]["assumptions"])
+    assert not any("ground elevation not known" in x for x in b["survey"]["assumptions"])
     za = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(a)]
     zb = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(b)]
     assert len(za) == len(zb) > 0
@@ -439,3 +452,167 @@ def test_camera_timing_comes_from_the_database_where_it_is_known(tmp_path) -> No
     expected = min(sp.trigger_m / 2.5, DEFAULT_BLUR_PX * sp.gsd_m / 0.004, 30.0)
     assert sp.speed_ms == pytest.approx(expected, rel=1e-9)
     assert any(cam.timing_source in a for a in sp.assumptions)
+
+
+def test_pilot_distance_reads_in_whole_metres_in_the_cli_and_the_summary(tmp_path) -> None:
+    """The CLI summary, summary.html and summary.json give the pilot distance in whole metres,
+    the same number everywhere; result.json keeps the measured value."""
+    area = tmp_path / "f.geojson"
+    area.write_text(json.dumps(rect(10, 10, 70, 70)))
+    out = tmp_path / "out"
+    r = CliRunner().invoke(
+        main, ["plan", "--area", str(area), "--takeoff", f"{LAT0},{LON0}", "--resolution", "0.05",
+               "--start", START, "--out", str(out)],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    d = json.loads((out / "result.json").read_text())["distances"]
+    assert d["area_pilot_distance_m"] == pytest.approx(80 * math.sqrt(2), rel=1e-3)
+    exact = d["pilot_distance_m"]
+    assert exact != round(exact)
+    texts = [r.stdout, (out / "summary.html").read_text(), (out / "summary.json").read_text()]
+    for text in texts:
+        shown = re.findall(r"(\d[\d.]*) m from the (?:pilot|farthest point)", text)
+        assert shown and set(shown) == {f"{exact:.0f}"}, shown
+    for text in texts[:2]:  # the JSON's numbers keep their precision, its sentences do not
+        assert f"{exact:.1f}" not in text
+    assert f"{exact:.1f}" not in "".join(json.loads(texts[2])["notes"])
+
+
+@pytest.mark.parametrize(
+    ("home_alt", "said"), [(0.0, "altitude 0 m"), (None, "no altitude")], ids=["zero", "null"]
+)
+def test_a_plan_home_at_0_m_or_without_altitude_is_no_ground(large, tmp_path, home_alt, said) -> None:
+    """QGroundControl writes 0 m (or null) for a planned home it could not place on terrain:
+    the ground is then assumed, said so in the ground block, the survey and the CLI warning."""
+    _res, out = large
+    doc = json.loads((out / "flight-01.plan").read_text())
+    doc["mission"]["plannedHomePosition"][2] = home_alt
+    area = tmp_path / "home.plan"
+    area.write_text(json.dumps(doc))
+    res = uasnav.plan(area=str(area), resolution=0.05, start=START)
+    g = res["ground"]
+    assert g["assumed"] and g["elevation_m"] == 0.0
+    assert said in g["source"] and "QGroundControl" in g["source"]
+    assert any(said in a and "give --ground-elevation" in a for a in res["survey"]["assumptions"])
+    r = CliRunner().invoke(
+        main,
+        ["plan", "--area", str(area), "--resolution", "0.05", "--start", START, "--out", str(tmp_path / "o")],
+    )
+    assert r.exit_code == 0, r.output
+    warning = [x for x in r.stderr.splitlines() if x.startswith("warning: ")]
+    assert len(warning) == 1 and said in warning[0], r.stderr
+    # a real home altitude is the ground, as before
+    doc["mission"]["plannedHomePosition"][2] = 488.9
+    area.write_text(json.dumps(doc))
+    g = uasnav.plan(area=str(area), resolution=0.05, start=START)["ground"]
+    assert g["elevation_m"] == 488.9 and not g["assumed"]
+
+
+def _with_heights(geom: dict, h) -> dict:
+    """``geom`` with a third coordinate on every position: ``h(lon, lat)`` m."""
+    ring = [[lon, lat, float(h(lon, lat))] for lon, lat in geom["coordinates"][0]]
+    return {"type": "Polygon", "coordinates": [ring]}
+
+
+def test_geojson_heights_are_ellipsoidal_and_give_the_ground_in_amsl() -> None:
+    """RFC 7946 heights are above the WGS-84 ellipsoid: the ground is each height less the EGM96
+    geoid height there, and the intents stand on it (h_W84 = H + height + N)."""
+    from uasnav.geo.geoid import geoid_height
+
+    field = rect(10, 10, 70, 70)
+    amsl = 450.0
+    res = uasnav.plan(
+        area=_with_heights(field, lambda lon, lat: amsl + geoid_height(lat, lon)),
+        takeoff=f"{LAT0},{LON0}",
+        resolution=0.05,
+        start=START,
+    )
+    g = res["ground"]
+    assert not g["assumed"] and g["elevation_m"] == pytest.approx(amsl, abs=1e-6)
+    assert "RFC 7946" in g["source"] and "geoid" in g["source"]
+    assert g["spread_m"] == pytest.approx(0.0, abs=1e-6)
+    given = uasnav.plan(
+        area=field, takeoff=f"{LAT0},{LON0}", resolution=0.05, start=START, ground_elevation=amsl
+    )
+    za = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(res)]
+    zb = [(v["altitude_lower"]["value"], v["altitude_upper"]["value"]) for v in _intent_volumes(given)]
+    assert np.allclose(za, zb, atol=1e-6)
+    # the operator's elevation wins over the file's
+    assert (
+        uasnav.plan(
+            area=_with_heights(field, lambda lon, lat: 999.0), takeoff=f"{LAT0},{LON0}", resolution=0.05,
+            start=START, ground_elevation=amsl,
+        )["ground"]["elevation_m"]
+        == amsl
+    )  # fmt: skip
+
+
+def test_geojson_heights_that_cannot_be_the_ground_are_said_why() -> None:
+    field = rect(10, 10, 70, 70)
+    zeros = uasnav.plan(area=_with_heights(field, lambda lon, lat: 0.0), resolution=0.05, start=START)
+    assert zeros["ground"]["assumed"] and "all 0" in zeros["ground"]["source"]
+    far = uasnav.plan(
+        area=_with_heights(rect(1500, 0, 70, 70), lambda lon, lat: 300.0),
+        takeoff=f"{LAT0},{LON0}",
+        resolution=0.05,
+        start=START,
+    )
+    assert far["ground"]["assumed"] and "from area" in far["ground"]["source"]
+    # a sloping field: its mean is taken, and the flat-field assumption is flagged with the span
+    slope = uasnav.plan(
+        area=_with_heights(field, lambda lon, lat: 300.0 + (lat - LAT0) * 111e3 * 0.5),
+        takeoff=f"{LAT0},{LON0}",
+        resolution=0.05,
+        start=START,
+    )
+    assert slope["ground"]["spread_m"] == pytest.approx(35.0, abs=0.5)
+    assert any("span 35 m" in a for a in slope["survey"]["assumptions"])
+
+
+def test_the_large_field_is_flown_by_a_rotorcraft_and_the_fixed_wings_are_said_why(large) -> None:
+    """The survey's lines are a rotorcraft pattern (stop and turn one swath away): a fixed wing,
+    which turns on a circle of 2·v²/(g·tan 30°) at its cruise speed, is not ranked for it, and
+    the answer says which ones and why."""
+    from uasnav.mission.feasibility import HOVERING_TYPES
+
+    res, _out = large
+    db = res.selection.database.uas
+    chosen = db.ids.index(res["configuration"]["uas_id"])
+    assert db.types[chosen] in HOVERING_TYPES
+    spacing = res["survey"]["line_spacing_m"]
+    disco = next(
+        r for r in res.selection.rejections if r.item == "parrot-disco" and r.test == "survey-pattern"
+    )
+    v = 0.7 * 22.0  # the cruise fraction of the Disco's 22 m/s
+    assert disco.value == pytest.approx(2 * v**2 / (9.80665 * math.tan(math.radians(30.0))), rel=1e-9)
+    assert disco.value > spacing  # 84 m across: wider than the lines are apart
+    assert "cannot hover" in disco.message and f"{disco.value:.0f} m across" in disco.message
+    note = next(n for n in res["notes"] if n.startswith("survey: "))
+    assert "Parrot Disco" in note and "cannot hover" in note
+    # rotorcraft are never held back by the pattern
+    assert not any(
+        r.test == "survey-pattern" and db.types[db.ids.index(r.item)] in HOVERING_TYPES
+        for r in res.selection.rejections
+        if r.kind == "uas"
+    )
+
+
+def test_the_pilot_distance_covers_the_route_the_plans_fly(large) -> None:
+    """The operation's pilot distance is the farthest point the written flights reach (run-ins
+    and run-outs past the field included), measured on the .plan files themselves."""
+    res, out = large
+    farthest = 0.0
+    for f in res["flights"]:
+        plan = read_plan(out / f"{f['name']}.plan")
+        pos = [(it.lat_deg, it.lon_deg) for it in plan.items if it.has_position]
+        farthest = max(farthest, float(np.hypot(*_local(*zip(*pos, strict=True)).T).max()))
+    d, op = res["distances"], res["operation"]
+    assert d["pilot_distance_on"].startswith("the planned route")
+    assert d["pilot_distance_m"] == pytest.approx(farthest, abs=0.5)
+    assert d["pilot_distance_m"] > d["area_pilot_distance_m"] == pytest.approx(math.hypot(420, 320), abs=1)
+    assert op["max_distance_m"] == pytest.approx(d["pilot_distance_m"])
+    assert (op["visibility"] == "VLOS") == (op["max_distance_m"] <= op["vlos_distance_m"])
+    # the derivation names where the distance was measured, not an option nobody typed
+    seen = next(f for f in res.selection.operation.derivation if f.name == "visibility")
+    assert seen.requirement.startswith("the planned route's farthest point from the pilot position = ")
+    assert "--max-distance" not in seen.requirement

@@ -72,8 +72,9 @@ class Pages:
         self.outside: list[str] = []
         self.contexts: list[object] = []
 
-    def new(self, viewport: dict[str, int] = DESKTOP):  # type: ignore[no-untyped-def]
-        ctx = self.browser.new_context(viewport=viewport, accept_downloads=True)
+    def new(self, viewport: dict[str, int] = DESKTOP, **options: object):  # type: ignore[no-untyped-def]
+        """A page at ``viewport``; ``options`` go to the browser context (``has_touch`` …)."""
+        ctx = self.browser.new_context(viewport=viewport, accept_downloads=True, **options)
         self.contexts.append(ctx)
         base = self.server.url + "/"
 
@@ -544,6 +545,51 @@ def test_map_click_places_takeoff_and_pilot(pages, server, tmp_path) -> None:
             which,
         )
         assert abs(got[0] - lat) * 111e3 < 0.5 and abs(got[1] - lon) * 77e3 < 0.5, (which, got, text)
+
+
+def test_map_taps_place_takeoff_and_pilot_on_a_phone(pages, server, tmp_path) -> None:
+    """On a 390 px touch screen, taps (touch events, no mouse) on the offline map set the
+    take-off point and then the pilot's position; the next run plans from them, and the
+    regulation line gives the pilot distance in whole metres."""
+    area = tmp_path / "field.geojson"
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [FIELD_RING]}))
+    page = pages.new(PHONE, has_touch=True, is_mobile=True)
+    assert page.evaluate("navigator.maxTouchPoints") > 0
+    page.goto(server.url + "/")
+    page.set_input_files("#f-area", str(area))
+    page.fill("#f-range", "")
+    page.tap("#select-form button[type=submit]")
+    landed(page)
+    svg = page.locator("svg.map")
+    svg.scroll_into_view_if_needed()
+    size = svg.bounding_box()
+    assert size and size["width"] <= PHONE["width"] and page.locator("#map-set").is_visible()
+    placed = {}
+    for which, (fx, fy) in (("takeoff", (0.35, 0.7)), ("pilot", (0.65, 0.35))):
+        page.locator(f"#map-set input[value={which}]").tap()
+        assert page.is_checked(f"#map-set input[value={which}]")
+        svg.tap(position={"x": fx * size["width"], "y": fy * size["height"]})
+        placed[which] = page.input_value(f"#f-{which}")
+        lat, lon = map(float, placed[which].split(","))
+        assert 46.2 < lat < 46.23 and 6.15 < lon < 6.18, placed[which]
+        assert placed[which] in page.locator("#map-status").inner_text()
+        box = svg.bounding_box()
+        dot = page.locator(f"svg.map g.pt.{which} circle").bounding_box()
+        assert box and dot
+        assert abs(dot["x"] + dot["width"] / 2 - (box["x"] + fx * box["width"])) < 2
+        assert abs(dot["y"] + dot["height"] / 2 - (box["y"] + fy * box["height"])) < 2
+    assert placed["takeoff"] != placed["pilot"]
+    shot(page, "select-map-tapped-phone")
+    page.tap("#select-form button[type=submit]")  # the kept area, from the tapped points
+    landed(page)
+    assert page.locator("#plan").count() == 1
+    for which, text in placed.items():
+        assert page.input_value(f"#f-{which}") == text
+    notes = " ".join(page.locator("p.note").all_inner_texts())
+    shown = re.findall(r"(\d[\d.,]*) m from the pilot", notes)
+    assert shown and all(re.fullmatch(r"\d+", x) for x in shown), notes
+    shot(page, "select-map-tapped-result-phone")
+    assert page.evaluate("document.documentElement.scrollWidth") <= PHONE["width"]
 
 
 def test_oversize_upload_is_refused_beside_the_field(pages, server, tmp_path) -> None:

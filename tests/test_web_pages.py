@@ -241,3 +241,42 @@ def test_answers_name_fields_not_command_line_options(client) -> None:
     plan = re.sub(r'href="data:[^"]*"', "", plan)
     notes = " ".join(re.findall(r'<p class="note">(.*?)</p>', r.text, re.S))
     assert "“Altitude”" in plan and not re.search(r"--[a-z]", plan + notes)
+
+
+def _pilot_distances(text: str) -> list[str]:
+    """Every "<n> m from the pilot" of a text, and the derivation's "… = <n> m" distances."""
+    return re.findall(r"(\d[\d.,]*) m from the pilot", text) + re.findall(
+        r"pilot position = (\d[\d.,]*) m", text
+    )
+
+
+def test_pilot_distance_reads_in_whole_metres_on_the_page_and_its_print_view(client) -> None:
+    """The page, its print view (the summary download) and the summary JSON round the pilot
+    distance measured on the area the same way (whole metres), the JSON keeps its precision."""
+    import base64
+
+    r = client.post("/select", data={"range": "", "altitude": "50"}, files={"area": ("field.geojson", AREA)})
+    assert r.status_code == 200
+    links = re.findall(r'href="data:[^;]+;charset=utf-8;base64,([^"]+)"\s+download="([^"]+)"', r.text)
+    views = {name: base64.b64decode(b).decode() for b, name in links}
+    page = r.text
+    shown = _pilot_distances(page) + _pilot_distances(views["authorisation-summary.html"])
+    shown += _pilot_distances(views["authorisation-summary.json"])
+    assert len(shown) >= 4, shown
+    exact = json.loads(views["selection.json"])["operation"]["max_distance_m"]
+    assert exact != round(exact)  # the case shows the rounding
+    assert set(shown) == {f"{exact:.0f}"}, shown
+    assert f"{exact:.4g}" not in page.replace(f"{exact:.0f} m", "")
+
+
+def test_unreachable_resolution_is_said_in_the_forms_words(client) -> None:
+    """A resolution no camera reaches: the page names the field and the value as typed, in its
+    unit, and where the finest camera falls short (no option names, no height never asked)."""
+    r = client.post("/select", data={"resolution": "0.0005", "altitude": "50"})
+    assert r.status_code == 200
+    box = re.search(r'<div class="verdict-box" role="alert" id="not-authorisable">(.*?)</div>', r.text, re.S)
+    assert box, r.text[:2000]
+    text = box.group(1)
+    assert "“Resolution” 0.0005 m/px (0.5 mm per pixel) asked" in text, text
+    assert "at 50 m, the planned height (“Altitude”)" in text, text
+    assert not re.search(r"--[a-z]", text), text

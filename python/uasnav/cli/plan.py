@@ -11,6 +11,7 @@ from uasnav.cli._common import OutputPath, Real, echo_json
 from uasnav.cli.select import _USAGE_KINDS, _options
 from uasnav.errors import InputError
 from uasnav.mission.planner import PLAN_OPTIONS
+from uasnav.mission.readable import metres
 from uasnav.mission.request import SELECT_OPTIONS, OptionError, read_file_option
 
 
@@ -103,9 +104,9 @@ def command(
     click.echo(f"Configuration: {c['uas']} + {c['camera']} (score {c['score']:.2f})")
     if op:
         click.echo(
-            f"Operation: {op['visibility']}, {op['category']}; pilot "
-            f"{d.get('pilot_distance_m', 0):.0f} m from the farthest point of the area "
-            f"({d.get('pilot_from')})"
+            f"Operation: {op['visibility']}, {op['category']}; the pilot ({d.get('pilot_from')}) is "
+            f"{metres(d.get('pilot_distance_m', 0))} from the farthest point of "
+            f"{d.get('pilot_distance_on', 'the area')}"
         )
     click.echo(f"Survey: {s['altitude_m']:.1f} m {s['altitude_datum']} — {s['height_reason']}")
     click.echo(
@@ -144,6 +145,7 @@ def _warn_assumed_ground(g: dict[str, Any]) -> None:
     if g["assumed"]:
         click.echo(
             f"warning: the intents' WGS-84 altitudes assume the take-off ground at {g['elevation_m']:g} m "
-            "AMSL: give --ground-elevation (m AMSL) before filing them",
+            f"AMSL ({g['source'].removeprefix('assumed: ')}): give --ground-elevation (m AMSL) before "
+            "filing them",
             err=True,
         )

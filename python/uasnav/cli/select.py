@@ -8,6 +8,7 @@ from typing import Any
 import click
 
 from uasnav.cli._common import OutputPath, Real, check_outputs, echo_json
+from uasnav.mission.readable import metres
 from uasnav.mission.request import (
     SELECT_OPTIONS,
     OptionError,
@@ -121,14 +122,15 @@ def command(as_json: bool, **options: Any) -> None:
     if request.distances is not None:
         d = request.distances
         click.echo(
-            f"Distances: pilot {d['pilot_distance_m']:.0f} m from the farthest point of the area "
-            f"(pilot at {d['pilot_from']}), range {d['range_m']:.0f} m from the take-off point "
+            f"Distances: pilot {metres(d['pilot_distance_m'])} from the farthest point of the area "
+            f"(pilot at {d['pilot_from']}), range {metres(d['range_m'])} from the take-off point "
             f"({d['takeoff_from']})"
         )
     if op is not None:
         click.echo(
-            f"Operation: {op.visibility}, {op.max_distance_m:g} m from the pilot (in sight up to "
-            f"{op.vlos_distance_m:g} m), {op.height_m:g} m AGL, {'urban' if op.urban else 'rural'} "
+            f"Operation: {op.visibility}, {metres(op.max_distance_m, against=op.vlos_distance_m)} from the "
+            f"pilot (in sight up to {metres(op.vlos_distance_m)}), {metres(op.height_m)} AGL, "
+            f"{'urban' if op.urban else 'rural'} "
             f"({op.population}), over people: {op.over_people}, {'night' if op.night else 'day'}, "
             f"airspace {op.airspace}"
         )
@@ -141,7 +143,7 @@ def command(as_json: bool, **options: Any) -> None:
                 )
                 click.echo(
                     f"  {o.visibility}/{o.category} for {len(o.uas)} UAS "
-                    f"(in sight up to {o.vlos_distance_m:g} m): {best}"
+                    f"(in sight up to {metres(o.vlos_distance_m)}): {best}"
                 )
     if sel.sora is not None:
         s = sel.sora

@@ -19,6 +19,13 @@ CAMERA_HEIGHTS = ("planned", "regulatory-max")
 #: Lowest height a survey is planned at, m above ground (clear of trees, buildings and people's
 #: heads on an agricultural field; below it a camera is too narrow for the resolution asked).
 MIN_SURVEY_HEIGHT_M = 10.0
+#: UA types that can fly the planned survey's lines: stop at a line's end, turn on the spot and
+#: go on along the next line one swath (tens of metres) away, take off and land vertically.
+HOVERING_TYPES = frozenset({"multirotor", "helicopter"})
+#: Bank angle of a fixed wing's survey turn, deg: comfortable for a survey, below the
+#: autopilots' roll limits (ArduPlane ``ROLL_LIMIT_DEG`` 45°, PX4 ``FW_R_LIM`` 50°).
+SURVEY_BANK_DEG = 30.0
+_G = 9.80665
 
 
 @dataclass(frozen=True)
@@ -89,7 +96,9 @@ class Requirements:
     mosaic : bool
         The target is covered by many photos (a survey, ``uasnav plan``): no single photo has to
         hold it (no field-of-view test), and the resolution only has to be reachable at or above
-        :data:`MIN_SURVEY_HEIGHT_M` (the survey flies at the height that gives it).
+        :data:`MIN_SURVEY_HEIGHT_M` (the survey flies at the height that gives it). The survey's
+        lines are a rotorcraft pattern, so only :data:`HOVERING_TYPES` fly it (test
+        ``survey-pattern``).
     """
 
     mission: str = "precision-agriculture"
@@ -121,6 +130,9 @@ class Requirements:
     flight_duration_s: float | None = None
     #: Where ``altitude_m`` came from when not ``--altitude`` (a plan flying higher), else None.
     altitude_source: str | None = None
+    #: Where ``max_distance_m`` was measured when not ``--max-distance`` (the area or the planned
+    #: route, from the pilot's position), else None.
+    max_distance_source: str | None = None
     camera_height: str = "planned"
     mosaic: bool = False
 
@@ -237,6 +249,13 @@ def uas_tests(u: UasTable, req: Requirements, max_mtom_g: float) -> list[TestRes
     out.append(TestResult("regulation-mass", u.mass_g < max_mtom_g, u.mass_g, full * max_mtom_g, "g", "<"))
     if req.rain:
         out.append(TestResult("rain", u.rain.copy(), u.rain.astype(float), full, "rated", "=="))
+    if req.mosaic:
+        # A UA that cannot hover turns on a circle of radius v²/(g·tan φ) at its cruise speed:
+        # the value says how wide, against the 0 m of a stop-and-turn at the line's end.
+        hover = np.array([t in HOVERING_TYPES for t in u.types], dtype=bool)
+        v = req.cruise_fraction * u.max_speed_ms
+        across = np.where(hover, 0.0, 2.0 * v**2 / (_G * math.tan(math.radians(SURVEY_BANK_DEG))))
+        out.append(TestResult("survey-pattern", hover, across, full * 0.0, "m", "<="))
     return out
 
 
@@ -317,6 +336,12 @@ def describe(test: TestResult, i, label: str) -> str:
         )
     if test.name == "rain":
         return f"{label}: not rated for rain (needs IPX3 or better)"
+    if test.name == "survey-pattern":
+        return (
+            f"{label}: survey-pattern: cannot hover, and a {SURVEY_BANK_DEG:g}°-bank turn at its cruise "
+            f"speed is {v:.0f} m across; the survey is planned for rotorcraft, which stop at each line's "
+            "end and turn onto the next line one swath away (fixed-wing survey patterns are not planned)"
+        )
     if test.name == "endurance":
         if not math.isfinite(lim):
             return f"{label}: endurance: cruise airspeed does not exceed the wind"

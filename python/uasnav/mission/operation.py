@@ -21,6 +21,7 @@ import numpy as np
 
 from uasnav.errors import InputError
 from uasnav.mission.feasibility import Requirements
+from uasnav.mission.readable import metres
 from uasnav.mission.sora import DENSITY_CLASSES, density_class
 
 #: The distance (m) up to which a UA is kept in unaided sight, from its size, when the user gives
@@ -180,7 +181,11 @@ def derive_operation(req: Requirements, *, vlos_default: tuple[float, str] | Non
     """
     facts: list[Fact] = []
     dist = req.max_distance_m if req.max_distance_m is not None else req.range_m
-    dist_req = "--max-distance" if req.max_distance_m is not None else "--range (no --max-distance given)"
+    dist_req = (
+        (req.max_distance_source or "--max-distance")
+        if req.max_distance_m is not None
+        else "--range (no --max-distance given)"
+    )
     if req.vlos_distance_m is not None:
         vlos_d, vlos_src = req.vlos_distance_m, "--vlos-distance"
     elif vlos_default is not None:
@@ -199,21 +204,23 @@ def derive_operation(req: Requirements, *, vlos_default: tuple[float, str] | Non
         Fact(
             "visibility",
             vis,
-            f"{dist_req} = {dist:g} m, --observers = {req.observers}",
-            f"kept in sight up to {vlos_d:g} m ({vlos_src}); "
+            f"{dist_req} = {metres(dist, against=vlos_d)}, --observers = {req.observers}",
+            f"kept in sight up to {metres(vlos_d)} ({vlos_src}); "
             "VLOS per (EU) 2019/947 Art. 2(7), 14 CFR §107.31; EVLOS: kept in sight by airspace "
             "observers posted along the route, each over the same distance (JARUS SORA glossary)",
         )
     )
     lvl = range_level(dist)
     facts.append(
-        Fact("range level", lvl, f"{dist_req} = {dist:g} m", "thesis Table 18 levels <1 km, 1–5 km, >5 km")
+        Fact(
+            "range level", lvl, f"{dist_req} = {metres(dist)}", "thesis Table 18 levels <1 km, 1–5 km, >5 km"
+        )
     )
     facts.append(
         Fact(
             "height",
-            f"{req.altitude_m:g} m AGL",
-            req.altitude_source or f"--altitude = {req.altitude_m:g} m",
+            f"{metres(req.altitude_m)} AGL",
+            req.altitude_source or f"--altitude = {metres(req.altitude_m)}",
             "(EU) 2019/947 Art. 4(1)(e) 120 m; 14 CFR §107.51(b) 400 ft",
         )
     )
@@ -284,7 +291,7 @@ def derive_operation(req: Requirements, *, vlos_default: tuple[float, str] | Non
                 f"{vis} (open category requires the remote pilot's own VLOS: Art. 4(1)(d), Art. 2(7))"
             )
         if req.altitude_m > EU_MAX_HEIGHT_M:
-            why_not.append(f"{req.altitude_m:g} m above 120 m (Art. 4(1)(e))")
+            why_not.append(f"{metres(req.altitude_m, against=EU_MAX_HEIGHT_M)} above 120 m (Art. 4(1)(e))")
         if req.over_people == "assemblies":
             why_not.append("over assemblies of people (Art. 4(1)(c))")
         derived = "open" if not why_not else "specific"
@@ -445,7 +452,7 @@ def _range_1_2km(sid: str) -> Limit:
         "max_distance_m",
         "<=obs",
         (1000.0, 2000.0),
-        "{max_distance_m:g} m from the pilot, " + sid + " allows 1 km (2 km with airspace observers)",
+        "{max_distance} from the pilot, " + sid + " allows 1 km (2 km with airspace observers)",
     )
 
 
@@ -574,7 +581,7 @@ SCENARIOS: tuple[Scenario, ...] = (
                 "height_m",
                 "<=",
                 PDRA_G03_MAX_HEIGHT_M,
-                "{height_m:g} m above the surface: PDRA-G03 flies at most " + f"{PDRA_G03_MAX_HEIGHT_M:g} m",
+                "{height} above the surface: PDRA-G03 flies at most " + f"{PDRA_G03_MAX_HEIGHT_M:g} m",
             ),
         ),
         ("pre-programmed flight within the direct C2 link's range",),
@@ -587,15 +594,18 @@ def scenario_facts(
     op: Operation, *, eu_class: str | None, mtom_g: float, dimension_m: float, speed_ms: float
 ) -> dict[str, Any]:
     """The facts the :class:`Limit` rows read: the operation's and one UA's (typical kinetic
-    energy ½·m·v² at the UA's maximum speed, J)."""
+    energy ½·m·v² at the UA's maximum speed, J); ``height`` and ``max_distance`` are the same
+    lengths as text for the ``why`` lines (:func:`~uasnav.mission.readable.metres`)."""
     ke = 0.5 * mtom_g / 1000.0 * speed_ms**2
     return {
         "vlos": op.visibility == "VLOS",
         "eu_class": eu_class,
         "eu_class_name": eu_class or "none",
         "height_m": op.height_m,
+        "height": metres(op.height_m, against=PDRA_G03_MAX_HEIGHT_M),
         "over_people": op.over_people,
         "max_distance_m": op.max_distance_m,
+        "max_distance": metres(op.max_distance_m, against=2000.0 if op.observers else 1000.0),
         "observers": op.observers,
         "sparse": DENSITY_CLASSES[op.population] < SPARSE_DENSITY,
         "airspace": op.airspace,

@@ -27,6 +27,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from uasnav.errors import InputError
 from uasnav.jsonable import to_jsonable
 from uasnav.mission.request import OptionError, Upload, parse_select_options
@@ -43,6 +45,8 @@ DEFAULT_GROUND_ELEVATION_M = 0.0
 #: Farthest a plan's home position may be from the take-off point (m) for its altitude to be
 #: taken as the take-off ground's.
 HOME_AS_TAKEOFF_M = 100.0
+#: Spread of an area's ground heights (m) beyond which the flat-field assumption is flagged.
+FLAT_SPREAD_M = 10.0
 #: Files written per flight (``{k:02d}`` is the flight number).
 FLIGHT_FILES = ("flight-{k:02d}.plan", "flight-{k:02d}.waypoints", "flight-{k:02d}.intent.json")
 
@@ -345,9 +349,16 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
     ground = ground_info["elevation_m"]
     if ground_info["assumed"]:
         sp.assumptions.append(
-            f"ground elevation not given: the take-off point is taken at {ground:g} m AMSL, so the "
-            f"intents' WGS-84 altitudes are {ground:g} m + height + geoid height "
-            f"({ground_info['geoid_height_m']:.1f} m here); give --ground-elevation (m AMSL) before filing"
+            f"ground elevation not known ({ground_info['source'].removeprefix('assumed: ')}): the take-off "
+            f"point is taken at {ground:g} m AMSL, so the intents' WGS-84 altitudes are {ground:g} m + "
+            f"height + geoid height ({ground_info['geoid_height_m']:.1f} m here); give --ground-elevation "
+            "(m AMSL) before filing"
+        )
+    if ground_info.get("spread_m", 0.0) > FLAT_SPREAD_M:
+        sp.assumptions.append(
+            f"the area's heights span {ground_info['spread_m']:.0f} m: the survey's heights are above the "
+            f"take-off point and the ground is taken at their mean, {ground:.0f} m AMSL; on ground this "
+            "uneven the resolution and the overlaps vary with it"
         )
     model = survey_predictor(sp.speed_ms)
     from uasnav.trajectory.features import wind_vector
@@ -385,6 +396,14 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
         if request.zones is not None
         else {}
     )
+    # The UA flies past the area on its run-ins and run-outs: the operation's distances are the
+    # route's when it reaches farther than the area (unless the operator typed them).
+    assert request.distances is not None
+    distances, farther = route_distances(sp, request.distances, lat0, lon0)
+    if "max_distance_m" in farther and req.max_distance_m == request.distances["pilot_distance_m"]:
+        req = replace(req, max_distance_m=farther["max_distance_m"], max_distance_source=ROUTE_DISTANCE_WORDS)
+    if "range_m" in farther and req.range_m == request.distances["range_m"]:
+        req = replace(req, range_m=farther["range_m"])
     flown = replace(
         req, altitude_m=math.ceil(sp.altitude_m * 10.0) / 10.0, flight_duration_s=max(total_s, 1.0)
     )
@@ -401,8 +420,47 @@ def plan(options: Mapping[str, Any] | None = None, /, **kw: Any) -> PlanResult:
         sel.flight_window["from"] = "predicted flight time of the survey (upper bounds, turnarounds included)"
     conflicts = _deconflict(flights, _read_intents(list(intents_in), dt.datetime.now(dt.timezone.utc)))
     result = _result(sel, best, sp, flights, conflicts, request, start, total_s, overlap, ground_info)
+    result["distances"] = distances
     files = _files(sel, sp, flights, result)
     return PlanResult(result, files, sel, sp, flights)
+
+
+#: Where the operation's pilot distance comes from when the flown route reaches past the area.
+ROUTE_DISTANCE_WORDS = "the planned route's farthest point from the pilot position"
+
+
+def route_distances(
+    sp: SurveyPlan, area_distances: dict[str, Any], lat0: float, lon0: float
+) -> tuple[dict[str, Any], dict[str, float]]:
+    """The distances of the flown survey: the farthest any line point (run-in and run-out ends
+    included) is from the pilot and from the take-off point (``lat0``, ``lon0``, the survey's
+    origin), against the area's (:func:`uasnav.mission.request.area_distances`).
+
+    Returns the ``distances`` block of the result — the area's, with ``route_pilot_distance_m``,
+    ``route_range_m``, ``area_pilot_distance_m``, and ``pilot_distance_m``/``range_m`` the larger
+    of the two, ``pilot_distance_on`` naming which — and the requirement changes
+    (``max_distance_m``, ``range_m``) where the route reaches farther than the area.
+    """
+    from uasnav.geo import frames
+
+    pts = np.array([p for ln in sp.lines for p in (ln.run_in_en, ln.start_en, ln.end_en, ln.run_out_en)])
+    pe, pn, _ = frames.geodetic_to_enu(
+        area_distances["pilot"][0], area_distances["pilot"][1], 0.0, lat0, lon0, 0.0
+    )
+    to_pilot = float(np.hypot(pts[:, 0] - float(pe), pts[:, 1] - float(pn)).max()) if len(pts) else 0.0
+    to_takeoff = float(np.hypot(pts[:, 0], pts[:, 1]).max()) if len(pts) else 0.0
+    out = dict(area_distances)
+    out["area_pilot_distance_m"] = area_distances["pilot_distance_m"]
+    out["route_pilot_distance_m"] = to_pilot
+    out["route_range_m"] = to_takeoff
+    changes: dict[str, float] = {}
+    on_route = to_pilot > area_distances["pilot_distance_m"]
+    out["pilot_distance_on"] = "the planned route (run-ins and run-outs included)" if on_route else "the area"
+    if on_route:
+        out["pilot_distance_m"] = changes["max_distance_m"] = to_pilot
+    if to_takeoff > area_distances["range_m"]:
+        out["range_m"] = changes["range_m"] = to_takeoff
+    return out, changes
 
 
 def _legal_height(regs: Any, req: Any) -> float:
@@ -468,37 +526,37 @@ def ground_datum(elevation_m: float | None, area: Any, lat_deg: float, lon_deg: 
     The survey flies at heights above this point (flat field); an F3548 intent needs WGS-84
     ellipsoidal altitudes: h_W84 = H_AMSL(ground) + height + N, with N the EGM96 geoid height
     (:func:`uasnav.geo.geoid.geoid_height`, evaluated at each point of the intent). The ground's
-    AMSL elevation is, in this order: the operator's (``elevation_m``, ``--ground-elevation``);
-    the home altitude of a mission plan given as the area, when its home is within
-    :data:`HOME_AS_TAKEOFF_M` of the take-off point; else :data:`DEFAULT_GROUND_ELEVATION_M`,
-    flagged ``assumed`` (uasnav carries no terrain model: the geoid gives ellipsoid ↔ AMSL,
-    not the ground).
+    AMSL elevation is, in this order:
+
+    1. the operator's (``elevation_m``, ``--ground-elevation``);
+    2. the home altitude (AMSL) of a mission plan given as the area, when its home is within
+       :data:`HOME_AS_TAKEOFF_M` of the take-off point. A home altitude of exactly 0 m or none
+       is no elevation: QGroundControl starts the planned home at 0 m and replaces it only with
+       the terrain height (when its terrain query answers) or the vehicle's home, and writes
+       ``null`` for an unknown altitude — so 0 means it had neither (the plans in
+       ``../shared/data/missions`` carry 343, 483–489 and 5.2 m, or ``null``);
+    3. the heights of a GeoJSON area (the third coordinate of its positions: metres above the
+       WGS-84 ellipsoid, RFC 7946 §4), each less its EGM96 geoid height, averaged, when the
+       take-off point is within :data:`HOME_AS_TAKEOFF_M` of the area. Heights that are all 0
+       are taken as unset (a placeholder many tools write);
+    4. else :data:`DEFAULT_GROUND_ELEVATION_M`, flagged ``assumed`` (uasnav carries no terrain
+       model: the geoid gives ellipsoid ↔ AMSL, not the ground); ``source`` says why.
 
     Returns
     -------
     dict
         ``elevation_m`` (m AMSL), ``datum`` ("AMSL"), ``source``, ``assumed``, ``at`` ([lat, lon]
-        of the take-off point), ``geoid`` (model), ``geoid_height_m`` (N at the take-off point)
-        and ``ellipsoidal_height_m`` (the ground's h_W84 there).
+        of the take-off point), ``geoid`` (model), ``geoid_height_m`` (N at the take-off point),
+        ``ellipsoidal_height_m`` (the ground's h_W84 there) and, from area heights, ``spread_m``
+        (highest less lowest AMSL elevation of the area's positions).
     """
-    from uasnav.geo import frames
     from uasnav.geo.geoid import GEOID_MODEL, geoid_height
 
-    assumed = False
+    extra: dict[str, Any] = {}
     if elevation_m is not None:
-        ground, source = float(elevation_m), "the operator (--ground-elevation)"
+        ground, source, assumed = float(elevation_m), "the operator (--ground-elevation)", False
     else:
-        home = getattr(area, "home", None)
-        d = math.inf
-        if home is not None:
-            e, n, _ = frames.geodetic_to_enu(home[0], home[1], 0.0, lat_deg, lon_deg, 0.0)
-            d = math.hypot(float(e), float(n))
-        if d <= HOME_AS_TAKEOFF_M:
-            ground = float(home[2])
-            source = f"the home position of the plan {area.where} ({d:.0f} m from the take-off point)"
-        else:
-            ground, assumed = DEFAULT_GROUND_ELEVATION_M, True
-            source = "assumed: no ground elevation given and no terrain model"
+        ground, source, assumed = _ground_of_area(area, lat_deg, lon_deg, extra)
     n_m = float(geoid_height(lat_deg, lon_deg))
     return {
         "elevation_m": ground,
@@ -509,7 +567,63 @@ def ground_datum(elevation_m: float | None, area: Any, lat_deg: float, lon_deg: 
         "geoid": GEOID_MODEL,
         "geoid_height_m": n_m,
         "ellipsoidal_height_m": ground + n_m,
+        **extra,
     }
+
+
+def _ground_of_area(
+    area: Any, lat_deg: float, lon_deg: float, extra: dict[str, Any]
+) -> tuple[float, str, bool]:
+    """(elevation m AMSL, source, assumed) of the take-off ground from the area document (steps
+    2–4 of :func:`ground_datum`); ``extra`` receives ``spread_m`` for area heights."""
+    from shapely import geometry as sg
+
+    from uasnav.geo import frames
+    from uasnav.geo.geoid import geoid_height
+
+    fallback = "assumed: no ground elevation given and no terrain model"
+    home = getattr(area, "home", None)
+    if home is not None:
+        e, n, _ = frames.geodetic_to_enu(home[0], home[1], 0.0, lat_deg, lon_deg, 0.0)
+        d = math.hypot(float(e), float(n))
+        if d <= HOME_AS_TAKEOFF_M:
+            where = f"the home position of the plan {area.where} ({d:.0f} m from the take-off point)"
+            alt = float(home[2])
+            if math.isfinite(alt) and alt != 0.0:
+                return alt, where, False
+            said = "no altitude" if not math.isfinite(alt) else "altitude 0 m"
+            return (
+                DEFAULT_GROUND_ELEVATION_M,
+                f"assumed: {where} has {said}, which QGroundControl writes when it had neither terrain "
+                "data nor a vehicle's home; no terrain model",
+                True,
+            )
+    heights = getattr(area, "heights", ())
+    if heights:
+        h = np.asarray(heights, dtype=float)
+        if not np.any(h[:, 2] != 0.0):
+            return (
+                DEFAULT_GROUND_ELEVATION_M,
+                f"{fallback} (the heights of {area.where} are all 0: unset)",
+                True,
+            )
+        near = area.local(lon_deg, lat_deg).distance(sg.Point(0.0, 0.0))
+        if near > HOME_AS_TAKEOFF_M:
+            return (
+                DEFAULT_GROUND_ELEVATION_M,
+                f"{fallback} (the take-off point is {near:.0f} m from {area.where}, whose heights "
+                "are not its ground)",
+                True,
+            )
+        amsl = h[:, 2] - np.asarray(geoid_height(h[:, 1], h[:, 0]), dtype=float)
+        extra["spread_m"] = float(amsl.max() - amsl.min())
+        return (
+            float(amsl.mean()),
+            f"the heights of {area.where}: mean of {len(amsl)} positions' WGS-84 ellipsoidal heights "
+            "(RFC 7946) less the EGM96 geoid height at each",
+            False,
+        )
+    return DEFAULT_GROUND_ELEVATION_M, fallback, True
 
 
 def _no_plan(sel: Any, request: Any) -> PlanResult:

@@ -611,6 +611,10 @@ def parse_position(name: str, value: Any) -> tuple[float, float]:
     return lat, lon
 
 
+#: Where the operation's pilot distance comes from when an area is given and no distance typed.
+AREA_DISTANCE_WORDS = "the area's farthest point from the pilot position"
+
+
 def area_distances(
     area: MissionArea, takeoff: tuple[float, float] | None, pilot: tuple[float, float] | None
 ) -> dict[str, Any]:
@@ -940,6 +944,7 @@ def parse_select_options(values: Mapping[str, Any]) -> SelectRequest:
         changes: dict[str, Any] = {}
         if v["max_distance"] is None:
             changes["max_distance_m"] = distances["pilot_distance_m"]
+            changes["max_distance_source"] = AREA_DISTANCE_WORDS
         if values.get("range") in (None, ""):
             changes["range_m"] = distances["range_m"]
         if changes:

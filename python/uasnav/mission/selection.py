@@ -33,6 +33,7 @@ from uasnav.mission.operation import (
     narrowed_features,
     vlos_distance_of,
 )
+from uasnav.mission.readable import metres
 from uasnav.mission.regulations import Regulations, load_regulations
 from uasnav.mission.scoring import ScoreMatrix, Targets, Weights, explain, rank, score_matrix
 from uasnav.mission.sora import SoraResult, assess
@@ -214,6 +215,24 @@ class Selection:
             "requirements": needs,
         }
 
+    def _resolution_unmet(self, finest: Rejection) -> str:
+        """The resolution no camera reaches, in the units and words it was asked in (m/px, by
+        --resolution), against the finest camera at the height it was tested at and why."""
+        r = self.requirements
+        if r.mosaic:
+            where = f"{metres(MIN_SURVEY_HEIGHT_M)}, the lowest height a survey flies"
+        elif r.camera_height == "regulatory-max":
+            where = f"{metres(self.camera_height_m or r.altitude_m)}, the highest the category allows"
+        else:
+            where = f"{metres(self.camera_height_m or r.altitude_m)}, the planned height (--altitude)"
+        cams = self.database.cameras
+        name = cams.label(cams.ids.index(finest.item)) if finest.item in cams.ids else finest.item
+        return (
+            f"resolution: --resolution {r.resolution_m:g} m/px ({_per_pixel(r.resolution_m)}) asked; "
+            f"the finest, {name}, gives {finest.value:.3g} m/px ({_per_pixel(finest.value)}) "
+            f"at {where}"
+        )
+
     @property
     def unmet(self) -> str:
         """What no configuration meets, said as what it is ("no camera meets the resolution
@@ -231,21 +250,14 @@ class Selection:
             binding = {next(iter(t)) for t in fails.values() if len(t) == 1}
             if binding:
                 tests_of["camera"] = binding
-            best = {}
-            for r in self.rejections:
-                if r.kind == "camera" and r.test == "resolution":
-                    best["resolution"] = min(best.get("resolution", float("inf")), r.value)
+            finest = min(
+                (r for r in self.rejections if r.kind == "camera" and r.test == "resolution"),
+                key=lambda r: r.value,
+                default=None,
+            )
             why = sorted(tests_of["camera"])
-            if "resolution" in best and np.isfinite(best["resolution"]):
-                why = [
-                    w
-                    if w != "resolution"
-                    else f"resolution (best {best['resolution']:.3g} m/px against "
-                    f"{self.requirements.resolution_m:g} m/px asked"
-                    + (f" at {self.camera_height_m:g} m" if self.camera_height_m else "")
-                    + ")"
-                    for w in why
-                ]
+            if finest is not None and np.isfinite(finest.value):
+                why = [w if w != "resolution" else self._resolution_unmet(finest) for w in why]
             parts.append("no camera in the database meets " + ", ".join(why))
         if len(self.database.uas) and not self.uas_ok.any():
             parts.append("no UAS in the database meets " + ", ".join(sorted(tests_of["uas"])))
@@ -481,6 +493,13 @@ def _operations_per_uas(u, req: Requirements, regs: Regulations) -> list[tuple[O
 DIRECT_C2_RANGE_M = 5000.0
 
 
+def _per_pixel(m_per_px: float) -> str:
+    """A ground resolution as people say it: "0.5 mm per pixel", "2 cm per pixel"."""
+    if m_per_px < 0.01:
+        return f"{m_per_px * 1000:.2g} mm per pixel"
+    return f"{m_per_px * 100:.3g} cm per pixel"
+
+
 def c2_name(item_id: str, name: str, distance_m: float) -> str:
     """The beyond-sight C2 link named by the range it must cover (``distance_m`` from the
     pilot): a network or SATCOM link only beyond :data:`DIRECT_C2_RANGE_M`."""
@@ -488,11 +507,11 @@ def c2_name(item_id: str, name: str, distance_m: float) -> str:
         return name
     if distance_m <= DIRECT_C2_RANGE_M:
         return (
-            f"BLOS C2 data link covering {distance_m:.0f} m from the pilot: a direct radio link with radio "
+            f"BLOS C2 data link covering {metres(distance_m)} from the pilot: a direct radio link with radio "
             "line of sight over the whole area (raised antenna), or a communication network link"
         )
     return (
-        f"BLOS C2 data link covering {distance_m:.0f} m from the pilot: communication network or SATCOM "
+        f"BLOS C2 data link covering {metres(distance_m)} from the pilot: communication network or SATCOM "
         "(beyond direct radio range)"
     )
 
@@ -532,11 +551,14 @@ def _plan_altitude(req: Requirements, area: MissionArea) -> tuple[Requirements, 
     h, how = got
     if h > req.altitude_m:
         note = (
-            f"the plan flies up to {h:g} m above ground ({how}), above --altitude {req.altitude_m:g} m: "
-            f"the height checks use {h:g} m"
+            f"the plan flies up to {metres(h, against=req.altitude_m)} above ground ({how}), above "
+            f"--altitude {metres(req.altitude_m)}: the height checks use {metres(h, against=req.altitude_m)}"
         )
         return replace(req, altitude_m=h, altitude_source=f"plan, highest item ({how})"), note
-    note = f"the plan's highest item is {h:g} m above ground ({how}), within --altitude {req.altitude_m:g} m"
+    note = (
+        f"the plan's highest item is {metres(h, against=req.altitude_m)} above ground ({how}), within "
+        f"--altitude {metres(req.altitude_m)}"
+    )
     return req, note
 
 
@@ -660,7 +682,8 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
                 op.vlos_distance_m,
                 "m",
                 f"{req.jurisdiction}/{category} requires VLOS ({cat.source}); the pilot-UA distance "
-                f"{op.max_distance_m:g} m exceeds the {op.vlos_distance_m:g} m kept in sight",
+                f"{metres(op.max_distance_m, against=op.vlos_distance_m)} exceeds the "
+                f"{metres(op.vlos_distance_m)} kept in sight",
             )
         )
     for chk in height_checks:
@@ -673,13 +696,15 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
                     req.altitude_m,
                     chk.limit.value_si,
                     "m",
-                    f"required altitude {req.altitude_m:g} m exceeds {chk.limit.describe()}",
+                    f"required altitude {metres(req.altitude_m, against=chk.limit.value_si)} exceeds "
+                    f"{chk.limit.describe()}",
                 )
             )
     if cat.vlos_required and not op.bvlos:
         notes.append(
             f"{req.jurisdiction}/{category}: VLOS required ({cat.source}); "
-            f"{op.max_distance_m:g} m from the pilot, within the {op.vlos_distance_m:g} m kept in sight"
+            f"{metres(op.max_distance_m, against=op.vlos_distance_m)} from the pilot, within the "
+            f"{metres(op.vlos_distance_m)} kept in sight"
         )
     # eq. 60 at the planned height, or at the highest height the regulations allow (the
     # thesis' rule, §5.2.3.4; the required altitude when the category sets no limit)
@@ -693,6 +718,17 @@ def _evaluate(op, members, req, mission, mx, regs, u, c, targets, weights) -> _B
         uas_tests(u, req, max_mtom) + equipment_tests(u, req, equipment), "uas", u.label, u.ids, members
     )
     rejections += rej
+    if req.mosaic:
+        # UAS kept out of a survey by its pattern alone: said once, beside the ranking
+        failed: dict[str, set[str]] = {}
+        for r in rej:
+            failed.setdefault(r.item, set()).add(r.test)
+        only = [u.label(k) for k, uid in enumerate(u.ids) if failed.get(uid) == {"survey-pattern"}]
+        if only:
+            notes.append(
+                f"survey: {', '.join(only)} would qualify but cannot hover; the survey's lines are a "
+                "rotorcraft pattern (stop and turn at each line's end), so they are not ranked for it"
+            )
     cam_ok, rej = _reject(camera_tests(c, req, h_cam), "camera", c.label, c.ids)
     rejections += rej
     pair_ok = uas_ok[:, None] & cam_ok[None, :] & mission_ok

@@ -18,6 +18,7 @@ from typing import Any
 from uasnav.atomicfile import atomic_write_text
 from uasnav.errors import InputError
 from uasnav.jsonable import to_jsonable
+from uasnav.mission.readable import metres
 from uasnav.mission.selection import Selection
 
 SUMMARY_VERSION = "2"  # 2: authorisation verdict, flight window, withheld configurations
@@ -140,8 +141,8 @@ def summary_fragment(sel: Selection) -> str:
     parts.append("<h3>Operation and category</h3>")
     if op:
         parts.append(
-            f"<p><b>{e(op['visibility'])}</b>, {op['max_distance_m']:g} m from the pilot, "
-            f"{op['height_m']:g} m AGL, {e(op['environment'])} ({e(op['population'])}), "
+            f"<p><b>{e(op['visibility'])}</b>, {metres(op['max_distance_m'])} from the pilot, "
+            f"{metres(op['height_m'])} AGL, {e(op['environment'])} ({e(op['population'])}), "
             f"over people: {e(op['over_people'])}, {'night' if op['night'] else 'day'}, "
             f"airspace {e(op['airspace'])}.</p>"
         )
@@ -281,6 +282,16 @@ def _ground_rows(g: dict[str, Any] | None) -> list[list[str]]:
             f"{g['geoid_height_m']:.2f} m, {g['geoid']}: ground {g['ellipsoidal_height_m']:.1f} m "
             "above the ellipsoid",
         ],
+        *(
+            [
+                [
+                    "Ground heights over the area",
+                    f"span {g['spread_m']:.1f} m (heights above the take-off point)",
+                ]
+            ]
+            if "spread_m" in g
+            else []
+        ),
     ]
 
 

@@ -86,14 +86,20 @@ class ZoneCheck:
         return {"source": self.source, "n_zones": self.n_zones, "hits": [h.to_dict() for h in self.hits]}
 
 
-def _geom(g: Any, path: str, buffer_m: float) -> list[Any]:
+def _geom(g: Any, path: str, buffer_m: float, heights: list[tuple[float, float, float]]) -> list[Any]:
+    """The parts of GeoJSON object ``g``; each position's third coordinate (a height) is added
+    to ``heights`` as (lon, lat, h)."""
     g = jc.obj(g, path)
     t = jc.string(jc.field(g, "type", path), jc.at(path, "type"))
     if t == "FeatureCollection":
         feats = jc.array(jc.field(g, "features", path), jc.at(path, "features"), max_len=10_000)
-        return [x for i, f in enumerate(feats) for x in _geom(f, jc.at(jc.at(path, "features"), i), buffer_m)]
+        return [
+            x
+            for i, f in enumerate(feats)
+            for x in _geom(f, jc.at(jc.at(path, "features"), i), buffer_m, heights)
+        ]
     if t == "Feature":
-        return _geom(jc.field(g, "geometry", path), jc.at(path, "geometry"), buffer_m)
+        return _geom(jc.field(g, "geometry", path), jc.at(path, "geometry"), buffer_m, heights)
     coords = jc.field(g, "coordinates", path)
     cpath = jc.at(path, "coordinates")
 
@@ -105,6 +111,8 @@ def _geom(g: Any, path: str, buffer_m: float) -> list[Any]:
             if x.size < 2 or not (-180 <= x[0] <= 180 and -90 <= x[1] <= 90):
                 raise jc.fail(jc.at(p, i), "expected a WGS84 [lon, lat] in degrees")
             out.append((float(x[0]), float(x[1])))
+            if x.size == 3:
+                heights.append((float(x[0]), float(x[1]), float(x[2])))
         return out
 
     def ring(seq: Any, p: str) -> list[tuple[float, float]]:
@@ -155,9 +163,12 @@ class MissionArea:
     #: For a plan's footprint: each positioned item's altitude as (altitude m, frame — an
     #: :class:`~uasnav.io.mission_plan.AltitudeFrame` value —, item index); empty otherwise.
     plan_altitudes: tuple[tuple[float, str, int], ...] = ()
-    #: For a plan's footprint: the plan's home position (lat, lon deg, altitude m AMSL) when the
-    #: plan gives its altitude; None otherwise.
+    #: For a plan's footprint: the plan's home position (lat, lon deg, altitude m AMSL; NaN when
+    #: the plan gives no altitude); None otherwise.
     home: tuple[float, float, float] | None = None
+    #: For a GeoJSON area: the positions that carry a third coordinate, as (lon, lat deg, height
+    #: m above the WGS-84 ellipsoid, RFC 7946 §4); empty otherwise.
+    heights: tuple[tuple[float, float, float], ...] = ()
 
     def centre(self) -> tuple[float, float]:
         """(lon, lat) deg: mean of every vertex (the projection origin)."""
@@ -192,23 +203,30 @@ def _enu(pts: list[tuple[float, float]], lon0: float, lat0: float) -> list[tuple
     return list(zip(np.atleast_1d(e).tolist(), np.atleast_1d(n).tolist(), strict=True))
 
 
+def _area_text(data: bytes, where: str, *, limit: int = MAX_BYTES, what: str = "area file") -> str:
+    """An area document's bytes as text: at most ``limit`` bytes of UTF-8 (a BOM dropped), else
+    one error naming ``where``."""
+    if len(data) > limit:
+        raise DataFormatError(f"{what} larger than {limit} bytes", path=where)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise DataFormatError("not a UTF-8 text file", path=where) from None
+
+
 def parse_area(data: bytes | str | dict, where: str = "area", *, buffer_m: float = 0.0) -> MissionArea:
     """The mission area from GeoJSON (bytes, text or a parsed object); see the module doc."""
     if not math.isfinite(buffer_m) or buffer_m < 0:
         raise InputError(f"area buffer {buffer_m} m: must be finite and >= 0")
     if isinstance(data, bytes):
-        if len(data) > MAX_BYTES:
-            raise DataFormatError(f"area file larger than {MAX_BYTES} bytes", path=where)
-        try:
-            data = data.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise DataFormatError("not a UTF-8 text file", path=where) from None
+        data = _area_text(data, where)
+    heights: list[tuple[float, float, float]] = []
     with jc.reraise_in(where):
         doc = jc.parse(data, "not a GeoJSON area (not valid JSON)") if isinstance(data, str) else data
-        parts = _geom(doc, "area", buffer_m)
+        parts = _geom(doc, "area", buffer_m, heights)
         if not parts:
             raise jc.fail("area", "no geometry")
-    return MissionArea(tuple(parts), float(buffer_m), where)
+    return MissionArea(tuple(parts), float(buffer_m), where, heights=tuple(heights))
 
 
 def area_from_plan(plan: MissionPlan, where: str = "plan", *, buffer_m: float) -> MissionArea:
@@ -239,7 +257,7 @@ def area_from_plan(plan: MissionPlan, where: str = "plan", *, buffer_m: float) -
     h = plan.home
     home = (
         (float(h.lat_deg), float(h.lon_deg), float(h.alt_amsl_m))
-        if h is not None and all(math.isfinite(x) for x in (h.lat_deg, h.lon_deg, h.alt_amsl_m))
+        if h is not None and all(math.isfinite(x) for x in (h.lat_deg, h.lon_deg))
         else None
     )
     return MissionArea((part,), float(buffer_m), where, alts, home)
@@ -311,12 +329,7 @@ def parse_area_document(data: bytes | str | dict, where: str = "area", *, buffer
 
         text = json.dumps(data)
     elif isinstance(data, bytes):
-        if len(data) > MAX_PLAN_BYTES:
-            raise DataFormatError(f"plan larger than {MAX_PLAN_BYTES} bytes", path=where)
-        try:
-            text = data.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise DataFormatError("not a UTF-8 text file", path=where) from None
+        text = _area_text(data, where, limit=MAX_PLAN_BYTES, what="plan")
     else:
         text = data
     return area_from_plan(parser(text, where), where, buffer_m=buffer_m)
@@ -473,16 +486,15 @@ __all__ = [
 def kml_area_geojson(data: bytes | str, where: str = "area.kml") -> dict[str, Any]:
     """A KML area (its ``Polygon`` placemarks; else a ``LineString`` or ``Point``) as the GeoJSON
     object :func:`parse_area` reads. Parsed by the hardened KML reader of
-    :mod:`uasnav.io.plan_formats.kml` (no DTD, no entities, no network)."""
+    :mod:`uasnav.io.plan_formats.kml` (no DTD, no entities, no network).
+
+    KML altitudes are dropped, so they never give the ground elevation: under KML's default
+    ``altitudeMode`` (``clampToGround``) they are ignored by definition, and the other modes
+    give heights above the terrain or above sea level of the drawn shape, not of the ground."""
     from uasnav.io.plan_formats import kml
 
     if isinstance(data, bytes):
-        if len(data) > MAX_BYTES:
-            raise DataFormatError(f"area file larger than {MAX_BYTES} bytes", path=where)
-        try:
-            data = data.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise DataFormatError("not a UTF-8 text file", path=where) from None
+        data = _area_text(data, where)
     root = kml._parse(data, where)
     geoms: list[dict[str, Any]] = []
     for poly in kml._find(root, "Polygon"):

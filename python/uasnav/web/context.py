@@ -185,7 +185,7 @@ def plain(text: Any) -> str:
 
 
 #: Where the pilot distance comes from when an area was uploaded and no distance typed.
-AREA_DISTANCE_WORDS = "the area's farthest point from the pilot position"
+AREA_DISTANCE_WORDS = select_request.AREA_DISTANCE_WORDS
 
 
 def in_operator_words(selection: Any, typed: Mapping[str, Any]) -> Any:
