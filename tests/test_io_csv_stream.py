@@ -18,7 +18,7 @@ from uasnav.errors import DataFormatError, InputError, ResourceLimitError
 from uasnav.imu import ImuLog
 from uasnav.io import _csvstream, read_log
 from uasnav.io._text import read_text
-from uasnav.io.csv_v1 import open_csv_v1, parse_csv_v1, read_csv_v1, write_csv_v1
+from uasnav.io.formats.csv_v1 import open_csv_v1, parse_csv_v1, read_csv_v1, write_csv_v1
 from uasnav.thermal import load_training_data
 from uasnav.thermal._common import check_training_temp
 from uasnav.thermal.binning import TimeBlockMeans, bin_by_time

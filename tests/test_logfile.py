@@ -269,7 +269,7 @@ def test_open_log_by_url(shared_data: Path, tmp_path: Path) -> None:
 
 
 def test_a_gnss_csv_replaces_the_logs_fixes(shared_data: Path, tmp_path: Path) -> None:
-    from uasnav.io.gnss_csv import write_gnss_csv
+    from uasnav.io.formats.gnss_csv import write_gnss_csv
 
     p = shared_data / "flights" / "px4_s500_mission_land.ulg"
     own = open_log(p).gnss
@@ -283,8 +283,7 @@ def test_a_gnss_csv_replaces_the_logs_fixes(shared_data: Path, tmp_path: Path) -
 
 def test_format_classes_state_their_interface() -> None:
     from uasnav.io.formats.alfa import AlfaFormat
-    from uasnav.io.formats.base import LogFormat, WholeFileFormat
-    from uasnav.io.formats.csvlog import ImuFileFormat
+    from uasnav.io.formats.base import ImuFileFormat, LogFormat, WholeFileFormat
     from uasnav.io.logfile import _CSV, BY_EXTENSION
 
     with pytest.raises(TypeError, match="abstract"):
