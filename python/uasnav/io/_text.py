@@ -194,30 +194,21 @@ def show_cell(cell: str, limit: int = 40) -> str:
     return repr(cell) if len(cell) <= limit else f"{cell[:limit]!r}… ({len(cell)} characters)"
 
 
-def finite_cell(cell: str, *, path: str, line: int, column: str) -> float:
+def finite_cell(cell: str, *, path: str, line: int, column: str, nan_ok: bool = False) -> float:
     """One CSV cell as a finite float, else :class:`DataFormatError` naming file, line, column
-    and the cell as written (the one cell rule of every CSV reader)."""
+    and the cell as written (the one cell rule of every CSV reader). ``nan_ok``: NaN is a
+    missing value of a numeric table, only ±inf is refused."""
     try:
         v = float(cell)
     except ValueError:
         raise DataFormatError(
             f"not a number: {show_cell(cell)}", path=path, line=line, column=column
         ) from None
-    if not math.isfinite(v):
+    if nan_ok:
+        if math.isinf(v):
+            raise DataFormatError(f"infinite value {show_cell(cell)}", path=path, line=line, column=column)
+    elif not math.isfinite(v):
         raise DataFormatError(f"non-finite value {show_cell(cell)}", path=path, line=line, column=column)
-    return v
-
-
-def table_cell(cell: str, *, path: str, line: int, column: str) -> float:
-    """One cell of a numeric table: a number or NaN (a missing value), not ±inf."""
-    try:
-        v = float(cell)
-    except ValueError:
-        raise DataFormatError(
-            f"not a number: {show_cell(cell)}", path=path, line=line, column=column
-        ) from None
-    if math.isinf(v):
-        raise DataFormatError(f"infinite value {show_cell(cell)}", path=path, line=line, column=column)
     return v
 
 
@@ -240,12 +231,11 @@ def numeric_rows(
     otherwise only a row too short for a wanted column is refused. Fewer than ``min_rows`` rows
     is an error (a log or a track needs at least two samples). ``lines[0]`` is file line
     ``offset + 1`` (a chunk of a file). ``nan_ok`` accepts NaN (a missing value of a numeric
-    table, :func:`table_cell`) and refuses only ±inf."""
+    table, :func:`finite_cell`) and refuses only ±inf."""
     idx = [header.index(c) for c in columns]
     fast = _numeric_rows_fast(lines, header_line, len(header), idx, exact_width, nan_ok)
     if fast is not None:
         return fast[0], [offset + ln for ln in fast[1]]
-    cell_rule = table_cell if nan_ok else finite_cell
     rows: list[list[float]] = []
     row_lines: list[int] = []
     for line, row in csv_rows(lines, header_line, source, header, offset=offset):
@@ -255,7 +245,7 @@ def numeric_rows(
         for c, j in zip(columns, idx, strict=True):
             if j >= len(row):
                 raise DataFormatError(f"missing cell (row has {len(row)})", path=source, line=line, column=c)
-            vals.append(cell_rule(row[j].strip(), path=source, line=line, column=c))
+            vals.append(finite_cell(row[j].strip(), path=source, line=line, column=c, nan_ok=nan_ok))
         rows.append(vals)
         row_lines.append(line)
     if len(rows) < min_rows:
@@ -353,5 +343,4 @@ __all__ = [
     "read_text",
     "show_cell",
     "split_lines",
-    "table_cell",
 ]
