@@ -295,7 +295,7 @@ def loadtxt_rows(
 
 
 def _numeric_rows_fast(
-    lines: list[str], start: int, width: int, idx: Sequence[int], exact_width: bool, nan_ok: bool
+    lines: list[str], start: int, width: int, idx: Sequence[int], exact_width: bool, nan_ok: bool = False
 ) -> tuple[NDArray[np.float64], list[int]] | None:
     """:func:`numeric_rows` in one vectorised pass (:func:`loadtxt_rows`), or ``None``."""
     body = lines[start:]
