@@ -98,8 +98,8 @@ def bench_io(n: int, repeat: int) -> None:
 
 
 def bench_csv_pyarrow(seconds: float, repeat: int) -> None:
-    """CSV log format v1 against the library it reads through: ``read_log`` (chunks of
-    ``pyarrow.csv.read_csv``, every cell checked, t strictly increasing, an ImuLog built) and
+    """CSV log format v1 against ``pyarrow.csv.read_csv``: ``read_log`` (chunks through numpy's
+    C reader, every cell checked, t strictly increasing, an ImuLog built) and
     ``load_training_data`` (calibration block means while reading) against
     ``pyarrow.csv.read_csv`` of the same file (all columns, types inferred), one process."""
     import os

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 
 from uasnav.cli import main
 from uasnav.imu import ImuLog
-from uasnav.io.csv_v1 import write_csv_v1
+from uasnav.io.formats.csv_v1 import write_csv_v1
 from uasnav.thermal import PolynomialBiasModel
 
 

@@ -22,7 +22,7 @@ from click.testing import CliRunner
 
 from uasnav.cli import main
 from uasnav.imu import ImuLog
-from uasnav.io.csv_v1 import write_csv_v1
+from uasnav.io.formats.csv_v1 import write_csv_v1
 from uasnav.trajectory.baselines import MIN_ELEMENTS_PER_CLASS, class_method_reason
 
 TLOG = (

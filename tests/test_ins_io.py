@@ -16,7 +16,7 @@ from uasnav.cli import main
 from uasnav.errors import DataFormatError, InputError
 from uasnav.ins import evaluate as ev
 from uasnav.io import read_nav
-from uasnav.io.gnss_csv import GNSS_COLUMNS, read_gnss_csv, write_gnss_csv
+from uasnav.io.formats.gnss_csv import GNSS_COLUMNS, read_gnss_csv, write_gnss_csv
 from uasnav.sim.flight import simulate_flight
 
 

@@ -8,7 +8,7 @@ import pytest
 from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
 from uasnav.io import read_log, write_csv_v1
-from uasnav.io.csv_v1 import parse_csv_v1
+from uasnav.io.formats.csv_v1 import parse_csv_v1
 
 
 def _log(n=50, temp=True, truth=True):

@@ -1,10 +1,14 @@
-"""Log format v1 read in chunks through pyarrow (``uasnav.io._csvstream``, ``read_csv_v1``):
-the same values bit for bit and the same errors (message, line, column) as the whole-text
-row-by-row reader, whatever the chunk size; memory refused early and realistically; the
-calibration's block means computed while reading equal the in-memory ones."""
+"""The CSV engine (``uasnav.io._csvstream``): log format v1 and every other numeric CSV read in
+chunks through numpy's C reader give the same values bit for bit and the same errors (message,
+line, column) as the whole-text row-by-row reader, whatever the chunk size; memory is refused
+early and realistically; the calibration's block means computed while reading equal the
+in-memory ones; every base-install reader works with pyarrow unimportable."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -16,9 +20,9 @@ from hypothesis import strategies as st
 from uasnav.cli import main
 from uasnav.errors import DataFormatError, InputError, ResourceLimitError
 from uasnav.imu import ImuLog
-from uasnav.io import _csvstream, read_log
+from uasnav.io import _csvstream, _text, read_log
 from uasnav.io._text import read_text
-from uasnav.io.csv_v1 import open_csv_v1, parse_csv_v1, read_csv_v1, write_csv_v1
+from uasnav.io.formats.csv_v1 import open_csv_v1, parse_csv_v1, read_csv_v1, write_csv_v1
 from uasnav.thermal import load_training_data
 from uasnav.thermal._common import check_training_temp
 from uasnav.thermal.binning import TimeBlockMeans, bin_by_time
@@ -218,3 +222,184 @@ def test_calibrate_a_log_larger_than_the_memory_limit_allows_reading(tmp_path: P
     r = CliRunner().invoke(main, ["calibrate", str(p), "--method", "poly", "--out", str(out), "--json"])
     assert r.exit_code == 0, r.output
     assert out.is_file() and '"n_samples": 400' in r.output
+
+
+def _select_all(header: list[str], header_line: int) -> list[str]:
+    return header
+
+
+def _select_two(header: list[str], header_line: int) -> list[str]:
+    if "b" not in header:
+        raise DataFormatError("no column b", path="x", line=header_line)
+    return ["c", "a"] if "c" in header else ["a"]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.lists(cells, min_size=3, max_size=3), min_size=0, max_size=40),
+    st.sampled_from(["\n", "\r\n"]),
+    st.integers(40, 300),
+    st.booleans(),
+    st.booleans(),
+    st.sampled_from(["", "quote", "nul", "latin1", "short", "long", "blank", "inf", "nan"]),
+)
+def test_any_table_in_chunks_equals_the_whole_text_reader(
+    tmp_path_factory, rows, nl, chunk, exact, nan_ok, hostile
+) -> None:
+    """read_table (the numeric tables, GNSS, x-io and flight CSVs) against the row-by-row
+    reader of the whole text (csv and float, no numpy), for every option of the engine."""
+    lines = ["# unit: m", "a,b,c"]
+    lines += [",".join(r) for r in rows]
+    if rows:
+        at = 2 + len(rows) // 2
+        lines[at] = {
+            "quote": lines[at].replace(",", ',"', 1),
+            "nul": lines[at] + "\x00",
+            "short": lines[at].rsplit(",", 1)[0],
+            "long": lines[at] + ",1",
+            "blank": "  ",
+            "inf": "inf" + lines[at][lines[at].index(",") :],
+            "nan": "nan" + lines[at][lines[at].index(",") :],
+            "latin1": lines[at] + "é",
+        }.get(hostile, lines[at])
+    raw = (nl.join(lines) + nl).encode("utf-8")
+    if hostile == "latin1":
+        raw = raw.replace("é".encode(), b"\xe9", 1)
+    path = tmp_path_factory.mktemp("t") / "t.csv"
+    path.write_bytes(raw)
+    for select in (_select_all, _select_two):
+        kw = {"what": "table", "exact_width": exact, "nan_ok": nan_ok, "min_rows": 2 if exact else 0}
+        try:
+            with pytest.MonkeyPatch.context() as slow:  # the reference: every row by csv and float
+                slow.setattr(_text, "_numeric_rows_fast", lambda *a: None)
+                want = _csvstream._read_whole(str(path), select, "empty", exact, nan_ok, kw["min_rows"])
+        except DataFormatError as e:
+            mp = pytest.MonkeyPatch()
+            mp.setattr(_csvstream, "chunk_bytes", lambda: chunk)
+            try:
+                with pytest.raises(DataFormatError) as got:
+                    _csvstream.read_table(path, select, **kw)
+            finally:
+                mp.undo()
+            assert (str(got.value), got.value.line, got.value.column) == (str(e), e.line, e.column)
+            continue
+        mp = pytest.MonkeyPatch()
+        mp.setattr(_csvstream, "chunk_bytes", lambda: chunk)
+        try:
+            got = _csvstream.read_table(path, select, **kw)
+        finally:
+            mp.undo()
+        assert got.columns.keys() == want.columns.keys()
+        assert all(got.columns[c].tobytes() == want.columns[c].tobytes() for c in want.columns)
+        assert (got.header, got.header_line, got.comments) == (want.header, want.header_line, want.comments)
+        for r in range(got.rows):
+            assert got.row_line(r) == want.row_line(r)
+
+
+def test_clean_tables_never_go_row_by_row(tmp_path: Path, small_chunks: None, monkeypatch) -> None:
+    """The GNSS, x-io, flight and numeric-table readers parse clean files in numpy alone, NaN
+    of a numeric table included."""
+    from uasnav.io import read_csv_table, write_csv_table
+    from uasnav.io.formats.flight_csv import read_flight_csv
+    from uasnav.io.formats.gnss_csv import read_gnss_csv, write_gnss_csv
+    from uasnav.io.formats.xio import read_xio_csv
+    from uasnav.sim.flight import simulate_flight
+
+    def refuse(*a, **k):
+        raise AssertionError("row-by-row reader used on a clean chunk")
+
+    n = 2000
+    x = np.linspace(0.0, 1.0, n)
+    x[5] = np.nan
+    write_csv_table(tmp_path / "t.csv", {"t": np.arange(n) * 0.1, "x": x}, comments={"unit": "m"})
+    f = simulate_flight(duration_s=60.0, seed=1)
+    write_gnss_csv(tmp_path / "g.csv", f.gnss)
+    head = "Time (s),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
+    head += "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)"
+    rows = "\n".join(f"{0.01 * k!r},0.1,0.2,0.3,0,0,1" for k in range(n))
+    (tmp_path / "x.csv").write_text(head + "\n" + rows + "\n")
+    track = "\n".join(f"{k},{45 + k * 1e-6!r},7.5,100,1,0,0" for k in range(n))
+    (tmp_path / "f.csv").write_text("t,lat,lon,alt,v_N,v_E,v_D\n" + track + "\n")
+    monkeypatch.setattr(_csvstream.NumericCsv, "_row_by_row", refuse)
+    cols, notes = read_csv_table(tmp_path / "t.csv")
+    assert np.isnan(cols["x"][5]) and cols["x"][6] == x[6] and notes == {"unit": "m"}
+    assert read_gnss_csv(tmp_path / "g.csv").t.tobytes() == f.gnss.t.tobytes()
+    assert read_xio_csv(tmp_path / "x.csv").n == n
+    assert read_flight_csv(tmp_path / "f.csv").t.size == n
+
+
+def test_table_errors_name_the_row_of_a_chunked_file(tmp_path: Path, small_chunks: None) -> None:
+    """A value error found after reading (time, range) names the file line of its row, found
+    again in the chunk that holds it."""
+    from uasnav.io.formats.flight_csv import read_flight_csv
+    from uasnav.io.formats.xio import read_xio_csv
+
+    n = 3000
+    track = [f"{k},{45 + k * 1e-6!r},7.5,100,1,0,0" for k in range(n)]
+    track[2500] = "2500,95.5,7.5,100,1,0,0"
+    (tmp_path / "f.csv").write_text("# flight\nt,lat,lon,alt,v_N,v_E,v_D\n" + "\n".join(track) + "\n")
+    with pytest.raises(DataFormatError) as e:
+        read_flight_csv(tmp_path / "f.csv")
+    assert (e.value.line, e.value.column) == (2503, "lat") and "95.5 is outside [-90, 90]" in str(e.value)
+    head = "Time (s),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),"
+    head += "Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)"
+    rows = [f"{0.01 * k!r},0.1,0.2,0.3,0,0,1" for k in range(n)]
+    rows[2000] = "0.5,0.1,0.2,0.3,0,0,1"
+    (tmp_path / "x.csv").write_text(head + "\n" + "\n".join(rows) + "\n")
+    with pytest.raises(DataFormatError) as e:
+        read_xio_csv(tmp_path / "x.csv")
+    assert (e.value.line, e.value.column) == (2002, "Time (s)")
+
+
+def test_every_base_reader_works_without_pyarrow(tmp_path: Path) -> None:
+    """pyarrow unimportable (as in a base install): CSV v1 (whole, streamed, calibration block
+    means), numeric tables, GNSS, x-io and flight CSVs and npz read, with their own errors, and
+    nothing imports pyarrow on the way."""
+    script = textwrap.dedent(
+        f"""
+        import sys
+        sys.modules["pyarrow"] = None  # any import of pyarrow now fails
+        from pathlib import Path
+        import numpy as np
+        from uasnav import sim
+        from uasnav.errors import DataFormatError
+        from uasnav.io import (open_log, read_csv_table, read_flight, read_log, read_nav,
+            write_csv_table, write_log)
+        from uasnav.io.formats.gnss_csv import read_gnss_csv, write_gnss_csv
+        from uasnav.sim.flight import simulate_flight
+        from uasnav.thermal import load_training_data
+        d = Path({str(tmp_path)!r})
+        log = sim.simulate("ax1", profile="ramp", duration=120.0, rate=50.0, seed=1)
+        write_log(log, d / "imu.csv"); write_log(log, d / "imu.npz")
+        assert read_log(d / "imu.csv").gyro.tobytes() == log.gyro.tobytes()
+        assert read_log(d / "imu.npz").gyro.tobytes() == log.gyro.tobytes()
+        with open_log(d / "imu.csv").format.stream() as s:
+            assert sum(b.shape[0] for b in s.blocks()) == log.n
+        assert load_training_data(d / "imu.csv", 1.0) is not None
+        write_csv_table(d / "t.csv", {{"t": [0.0, 1.0], "x": [1.5, float("nan")]}})
+        cols, _ = read_csv_table(d / "t.csv")
+        assert np.isnan(cols["x"][1])
+        f = simulate_flight(duration_s=30.0, seed=2)
+        write_gnss_csv(d / "g.csv", f.gnss)
+        assert read_gnss_csv(d / "g.csv").n == f.gnss.n
+        assert read_nav(d / "imu.csv", gnss_csv=d / "g.csv").gnss.n == f.gnss.n
+        (d / "x.csv").write_text("Time (s),Gyroscope X (deg/s),Gyroscope Y (deg/s),"
+            "Gyroscope Z (deg/s),Accelerometer X (g),Accelerometer Y (g),Accelerometer Z (g)\\n"
+            "0,1,2,3,0,0,1\\n0.01,1,2,3,0,0,1\\n")
+        assert read_log(d / "x.csv").n == 2
+        (d / "f.csv").write_text("t,lat,lon,alt,v_N,v_E,v_D\\n0,45,7,100,1,0,0\\n1,45.00001,7,100,1,0,0\\n")
+        assert read_flight(d / "f.csv").t.size == 2
+        (d / "bad.csv").write_text("t,gx,gy,gz,ax,ay,az\\n0,1,2,3,4,5,6\\n1,1,x,3,4,5,6\\n")
+        try:
+            read_log(d / "bad.csv")
+        except DataFormatError as e:
+            assert (e.line, e.column) == (3, "gy"), (e.line, e.column)
+        else:
+            raise AssertionError("no error")
+        assert sys.modules["pyarrow"] is None
+        assert not [m for m in sys.modules if m.startswith("pyarrow.")]
+        print("ok")
+        """
+    )
+    r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr[-3000:]

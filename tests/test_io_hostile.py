@@ -44,9 +44,9 @@ from uasnav.io import (
 )
 from uasnav.io._common import longest_nondecreasing
 from uasnav.io._quiet import library_output_captured
-from uasnav.io.csv_v1 import parse_csv_v1
 from uasnav.io.flight import Flight
-from uasnav.io.xio import read_xio_csv
+from uasnav.io.formats.csv_v1 import parse_csv_v1
+from uasnav.io.formats.xio import read_xio_csv
 
 V1_HEAD = "t,gx,gy,gz,ax,ay,az"
 XIO_HEAD = (

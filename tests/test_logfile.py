@@ -44,6 +44,25 @@ def parses(monkeypatch: pytest.MonkeyPatch) -> collections.Counter[str]:
 
     monkeypatch.setattr(pyulog, "ULog", CountingULog)
     monkeypatch.setattr(mavutil, "mavlink_connection", counting_conn)
+    # text logs: every numeric CSV is read by the CSV engine (NumericCsv.open), or as a whole
+    # text when its header lies beyond the first chunk (read_text)
+    from uasnav.io import _csvstream, _text
+
+    real_open = _csvstream.NumericCsv.open.__func__  # type: ignore[attr-defined]
+
+    def counting_open(cls: Any, path: Any) -> Any:
+        counts[Path(str(path)).name] += 1
+        return real_open(cls, path)
+
+    real_text = _text.read_text
+
+    def counting_text(path: Any) -> str:
+        counts[Path(str(path)).name] += 1
+        return real_text(path)
+
+    monkeypatch.setattr(_csvstream.NumericCsv, "open", classmethod(counting_open))
+    monkeypatch.setattr(_text, "read_text", counting_text)
+    monkeypatch.setattr(_csvstream, "read_text", counting_text)
     return counts
 
 
@@ -61,17 +80,47 @@ def _run(args: list[str]) -> Any:
         ["nav", "{ulg}", "--json"],
         ["nav", "{tlog}", "--json"],
         ["trajectory", "evaluate", "{tlog}", "--json"],
+        ["nav", "{bin}", "--json", "--end", "60"],
+        ["allan", "{bin}", "--json"],
+        ["calibrate", "{ulg}", "--method", "poly", "--out", "{tmp}/m.json"],
+        ["replay", "{ulg}", "--to", "udp:127.0.0.1:9", "--speed", "1000", "--stop-after", "5"],
+        ["allan", "{csv}", "--json"],
+        ["zupt", "{csv}", "--json"],
+        ["calibrate", "{csv}", "--method", "poly", "--out", "{tmp}/m.json"],
+        ["calibrate", "--model", "{tmp}/m.json", "--test", "{csv}", "--json"],
+        ["nav", "{csv}", "--gnss", "{gnss}", "--json"],
+        ["allan", "{xio}", "--json"],
     ],
 )
 def test_each_command_decodes_a_log_once(
-    shared_data: Path, parses: collections.Counter[str], args: list[str]
+    shared_data: Path, parses: collections.Counter[str], args: list[str], tmp_path: Path
 ) -> None:
+    from uasnav import sim
+    from uasnav.io import write_log
+    from uasnav.io.formats.gnss_csv import write_gnss_csv
+    from uasnav.sim.flight import imu_log_with_truth, simulate_flight
+
     ulg = shared_data / "logs" / "px4_sample_log_small.ulg"
     tlog = shared_data / "flights" / "phoenix_mission1_arducopter.tlog"
-    argv = [a.format(ulg=ulg, tlog=tlog) for a in args]
+    binlog = shared_data / "logs" / "ardupilot_log171.bin"
+    xio = shared_data / "imu" / "xio_fusion_sensor_data.csv"
+    csv, gnss = tmp_path / "imu.csv", tmp_path / "imu_gnss.csv"
+    if "{gnss}" in args:
+        f = simulate_flight(duration_s=60.0, seed=3)
+        write_log(imu_log_with_truth(f), csv)
+        write_gnss_csv(gnss, f.gnss)
+    else:
+        log = sim.simulate("ax1", profile="cycles", duration=300.0, rate=20.0, seed=1)
+        write_log(log, csv)
+        if "--model" in args:
+            _run(["calibrate", str(csv), "--method", "poly", "--out", str(tmp_path / "m.json")])
+    argv = [a.format(ulg=ulg, tlog=tlog, bin=binlog, csv=csv, gnss=gnss, xio=xio, tmp=tmp_path) for a in args]
+    parses.clear()
     CliRunner().invoke(main, argv)  # the count matters, not the outcome on this sample
-    name = Path(argv[1] if argv[0] != "trajectory" else argv[2]).name
+    name = Path(next(a for a in argv[1:] if a.startswith("/") and not a.endswith("m.json"))).name
     assert parses[name] == 1, dict(parses)
+    if "{gnss}" in args:
+        assert parses[gnss.name] == 1, dict(parses)
 
 
 def test_train_intent_and_fleet_decode_a_log_once(
@@ -269,7 +318,7 @@ def test_open_log_by_url(shared_data: Path, tmp_path: Path) -> None:
 
 
 def test_a_gnss_csv_replaces_the_logs_fixes(shared_data: Path, tmp_path: Path) -> None:
-    from uasnav.io.gnss_csv import write_gnss_csv
+    from uasnav.io.formats.gnss_csv import write_gnss_csv
 
     p = shared_data / "flights" / "px4_s500_mission_land.ulg"
     own = open_log(p).gnss
@@ -283,8 +332,7 @@ def test_a_gnss_csv_replaces_the_logs_fixes(shared_data: Path, tmp_path: Path) -
 
 def test_format_classes_state_their_interface() -> None:
     from uasnav.io.formats.alfa import AlfaFormat
-    from uasnav.io.formats.base import LogFormat, WholeFileFormat
-    from uasnav.io.formats.csvlog import ImuFileFormat
+    from uasnav.io.formats.base import ImuFileFormat, LogFormat, WholeFileFormat
     from uasnav.io.logfile import _CSV, BY_EXTENSION
 
     with pytest.raises(TypeError, match="abstract"):

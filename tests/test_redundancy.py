@@ -14,7 +14,7 @@ from uasnav import redundancy as R
 from uasnav.cli import main
 from uasnav.errors import InputError
 from uasnav.experiments import redundancy as X
-from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
+from uasnav.io.formats.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.sim import array_mountings, inject_fault, load_preset, simulate_array
 
 DEG = math.pi / 180

@@ -376,7 +376,7 @@ def test_bin_means_by_temperature_and_by_time() -> None:
 def test_workflow_fit_and_evaluate(tmp_path, data) -> None:
     """The ``uasnav calibrate`` pipeline as library calls: load, fit, evaluate."""
     from uasnav.imu import ImuLog
-    from uasnav.io.csv_v1 import write_csv_v1
+    from uasnav.io.formats.csv_v1 import write_csv_v1
     from uasnav.thermal import evaluate_model, fit_polynomial, load_training_data
 
     t, b = data

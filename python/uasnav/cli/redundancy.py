@@ -110,7 +110,7 @@ def fuse_command(
     possible are left out and counted.
     """
     from uasnav.errors import NumericalError
-    from uasnav.io.csv_v1 import write_csv_v1
+    from uasnav.io.formats.csv_v1 import write_csv_v1
     from uasnav.redundancy import fuse_files
 
     check_outputs(logs, {"--out": out_path})

@@ -174,7 +174,7 @@ def _simulate_flight(
 
     from uasnav.atomicfile import output_set
     from uasnav.io import write_log
-    from uasnav.io.gnss_csv import write_gnss_csv
+    from uasnav.io.formats.gnss_csv import write_gnss_csv
     from uasnav.sim import load_preset
     from uasnav.sim.flight import imu_log_with_truth, simulate_flight
 

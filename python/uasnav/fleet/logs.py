@@ -63,8 +63,8 @@ class FleetLog:
 
 def csv_kind(path: str) -> str:
     """``csv-v1``, ``xio-csv`` or ``flight-csv`` from the header
-    (:func:`uasnav.io.formats.csvlog.csv_kind`)."""
-    from uasnav.io.formats.csvlog import csv_kind as kind
+    (:func:`uasnav.io.logfile.csv_kind`)."""
+    from uasnav.io.logfile import csv_kind as kind
 
     return kind(path)
 

@@ -85,7 +85,7 @@ def scan_log(path: str) -> LogRows:
             waypoints = len(fl.waypoints)
             duration = max(duration, float(fl.t[-1] - fl.t[0]) if fl.t.size else 0.0)
     elif log.format == "csv-v1" and (companion := gnss_companion(path)) is not None:
-        from uasnav.io.gnss_csv import read_gnss_csv
+        from uasnav.io.formats.gnss_csv import read_gnss_csv
 
         gnss = read_gnss_csv(companion).n > 0
     row = {

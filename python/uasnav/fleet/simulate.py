@@ -157,7 +157,7 @@ def _nav_flight(
 ) -> None:  # fmt: skip
     """Write one GNSS/INS flight: ``name``.csv, ``name``_gnss.csv and ``name``.tlog (module docs)."""
     from uasnav.io import write_csv_v1
-    from uasnav.io.gnss_csv import write_gnss_csv
+    from uasnav.io.formats.gnss_csv import write_gnss_csv
     from uasnav.io.tlog_write import write_tlog_flight
     from uasnav.sim.flight import imu_log_with_truth, simulate_flight
     from uasnav.trajectory.geometry import geodetic_to_local

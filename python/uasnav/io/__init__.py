@@ -30,8 +30,10 @@ message types each view needs, the record decoders, and the format's rules (GNSS
 origin, height datums, declination parameter, field layouts across firmware versions):
 :mod:`~uasnav.io.formats.ulog` (PX4 ULog), :mod:`~uasnav.io.formats.dataflash`,
 :mod:`~uasnav.io.formats.tlog`, :mod:`~uasnav.io.formats.alfa`,
-:mod:`~uasnav.io.formats.csvlog` (CSV v1 over :mod:`~uasnav.io.csv_v1`, x-io over
-:mod:`~uasnav.io.xio`, flight CSV, ``.npz`` over :mod:`~uasnav.io.npz`). The functions
+:mod:`~uasnav.io.formats.csv_v1` (+ :mod:`~uasnav.io.formats.gnss_csv`),
+:mod:`~uasnav.io.formats.xio`, :mod:`~uasnav.io.formats.flight_csv` and
+:mod:`~uasnav.io.formats.npz`. Every numeric CSV is read in chunks of whole lines through
+numpy's C reader (:mod:`uasnav.io._csvstream`: bounded memory, no pyarrow). The functions
 ``read_ulog``, ``read_dataflash``, ``read_tlog``, ``read_*_flight`` and
 ``read_dataflash_messages`` exported here are those decoders (each reads its file in one pass,
 or replays the active pass of a :class:`LogFile`). Nothing here imports from the rest of uasnav
@@ -56,16 +58,17 @@ from pathlib import Path
 
 from uasnav.errors import DataFormatError, InputError, ResourceLimitError
 from uasnav.imu import ImuLog, require_log
-from uasnav.io.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.io.flight import Flight
-from uasnav.io.formats.csvlog import read_flight_csv
+from uasnav.io.formats.csv_v1 import read_csv_v1, write_csv_v1
 from uasnav.io.formats.dataflash import read_dataflash, read_dataflash_flight, read_dataflash_messages
+from uasnav.io.formats.flight_csv import read_flight_csv
+from uasnav.io.formats.gnss_csv import read_gnss_csv, write_gnss_csv
+from uasnav.io.formats.npz import read_npz, write_npz
 from uasnav.io.formats.tlog import read_tlog, read_tlog_flight
 from uasnav.io.formats.ulog import read_ulog, read_ulog_flight
+from uasnav.io.formats.xio import read_xio_csv
 from uasnav.io.logfile import LogFile, open_log
-from uasnav.io.npz import read_npz, write_npz
 from uasnav.io.table import read_csv_table, write_csv_table
-from uasnav.io.xio import read_xio_csv
 
 READ_EXTENSIONS = (".csv", ".txt", ".npz", ".ulg", ".bin", ".tlog")
 WRITE_EXTENSIONS = (".csv", ".npz")
@@ -157,6 +160,7 @@ __all__ = [
     "read_dataflash_messages",
     "read_flight",
     "read_flight_csv",
+    "read_gnss_csv",
     "read_log",
     "read_nav",
     "read_npz",
@@ -167,6 +171,7 @@ __all__ = [
     "read_xio_csv",
     "write_csv_table",
     "write_csv_v1",
+    "write_gnss_csv",
     "write_log",
     "write_npz",
 ]

@@ -1,18 +1,20 @@
-"""Numeric CSV read in chunks through pyarrow's CSV reader, with the row-by-row reader's errors.
+"""The CSV engine of every numeric CSV reader: chunks of whole lines through numpy's C reader,
+with the row-by-row reader's errors.
 
 :class:`NumericCsv` reads a CSV file (``#`` comment lines, a header row, numeric data rows) in
 chunks of whole lines (:func:`chunk_bytes`, at most 16 MiB), each parsed by
-:func:`pyarrow.csv.read_csv` into float64 columns, so memory stays bounded by the chunk size
-whatever the file's length, and a consumer can stream (block means while reading) or
-concatenate.
+:func:`~uasnav.io._text.loadtxt_rows` (:func:`numpy.loadtxt`) into float64 columns, so memory
+stays bounded by the chunk size whatever the file's length, and a consumer can stream (block
+means while reading, :class:`~uasnav.io.formats.csv_v1.CsvV1Stream`) or concatenate
+(:func:`read_table`: numeric tables, the GNSS, x-io and flight CSVs).
 
-pyarrow accepts a subset of what the row-by-row reader of :mod:`uasnav.io._text` accepts, never
-more: no quoting (a ``"`` anywhere sends the chunk row by row), no null markers, cells of at
-most 64 KiB, UTF-8 checked, NUL bytes, NaN and ±inf handed over. Any chunk pyarrow refuses is
-parsed by the row-by-row reader, which either names the first bad cell (file, line, column:
-the same :class:`~uasnav.errors.DataFormatError` as reading the whole text) or accepts what
-``float`` accepts and pyarrow does not (``1_0``, non-ASCII digits). Both paths return the same
-values bit for bit (``tests/test_io_csv_stream.py``).
+numpy accepts a subset of what the row-by-row reader of :mod:`uasnav.io._text` accepts, never
+more: no quoting (a ``"`` anywhere sends the chunk row by row), no lines of spaces, cells of at
+most 64 KiB, UTF-8 checked, NUL bytes, ±inf (and NaN where it is refused) handed over. Any chunk
+numpy refuses is parsed by the row-by-row reader, which either names the first bad cell (file,
+line, column: the same :class:`~uasnav.errors.DataFormatError` as reading the whole text) or
+accepts what ``float`` accepts and numpy does not (``1_0``, non-ASCII digits). Both paths return
+the same values bit for bit (``tests/test_io_csv_stream.py``).
 
 The errors come in the order the whole-text reader finds them: an encoding error anywhere in
 the file (not UTF-8, a NUL byte) wins over any other error, so after the first other error the
@@ -24,25 +26,24 @@ from __future__ import annotations
 import os
 import re
 import stat
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import BinaryIO, NoReturn
 
 import numpy as np
-import pyarrow as pa
-import pyarrow.csv as pacsv
 from numpy.typing import NDArray
 
 from uasnav.errors import DataFormatError
-from uasnav.io._text import csv_rows, decode, decode_part, numeric_rows, split_lines
-from uasnav.limits import max_memory
+from uasnav.io._text import csv_rows, decode, decode_part, loadtxt_rows, numeric_rows, read_text, split_lines
+from uasnav.limits import check_memory, max_memory
 
 #: Largest chunk (bytes of text) parsed at once.
 MAX_CHUNK_BYTES = 16 * 1024**2
-#: Peak bytes of memory per byte of a chunk while it is parsed (pyarrow's buffers and columns,
-#: or the row-by-row reader's Python objects when it takes over: ≈ 6, see ``_text``).
+#: Peak bytes of memory per byte of a chunk while it is parsed (the bytes, the text, its lines
+#: and the columns: ≈ 4; or the row-by-row reader's Python objects when it takes over: ≈ 6, see
+#: ``_text``).
 CHUNK_MEMORY_FACTOR = 8
-#: A chunk whose lines are all shorter than this is parsed by pyarrow; a longer line may hold a
+#: A chunk whose lines are all shorter than this is parsed by numpy; a longer line may hold a
 #: cell beyond the :mod:`csv` module's field limit (128 KiB), which only the row-by-row reader
 #: reports as such.
 _MAX_FAST_LINE = 64 * 1024
@@ -244,21 +245,25 @@ class NumericCsv:
             return after
         return after[: _cut(after)]
 
-    def blocks(self, columns: Sequence[str], *, exact_width: bool = False) -> Iterator[Block]:
+    def blocks(
+        self, columns: Sequence[str], *, exact_width: bool = False, nan_ok: bool = False
+    ) -> Iterator[Block]:
         """The data rows, chunk by chunk, as :class:`Block` s of ``columns`` (names in
         :attr:`header`). ``exact_width`` refuses a row whose cell count differs from the
-        header's; otherwise only a row too short for a wanted column is refused.
+        header's; otherwise only a row too short for a wanted column is refused. Every cell
+        must be finite, or with ``nan_ok`` a number or NaN (a missing value), not ±inf.
 
         Raises
         ------
         DataFormatError
             The first bad row's error (file, line, column), or an encoding error further on.
         """
+        idx = [self.header.index(c) for c in columns]
         for line, raw in self._chunks():
             try:
-                data = self._fast(raw, columns)
+                data = self._fast(raw, idx, exact_width, nan_ok)
                 if data is None:
-                    data = self._row_by_row(raw, line, columns, exact_width)
+                    data = self._row_by_row(raw, line, columns, exact_width, nan_ok)
             except DataFormatError as e:
                 self.fail(e)
             yield Block(data, line, raw, self.header, self.source)
@@ -271,44 +276,26 @@ class NumericCsv:
                 decode_part(raw, self.source, first, self.header)
         raise error
 
-    def _fast(self, raw: bytes, columns: Sequence[str]) -> NDArray[np.float64] | None:
+    def _fast(
+        self, raw: bytes, idx: Sequence[int], exact_width: bool, nan_ok: bool
+    ) -> NDArray[np.float64] | None:
         if b'"' in raw or b"\x00" in raw or not _short_lines(raw):
             return None
-        if not raw.isascii():
+        if raw.isascii():
+            text = raw.decode("ascii")
+        else:
             try:
-                raw.decode("utf-8")
+                text = raw.decode("utf-8")
             except UnicodeDecodeError:
                 return None  # the row-by-row reader names the line and column
-        try:
-            table = pacsv.read_csv(
-                pa.py_buffer(raw),
-                read_options=pacsv.ReadOptions(column_names=self.header),
-                parse_options=pacsv.ParseOptions(
-                    quote_char=False, double_quote=False, escape_char=False, ignore_empty_lines=True
-                ),
-                convert_options=pacsv.ConvertOptions(
-                    column_types=dict.fromkeys(columns, pa.float64()),
-                    include_columns=list(columns),
-                    null_values=[],
-                    strings_can_be_null=False,
-                    quoted_strings_can_be_null=False,
-                    check_utf8=False,
-                ),
-            )
-        except (pa.ArrowInvalid, pa.ArrowTypeError):
-            return None
-        out = np.empty((table.num_rows, len(columns)), dtype=np.float64, order="F")
-        for j, c in enumerate(columns):
-            col = table.column(c)
-            if col.null_count:
-                return None
-            out[:, j] = col.to_numpy()
-        if not np.isfinite(out).all():
-            return None
-        return out
+        lines = text.split("\n") if "\r" not in text else split_lines(text)
+        if lines and not lines[-1]:
+            lines.pop()
+        data = loadtxt_rows(lines, len(self.header), idx, exact_width=exact_width, nan_ok=nan_ok)
+        return None if data is None else np.asfortranarray(data)
 
     def _row_by_row(
-        self, raw: bytes, line: int, columns: Sequence[str], exact_width: bool
+        self, raw: bytes, line: int, columns: Sequence[str], exact_width: bool, nan_ok: bool
     ) -> NDArray[np.float64]:
         # A '"' may open a quoted cell that runs into the next chunk: the csv module reads on to
         # its field limit, so the text after the chunk is given too (and its rows dropped).
@@ -316,10 +303,192 @@ class NumericCsv:
         text = decode_part(raw + after, self.source, line, self.header)
         lines = split_lines(text)
         data, row_lines = numeric_rows(
-            lines, 0, self.source, self.header, columns, exact_width=exact_width, offset=line - 1, min_rows=0
+            lines,
+            0,
+            self.source,
+            self.header,
+            columns,
+            exact_width=exact_width,
+            offset=line - 1,
+            min_rows=0,
+            nan_ok=nan_ok,
         )
         keep = int(np.searchsorted(np.asarray(row_lines), line + _line_count(raw)))
         return np.asfortranarray(data[:keep].reshape(-1, len(columns)))
 
 
-__all__ = ["CHUNK_MEMORY_FACTOR", "MAX_CHUNK_BYTES", "Block", "NumericCsv", "chunk_bytes"]
+#: Copies of the numbers alive at once while a reader assembles what it read: the chunks'
+#: columns, the joined columns, the arrays the reader builds from them (8 bytes each).
+READ_COPIES = 3
+
+
+def check_read_memory(
+    source: str, what: str, rows: int, k: int, done: int, total: int | None, chunk: int
+) -> None:
+    """Refuse a read as soon as it is known to need more than the memory limit: ``rows`` rows of
+    ``k`` numbers read from the first ``done`` of ``total`` bytes of data (None: a pipe), the
+    largest chunk ``chunk`` bytes (the rows per byte so far project the file's rows).
+
+    Raises
+    ------
+    ResourceLimitError
+        With the file and the projected size named.
+    """
+    scale = total / done if total and done else 1.0
+    expect = rows * max(scale, 1.0)
+    check_memory(
+        expect * k * 8 * READ_COPIES + chunk * CHUNK_MEMORY_FACTOR,
+        f"{source}: a {what} of about {expect:.3g} rows × {k} columns",
+    )
+
+
+@dataclass
+class NumericTable:
+    """A numeric CSV read whole by :func:`read_table`.
+
+    Attributes
+    ----------
+    source : str
+        The file.
+    comments : list of str
+        The lines before the header (``#`` comments, blank lines).
+    header : list of str
+        The column names of the header row, stripped.
+    header_line : int
+        The file line (1-based) of the header row.
+    columns : dict of str → ndarray, shape (n,)
+        The columns read, float64.
+    """
+
+    source: str
+    comments: list[str]
+    header: list[str]
+    header_line: int
+    columns: dict[str, NDArray[np.float64]]
+    _row_lines: list[int] | None = None
+    _exact_width: bool = False
+    _nan_ok: bool = False
+
+    @property
+    def rows(self) -> int:
+        """Data rows read."""
+        return next(iter(self.columns.values())).size if self.columns else 0
+
+    def row_line(self, row: int) -> int:
+        """The file line (1-based) of data row ``row`` (0-based), for an error message: the rows
+        of a file read in chunks are found again by reading up to the chunk that holds it."""
+        if self._row_lines is not None:
+            return self._row_lines[row]
+        csv = NumericCsv.open(self.source)
+        assert csv is not None
+        with csv:
+            first = 0
+            for b in csv.blocks(list(self.columns), exact_width=self._exact_width, nan_ok=self._nan_ok):
+                m = b.data.shape[0]
+                if row < first + m:
+                    return b.row_lines()[row - first]
+                first += m
+        raise IndexError(row)
+
+
+def read_table(
+    path: str | os.PathLike[str],
+    select: Callable[[list[str], int], list[str]],
+    *,
+    what: str,
+    empty: str = "empty file (no header row)",
+    exact_width: bool = False,
+    nan_ok: bool = False,
+    min_rows: int = 0,
+) -> NumericTable:
+    """Read a numeric CSV file whole, in chunks (see the module docs).
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    select : callable (header, header_line) → list of str
+        The columns to read, in order; raises :class:`DataFormatError` for a header the reader
+        refuses (a missing or duplicated column, named).
+    what : str
+        What the file is, for the memory-limit message (``"GNSS CSV"``).
+    empty : str
+        The message for a file without a header row.
+    exact_width, nan_ok : bool
+        As :meth:`NumericCsv.blocks`.
+    min_rows : int
+        Fewer data rows is an error.
+
+    Raises
+    ------
+    DataFormatError
+        The first error of the file (file, line, column; see the module docs).
+    ResourceLimitError
+        If the columns would need more memory than the limit (``UASNAV_MAX_MEMORY``).
+    """
+    source = str(path)
+    csv = NumericCsv.open(path)
+    if csv is None:  # the header lies beyond the first chunk (or is quoted): the whole text decides
+        return _read_whole(source, select, empty, exact_width, nan_ok, min_rows)
+    with csv:
+        try:
+            columns = select(csv.header, csv.header_line)
+        except DataFormatError as e:
+            csv.fail(e)
+        total = csv.size - csv.data_start if csv.size is not None else None
+        parts: list[NDArray[np.float64]] = []
+        rows = done = largest = 0
+        for b in csv.blocks(columns, exact_width=exact_width, nan_ok=nan_ok):
+            parts.append(b.data)
+            rows += b.data.shape[0]
+            done += len(b.raw)
+            largest = max(largest, len(b.raw))
+            check_read_memory(source, what, rows, len(columns), done, total, largest)
+        if rows < min_rows:
+            raise DataFormatError(f"need at least {min_rows} data rows, got {rows}", path=source)
+        cols = {
+            c: np.concatenate([p[:, j] for p in parts]) if parts else np.empty(0)
+            for j, c in enumerate(columns)
+        }
+        return NumericTable(
+            source, csv.comments, csv.header, csv.header_line, cols, None, exact_width, nan_ok
+        )
+
+
+def _read_whole(
+    source: str,
+    select: Callable[[list[str], int], list[str]],
+    empty: str,
+    exact_width: bool,
+    nan_ok: bool,
+    min_rows: int,
+) -> NumericTable:
+    """:func:`read_table` of the whole text, row by row (a header beyond the first chunk)."""
+    lines = split_lines(read_text(source))
+    i = 0
+    while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
+        i += 1
+    first = next(csv_rows(lines, i, source), None) if i < len(lines) else None
+    if first is None:
+        raise DataFormatError(empty, path=source)
+    header_line, cells = first
+    header = [h.strip() for h in cells]
+    columns = select(header, header_line)
+    data, row_lines = numeric_rows(
+        lines, header_line, source, header, columns, exact_width=exact_width, min_rows=min_rows, nan_ok=nan_ok
+    )
+    cols = {c: np.ascontiguousarray(data[:, j]) for j, c in enumerate(columns)}
+    return NumericTable(source, lines[: header_line - 1], header, header_line, cols, row_lines)
+
+
+__all__ = [
+    "CHUNK_MEMORY_FACTOR",
+    "MAX_CHUNK_BYTES",
+    "READ_COPIES",
+    "Block",
+    "NumericCsv",
+    "NumericTable",
+    "check_read_memory",
+    "chunk_bytes",
+    "read_table",
+]

@@ -1,8 +1,8 @@
 """Reading text files for the CSV readers: bounded, decoded with positions, parsed row by row.
 
-The CSV readers of :mod:`uasnav.io` (x-io, flight CSV, numeric tables) read through
-:func:`read_text` and :func:`csv_rows`; log format v1 reads in chunks through pyarrow
-(:mod:`uasnav.io._csvstream`) and comes here, chunk by chunk (:func:`decode_part`,
+Every numeric CSV reader of :mod:`uasnav.io` (log format v1, x-io, the flight and GNSS CSVs,
+numeric tables) reads in chunks of whole lines (:mod:`uasnav.io._csvstream`), each parsed by
+numpy's C reader (:func:`loadtxt_rows`), and comes here, chunk by chunk (:func:`decode_part`,
 :func:`numeric_rows` with ``offset``), to name an error. So each hostile input gets one
 :class:`~uasnav.errors.DataFormatError` naming the file, line and (where it can be told) column:
 
@@ -194,16 +194,20 @@ def show_cell(cell: str, limit: int = 40) -> str:
     return repr(cell) if len(cell) <= limit else f"{cell[:limit]!r}… ({len(cell)} characters)"
 
 
-def finite_cell(cell: str, *, path: str, line: int, column: str) -> float:
+def finite_cell(cell: str, *, path: str, line: int, column: str, nan_ok: bool = False) -> float:
     """One CSV cell as a finite float, else :class:`DataFormatError` naming file, line, column
-    and the cell as written (the one cell rule of every CSV reader)."""
+    and the cell as written (the one cell rule of every CSV reader). ``nan_ok``: NaN is a
+    missing value of a numeric table, only ±inf is refused."""
     try:
         v = float(cell)
     except ValueError:
         raise DataFormatError(
             f"not a number: {show_cell(cell)}", path=path, line=line, column=column
         ) from None
-    if not math.isfinite(v):
+    if nan_ok:
+        if math.isinf(v):
+            raise DataFormatError(f"infinite value {show_cell(cell)}", path=path, line=line, column=column)
+    elif not math.isfinite(v):
         raise DataFormatError(f"non-finite value {show_cell(cell)}", path=path, line=line, column=column)
     return v
 
@@ -218,6 +222,7 @@ def numeric_rows(
     exact_width: bool = False,
     offset: int = 0,
     min_rows: int = 2,
+    nan_ok: bool = False,
 ) -> tuple[NDArray[np.float64], list[int]]:
     """The data rows of a CSV table as an (n, len(columns)) float array of ``columns`` (names in
     ``header``), with the file line of each row; every cell must be a finite number.
@@ -225,9 +230,10 @@ def numeric_rows(
     ``exact_width`` refuses a row whose cell count differs from the header's (log format v1);
     otherwise only a row too short for a wanted column is refused. Fewer than ``min_rows`` rows
     is an error (a log or a track needs at least two samples). ``lines[0]`` is file line
-    ``offset + 1`` (a chunk of a file)."""
+    ``offset + 1`` (a chunk of a file). ``nan_ok`` accepts NaN (a missing value of a numeric
+    table, :func:`finite_cell`) and refuses only ±inf."""
     idx = [header.index(c) for c in columns]
-    fast = _numeric_rows_fast(lines, header_line, len(header), idx, exact_width)
+    fast = _numeric_rows_fast(lines, header_line, len(header), idx, exact_width, nan_ok)
     if fast is not None:
         return fast[0], [offset + ln for ln in fast[1]]
     rows: list[list[float]] = []
@@ -239,7 +245,7 @@ def numeric_rows(
         for c, j in zip(columns, idx, strict=True):
             if j >= len(row):
                 raise DataFormatError(f"missing cell (row has {len(row)})", path=source, line=line, column=c)
-            vals.append(finite_cell(row[j].strip(), path=source, line=line, column=c))
+            vals.append(finite_cell(row[j].strip(), path=source, line=line, column=c, nan_ok=nan_ok))
         rows.append(vals)
         row_lines.append(line)
     if len(rows) < min_rows:
@@ -247,34 +253,57 @@ def numeric_rows(
     return np.array(rows, dtype=np.float64).reshape(len(rows), len(columns)), row_lines
 
 
-def _numeric_rows_fast(
-    lines: list[str], start: int, width: int, idx: Sequence[int], exact_width: bool
-) -> tuple[NDArray[np.float64], list[int]] | None:
-    """:func:`numeric_rows` for the common case in one vectorised pass (≈ 2× faster on a large
-    log), or ``None`` when some row needs the row-by-row reader's judgement: a ``"`` (quoting),
-    rows of different widths, a cell that is not a finite number. The row-by-row reader then
-    finds the first offending cell and names it, or accepts what ``float`` accepts and numpy
-    does not (``1_0``): both paths return the same values for every input."""
-    body = lines[start:]
-    keep = [k for k, ln in enumerate(body) if ln.strip()]
-    if len(keep) < 2:
-        return None
-    rows = [body[k] for k in keep]
-    if any('"' in ln for ln in rows):
-        return None
-    counts = {ln.count(",") for ln in rows}
-    if len(counts) != 1:
-        return None
-    ncell = counts.pop() + 1
-    if (exact_width and ncell != width) or max(idx, default=0) >= ncell:
-        return None
+def loadtxt_rows(
+    lines: Sequence[str], width: int, idx: Sequence[int], *, exact_width: bool, nan_ok: bool = False
+) -> NDArray[np.float64] | None:
+    """The numeric engine of every CSV reader: data ``lines`` (blank lines skipped) parsed by
+    numpy's C reader into an (m, len(idx)) float array of the columns at ``idx``, or ``None``
+    when some row needs the row-by-row reader's judgement: a ``"`` (quoting), a row of the
+    wrong width (any width other than ``width`` if ``exact_width``, else one too short for a
+    wanted column), a line of spaces, a cell that is not a number, ±inf (NaN too unless
+    ``nan_ok``). The row-by-row reader then names the first offending cell, or accepts what
+    ``float`` accepts and numpy does not (``1_0``, non-ASCII digits): numpy accepts a subset of
+    what ``float`` accepts, never more, so both paths return the same values for every input."""
+    if not lines:
+        return np.empty((0, len(idx)), dtype=np.float64)
     try:
-        # numpy's C reader, the wanted columns only, no comment or quote handling: it accepts a
-        # subset of what ``float`` accepts (not ``1_0`` nor non-ASCII digits), never more.
-        data = np.loadtxt(rows, dtype=np.float64, delimiter=",", comments=None, usecols=list(idx), ndmin=2)
+        if exact_width:
+            # all columns: numpy refuses a row whose cell count differs from the first row's
+            data = np.loadtxt(lines, dtype=np.float64, delimiter=",", comments=None, quotechar=None, ndmin=2)
+            if data.shape[1] != width:
+                return None
+            if list(idx) != list(range(width)):
+                data = data[:, list(idx)]
+        else:
+            data = np.loadtxt(
+                lines,
+                dtype=np.float64,
+                delimiter=",",
+                comments=None,
+                quotechar=None,
+                usecols=list(idx),
+                ndmin=2,
+            )
     except ValueError:
         return None
-    if data.shape != (len(rows), len(idx)) or not np.isfinite(data).all():
+    if data.shape[0] == 0 and any(ln for ln in lines):
+        return None
+    ok = ~np.isinf(data) if nan_ok else np.isfinite(data)
+    if not ok.all():
+        return None
+    return data
+
+
+def _numeric_rows_fast(
+    lines: list[str], start: int, width: int, idx: Sequence[int], exact_width: bool, nan_ok: bool = False
+) -> tuple[NDArray[np.float64], list[int]] | None:
+    """:func:`numeric_rows` in one vectorised pass (:func:`loadtxt_rows`), or ``None``."""
+    body = lines[start:]
+    keep = [k for k, ln in enumerate(body) if ln.strip()]
+    if len(keep) < 2 or any('"' in body[k] for k in keep):
+        return None
+    data = loadtxt_rows([body[k] for k in keep], width, idx, exact_width=exact_width, nan_ok=nan_ok)
+    if data is None or data.shape[0] != len(keep):
         return None
     return data, [start + k + 1 for k in keep]
 
@@ -307,6 +336,8 @@ __all__ = [
     "csv_rows",
     "decode",
     "decode_part",
+    "finite_cell",
+    "loadtxt_rows",
     "max_text_bytes",
     "numeric_rows",
     "read_text",

@@ -39,14 +39,17 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from uasnav.errors import InputError
+from uasnav.errors import DataFormatError, InputError
 from uasnav.io._active import active
 from uasnav.io.formats.alfa import AlfaFormat
 from uasnav.io.formats.base import VIEWS, LogFormat
-from uasnav.io.formats.csvlog import CsvV1Format, FlightCsvFormat, NpzFormat, XioFormat, csv_kind
+from uasnav.io.formats.csv_v1 import CsvV1Format
 from uasnav.io.formats.dataflash import DataflashFormat
+from uasnav.io.formats.flight_csv import FlightCsvFormat, is_flight_csv
+from uasnav.io.formats.npz import NpzFormat
 from uasnav.io.formats.tlog import TlogFormat
 from uasnav.io.formats.ulog import UlogFormat
+from uasnav.io.formats.xio import XioFormat, is_xio_csv
 
 #: Format classes by extension (CSV by header, see :func:`format_class`).
 BY_EXTENSION: dict[str, type[LogFormat]] = {
@@ -57,6 +60,38 @@ BY_EXTENSION: dict[str, type[LogFormat]] = {
 }
 _CSV = {"csv-v1": CsvV1Format, "xio-csv": XioFormat, "flight-csv": FlightCsvFormat}
 EXTENSIONS = (".ulg", ".bin", ".tlog", ".csv", ".txt", ".npz")
+
+
+def csv_kind(path: str | os.PathLike[str]) -> str:
+    """``csv-v1``, ``xio-csv`` or ``flight-csv`` from the first non-comment line of a CSV file.
+
+    Raises
+    ------
+    DataFormatError
+        Missing file, a directory, or unreadable.
+    """
+    p = Path(path)
+    try:
+        with open(p, "rb") as fh:
+            for _ in range(1000):
+                raw = fh.readline(4096)  # a bounded peek, whatever the file
+                if not raw:
+                    break
+                line = raw.decode("utf-8", errors="replace").lstrip("\ufeff").strip()
+                if not line or line.startswith("#"):
+                    continue
+                if is_xio_csv(line):
+                    return XioFormat.name
+                if is_flight_csv([c.strip() for c in line.split(",")]):
+                    return FlightCsvFormat.name
+                return CsvV1Format.name
+    except FileNotFoundError:
+        raise DataFormatError("no such file", path=str(p)) from None
+    except IsADirectoryError:
+        raise DataFormatError("is a directory, not a file", path=str(p)) from None
+    except OSError as e:
+        raise DataFormatError(f"cannot read ({e.strerror or e})", path=str(p)) from None
+    return CsvV1Format.name
 
 
 def format_class(path: str | os.PathLike[str]) -> type[LogFormat]:
@@ -243,4 +278,12 @@ def _fetch(url: str) -> tuple[Any, Path]:
     return tmp, local
 
 
-__all__ = ["EXTENSIONS", "FETCH_MAX_BYTES", "FETCH_TIMEOUT_S", "LogFile", "format_class", "open_log"]
+__all__ = [
+    "EXTENSIONS",
+    "FETCH_MAX_BYTES",
+    "FETCH_TIMEOUT_S",
+    "LogFile",
+    "csv_kind",
+    "format_class",
+    "open_log",
+]

@@ -17,7 +17,6 @@ from __future__ import annotations
 import os
 import re
 from collections.abc import Mapping
-from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
@@ -25,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
-from uasnav.io._text import csv_rows, read_text, show_cell, split_lines
+from uasnav.io._csvstream import read_table
 
 _KEY = re.compile(r"[\w.-]+")
 _COMMENT = re.compile(r"#\s*([\w.-]+)\s*:\s*(.*)$")
@@ -124,8 +123,17 @@ def write_csv_table(
         write_rows(fh, block)
 
 
+def check_header(header: list[str], header_line: int, source: str) -> None:
+    """Refuse a header row that names a column twice (the line named)."""
+    if len(set(header)) != len(header):
+        raise DataFormatError(f"duplicated column name in {header}", path=source, line=header_line)
+
+
 def read_csv_table(path: str | os.PathLike[str]) -> tuple[dict[str, NDArray[np.float64]], dict[str, str]]:
     """Read a table written by :func:`write_csv_table`: (columns, comments).
+
+    The file is read in chunks by the CSV engine (:mod:`uasnav.io._csvstream`): memory is about
+    24 bytes per number plus a bounded working set.
 
     Raises
     ------
@@ -133,44 +141,22 @@ def read_csv_table(path: str | os.PathLike[str]) -> tuple[dict[str, NDArray[np.f
         Missing file, no header, duplicated column name, a row of the wrong width, a cell that
         is not a number or is infinite, malformed CSV or text that is not UTF-8 (names the line
         and column).
+    ResourceLimitError
+        If the table would need more memory than the limit (``UASNAV_MAX_MEMORY``).
     """
-    p = Path(path)
-    source = str(p)
-    lines = split_lines(read_text(p))
+    source = str(path)
+
+    def select(header: list[str], header_line: int) -> list[str]:
+        check_header(header, header_line, source)
+        return header
+
+    table = read_table(path, select, what="CSV table", exact_width=True, nan_ok=True)
     comments: dict[str, str] = {}
-    i = 0
-    while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
-        m = _COMMENT.match(lines[i])
+    for line in table.comments:
+        m = _COMMENT.match(line)
         if m:
             comments[m.group(1)] = m.group(2).strip()
-        i += 1
-    first = next(csv_rows(lines, i, source), None)
-    if first is None:
-        raise DataFormatError("empty file (no header row)", path=source)
-    header_line, cells = first
-    header = [h.strip() for h in cells]
-    if len(set(header)) != len(header):
-        raise DataFormatError(f"duplicated column name in {header}", path=source, line=header_line)
-    rows: list[list[float]] = []
-    for line, row in csv_rows(lines, header_line, source, header):
-        if len(row) != len(header):
-            raise DataFormatError(f"expected {len(header)} cells, got {len(row)}", path=source, line=line)
-        vals = []
-        for name, cell in zip(header, row, strict=True):
-            try:
-                v = float(cell)
-            except ValueError:
-                raise DataFormatError(
-                    f"not a number: {show_cell(cell)}", path=source, line=line, column=name
-                ) from None
-            if np.isinf(v):  # the writer refuses ±inf; NaN is a missing value
-                raise DataFormatError(
-                    f"infinite value {show_cell(cell)}", path=source, line=line, column=name
-                )
-            vals.append(v)
-        rows.append(vals)
-    data = np.array(rows, dtype=np.float64).reshape(len(rows), len(header))
-    return {name: data[:, j].copy() for j, name in enumerate(header)}, comments
+    return table.columns, comments
 
 
-__all__ = ["FLOAT_FORMAT", "as_column", "read_csv_table", "write_csv_table", "write_rows"]
+__all__ = ["FLOAT_FORMAT", "as_column", "check_header", "read_csv_table", "write_csv_table", "write_rows"]

@@ -18,9 +18,12 @@ receivers have time-correlated errors). Barometer: height minus a constant datum
 white noise. Magnetometer: a fixed NED field (declination 0 plus a per-flight heading error)
 resolved in the body plus noise.
 
-Position: latitude/longitude from the local north/east with the radii at the start point
-(the mapping's relative error over a few km is ~1e-6); gravity at the start latitude with its
-exact height dependence (the latitude term changes it by < 1e-5 m/s² per km).
+Position: the north/east of the path are distances flown over the WGS-84 ellipsoid at the
+vehicle's height, so latitude and longitude are integrated with the radii of curvature where the
+vehicle is (:func:`uasnav.geo.frames.radii_of_curvature`):
+``φ̇ = v_N/(R_N(φ)+h)``, ``λ̇ = v_E/((R_E(φ)+h) cos φ)``, the same transport rate ``ω_en`` the
+simulated gyro carries (a constant course is a rhumb line). Gravity at the start latitude with
+its exact height dependence (the latitude term changes it by < 1e-5 m/s² per km).
 
 Deterministic from ``seed``.
 """
@@ -34,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import CubicHermiteSpline, CubicSpline
 from scipy.ndimage import gaussian_filter1d
 from scipy.spatial.transform import Rotation
 
@@ -86,6 +89,26 @@ def _gravity(lat0: float, h: FloatArray) -> FloatArray:
     g = [earth.normal_gravity(lat0, x) for x in (0.0, 1000.0, 2000.0)]
     c = np.polyfit([0.0, 1000.0, 2000.0], g, 2)
     return np.polyval(c, h)
+
+
+def _geodetic(
+    t: FloatArray, vel: FloatArray, h: FloatArray, lat0: float, lon0: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Latitude and longitude (rad) along the path and their rates (rad/s): the NED velocity
+    ``vel`` at height ``h`` integrated with the radii of curvature at the current latitude
+    (trapezoid rule on the sample times; the radii depend on the latitude being integrated, so
+    three fixed-point passes, each shrinking the radii's error by ~1e-5)."""
+    lat = np.full(t.size, lat0)
+    dt = np.diff(t)
+    for _ in range(3):
+        rn, re = radii_of_curvature(lat, degrees=False)
+        lat_rate = vel[:, 0] / (rn + h)
+        lat = lat0 + np.concatenate([[0.0], np.cumsum(0.5 * (lat_rate[1:] + lat_rate[:-1]) * dt)])
+    rn, re = radii_of_curvature(lat, degrees=False)
+    lat_rate = vel[:, 0] / (rn + h)
+    lon_rate = vel[:, 1] / ((re + h) * np.cos(lat))
+    lon = lon0 + np.concatenate([[0.0], np.cumsum(0.5 * (lon_rate[1:] + lon_rate[:-1]) * dt)])
+    return lat, lon, lat_rate, lon_rate
 
 
 def _path(
@@ -189,10 +212,8 @@ def simulate_flight(
 
     pos, vel, acc = kin(t)
     lat0, lon0 = math.radians(latitude_deg), math.radians(longitude_deg)
-    rn, re = radii_of_curvature(lat0, degrees=False)
     h = height_m - pos[:, 2]
-    lat = lat0 + pos[:, 0] / (rn + height_m)
-    lon = lon0 + pos[:, 1] / ((re + height_m) * math.cos(lat0))
+    lat, lon, lat_rate, lon_rate = _geodetic(t, vel, h, lat0, lon0)
     g = _gravity(lat0, h)
 
     # Yaw: the course where moving, held below 1 m/s, smoothed over 1 s.
@@ -230,6 +251,7 @@ def simulate_flight(
     lat_m = np.r_[lat[:1], 0.5 * (lat[1:] + lat[:-1])]
     h_m = np.r_[h[:1], 0.5 * (h[1:] + h[:-1])]
     w_ie = earth.OMEGA_IE * np.column_stack([np.cos(lat_m), np.zeros(n), -np.sin(lat_m)])
+    rn, re = radii_of_curvature(lat_m, degrees=False)
     w_en = np.column_stack(
         [vel_m[:, 1] / (re + h_m), -vel_m[:, 0] / (rn + h_m), -vel_m[:, 1] * np.tan(lat_m) / (re + h_m)]
     )
@@ -288,10 +310,13 @@ def simulate_flight(
     m = tg.size
     n_err = rng.normal(0.0, e.gnss_h_std_m, (m, 2))
     v_err = rng.normal(0.0, e.gnss_v_std_m, m)
+    lat_g = CubicHermiteSpline(t, lat, lat_rate)(tg)
+    lon_g = CubicHermiteSpline(t, lon, lon_rate)(tg)
+    rn_g, re_g = radii_of_curvature(lat_g, degrees=False)
     gnss = GnssData(
         t=tg,
-        lat=np.degrees(lat0 + (pg[:, 0] + n_err[:, 0]) / (rn + height_m)),
-        lon=np.degrees(lon0 + (pg[:, 1] + n_err[:, 1]) / ((re + height_m) * math.cos(lat0))),
+        lat=np.degrees(lat_g + n_err[:, 0] / (rn_g + hg)),
+        lon=np.degrees(lon_g + n_err[:, 1] / ((re_g + hg) * np.cos(lat_g))),
         alt=hg + v_err,
         vel=vg + rng.normal(0.0, e.gnss_vel_std_m_s, (m, 3)),
         h_acc=np.full(m, e.gnss_h_std_m),

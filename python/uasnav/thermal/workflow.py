@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
 from uasnav.io import open_log, read_log
-from uasnav.io.formats.csvlog import CsvV1Format
+from uasnav.io.formats.csv_v1 import CsvV1Format
 from uasnav.thermal._common import (
     TEMP_MAX_C,
     TEMP_MIN_C,

@@ -10,6 +10,8 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from uasnav.errors import DataFormatError
+from uasnav.imu import ImuLog
+from uasnav.io.views import Identity
 
 #: Every view a :class:`~uasnav.io.logfile.LogFile` can offer.
 VIEWS = (
@@ -117,7 +119,7 @@ class LogFormat(ABC):
 
         gnss = self.options["gnss"]
         if not isinstance(gnss, GnssData):
-            from uasnav.io.gnss_csv import read_gnss_csv
+            from uasnav.io.formats.gnss_csv import read_gnss_csv
 
             gnss = read_gnss_csv(gnss)
         return replace(nav, gnss=gnss)
@@ -147,4 +149,25 @@ class WholeFileFormat(LogFormat):
         return None
 
 
-__all__ = ["NAV_PARTS", "VIEWS", "LogFormat", "ScannedFormat", "WholeFileFormat"]
+class ImuFileFormat(WholeFileFormat):
+    """An IMU log read whole by one reader (:meth:`read_imu`), once, then cached."""
+
+    @abstractmethod
+    def read_imu(self) -> ImuLog:
+        """The file's IMU log."""
+
+    def build_imu(self) -> ImuLog:
+        cached = self.options.get("_imu")
+        if cached is None:
+            cached = self.options["_imu"] = self.read_imu()
+        return cached  # type: ignore[no-any-return]
+
+    def build_imus(self) -> dict[str, Any]:
+        return {"imu0": self.build_imu()}
+
+    def build_identity(self) -> Identity:
+        meta = self.build_imu().meta
+        return Identity(vehicle_id=meta.get("vehicle"), board=meta.get("hardware"), clock="file")
+
+
+__all__ = ["NAV_PARTS", "VIEWS", "ImuFileFormat", "LogFormat", "ScannedFormat", "WholeFileFormat"]

@@ -30,7 +30,7 @@ import os
 import zipfile
 import zlib
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, ClassVar
 
 import numpy as np
 from numpy.lib import format as npformat
@@ -38,6 +38,7 @@ from numpy.lib import format as npformat
 from uasnav.atomicfile import atomic_write_bytes
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
+from uasnav.io.formats.base import ImuFileFormat
 from uasnav.limits import check_memory
 from uasnav.units import convert
 
@@ -241,4 +242,14 @@ def _read_adis(z: dict[str, np.ndarray], p: Path) -> ImuLog:
     )
 
 
-__all__ = ["FORMAT", "read_npz", "write_npz"]
+class NpzFormat(ImuFileFormat):
+    """uasnav / ADIS ``.npz`` IMU arrays (:func:`read_npz`)."""
+
+    name = "npz"
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "identity": ()}
+
+    def read_imu(self) -> ImuLog:
+        return read_npz(self.path)
+
+
+__all__ = ["FORMAT", "NpzFormat", "read_npz", "write_npz"]

@@ -28,6 +28,7 @@ import os
 import re
 from collections.abc import Iterator, Mapping
 from pathlib import Path
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -35,25 +36,25 @@ from numpy.typing import ArrayLike, NDArray
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
 from uasnav.imu import ImuLog, require_log
-from uasnav.io._csvstream import CHUNK_MEMORY_FACTOR, NumericCsv
+from uasnav.io._csvstream import NumericCsv, check_read_memory
 from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
+from uasnav.io.flight import Flight, GnssData, MagData
+from uasnav.io.formats.base import ImuFileFormat
+from uasnav.io.formats.gnss_csv import read_gnss_csv
 from uasnav.io.table import as_column, write_rows
-from uasnav.limits import check_memory
 
 REQUIRED = ("t", "gx", "gy", "gz", "ax", "ay", "az")
 OPTIONAL = ("temp", "mx", "my", "mz")
 _AXES = ("x", "y", "z")
 _COMMENT = re.compile(r"#\s*([\w.-]+)\s*:\s*(.*)$")
-#: Copies of the numbers alive at once while :func:`read_csv_v1` assembles a log: the chunks'
-#: columns, the joined columns, the (n, 3) arrays of :class:`ImuLog` (8 bytes each).
-READ_COPIES = 3
 
 
 def read_csv_v1(path: str | os.PathLike[str]) -> ImuLog:
     """Read a CSV v1 log.
 
-    The file is read in chunks through pyarrow's CSV reader (:class:`CsvV1Stream`); memory is
-    about 24 bytes per number of the log's columns plus a bounded working set.
+    The file is read in chunks by the CSV engine (:class:`CsvV1Stream`,
+    :mod:`uasnav.io._csvstream`); memory is about 24 bytes per number of the log's columns plus a
+    bounded working set.
 
     Raises
     ------
@@ -75,14 +76,8 @@ def read_csv_v1(path: str | os.PathLike[str]) -> ImuLog:
             parts.append(block)
             rows += block.shape[0]
             largest_chunk = max(largest_chunk, done_bytes[1])
-            # the log's size projected from the rows per byte so far (the bytes read so far for
-            # a pipe): refused as soon as it is known to be too large
-            total = stream.data_bytes
-            scale = total / done_bytes[0] if total and done_bytes[0] else 1.0
-            expect = rows * max(scale, 1.0)
-            check_memory(
-                expect * k * 8 * READ_COPIES + largest_chunk * CHUNK_MEMORY_FACTOR,
-                f"{stream.source}: a CSV v1 log of about {expect:.3g} rows × {k} columns",
+            check_read_memory(
+                stream.source, "CSV v1 log", rows, k, done_bytes[0], stream.data_bytes, largest_chunk
             )
         col: dict[str, NDArray[np.float64]] = {}
         for j, c in enumerate(stream.columns):
@@ -357,4 +352,41 @@ def write_csv_v1(
         write_rows(fh, np.column_stack([a for _, a in cols]))
 
 
-__all__ = ["REQUIRED", "CsvV1Stream", "open_csv_v1", "parse_csv_v1", "read_csv_v1", "write_csv_v1"]
+class CsvV1Format(ImuFileFormat):
+    """CSV v1 IMU log (:func:`read_csv_v1`); ``nav`` with the GNSS CSV given as the option
+    ``gnss`` (``mx my mz`` become the magnetometer when present)."""
+
+    name = "csv-v1"
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "nav": (), "identity": ()}
+
+    def read_imu(self) -> ImuLog:
+        return read_csv_v1(self.path)
+
+    def stream(self) -> CsvV1Stream:
+        """The data rows in chunks, for consumers that stream (:func:`open_csv_v1`: block
+        means while reading)."""
+        return open_csv_v1(self.path)
+
+    def build_nav(self) -> Flight:
+        gnss: Any = self.options.get("gnss")
+        if gnss is None:
+            raise InputError(
+                f"{self.path}: a CSV IMU log needs --gnss GNSS.csv (t,lat,lon,alt,vn,ve,vd,h_acc,v_acc,s_acc)"
+            )
+        if not isinstance(gnss, GnssData):
+            gnss = read_gnss_csv(gnss)
+        imu = self.build_imu()
+        mag = MagData(imu.t, imu.mag) if imu.mag is not None else None
+        meta = {"source": str(self.path), "format": "csv-v1", "imu": "IMU"}
+        return Flight(imu, gnss, None, mag, imus={"IMU": imu}, meta=meta)
+
+
+__all__ = [
+    "REQUIRED",
+    "CsvV1Format",
+    "CsvV1Stream",
+    "open_csv_v1",
+    "parse_csv_v1",
+    "read_csv_v1",
+    "write_csv_v1",
+]

@@ -10,12 +10,14 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
 from uasnav.errors import DataFormatError
 from uasnav.imu import ImuLog
-from uasnav.io._text import csv_rows, numeric_rows, read_text, split_lines
+from uasnav.io._csvstream import read_table
+from uasnav.io.formats.base import ImuFileFormat
 from uasnav.units import convert
 
 HEADER_PREFIX = "Time (s)"
@@ -37,29 +39,30 @@ def is_xio_csv(first_line: str) -> bool:
 
 
 def read_xio_csv(path: str | os.PathLike[str]) -> ImuLog:
-    """Read an x-io CSV (see module docs).
+    """Read an x-io CSV (see module docs), in chunks by the CSV engine
+    (:mod:`uasnav.io._csvstream`).
 
     Raises
     ------
     DataFormatError
         Missing file or column, a non-numeric, missing or non-finite cell, non-increasing time,
         malformed CSV or text that is not UTF-8 (names the file, line and column).
+    ResourceLimitError
+        If the log would need more memory than the limit (``UASNAV_MAX_MEMORY``).
     """
     p = Path(path)
     source = str(p)
-    lines = split_lines(read_text(p))
-    first = next(csv_rows(lines, 0, source), None)
-    if first is None:
-        raise DataFormatError("empty file", path=source)
-    header_line, cells = first
-    header = [h.strip() for h in cells]
-    missing = [c for c in _COLS if c not in header]
-    if missing:
-        raise DataFormatError(
-            f"missing column(s) {missing}", path=source, line=header_line, column=missing[0]
-        )
-    want = list(_COLS) + [c for c in _MAG if c in header]
-    data, row_lines = numeric_rows(lines, header_line, source, header, want)
+
+    def select(header: list[str], header_line: int) -> list[str]:
+        missing = [c for c in _COLS if c not in header]
+        if missing:
+            raise DataFormatError(
+                f"missing column(s) {missing}", path=source, line=header_line, column=missing[0]
+            )
+        return list(_COLS) + [c for c in _MAG if c in header]
+
+    table = read_table(p, select, what="x-io CSV", empty="empty file", min_rows=2)
+    data = np.column_stack(list(table.columns.values()))
     t = data[:, 0]
     d = np.diff(t)
     if np.any(d <= 0):
@@ -67,7 +70,7 @@ def read_xio_csv(path: str | os.PathLike[str]) -> ImuLog:
         raise DataFormatError(
             f"time stamp not increasing ({float(t[i - 1])!r} then {float(t[i])!r})",
             path=source,
-            line=row_lines[i],
+            line=table.row_line(i),
             column="Time (s)",
         )
     mag = data[:, 7:10] if data.shape[1] >= 10 else None
@@ -80,4 +83,14 @@ def read_xio_csv(path: str | os.PathLike[str]) -> ImuLog:
     )
 
 
-__all__ = ["is_xio_csv", "read_xio_csv"]
+class XioFormat(ImuFileFormat):
+    """x-io Technologies CSV (:func:`read_xio_csv`)."""
+
+    name = "xio-csv"
+    SOURCES: ClassVar[dict[str, tuple[str, ...]]] = {"imus": (), "imu": (), "identity": ()}
+
+    def read_imu(self) -> ImuLog:
+        return read_xio_csv(self.path)
+
+
+__all__ = ["XioFormat", "is_xio_csv", "read_xio_csv"]

@@ -12,8 +12,9 @@ column      unit
 ``s_acc``   m/s    reported 1σ speed accuracy (> 0)
 =========== ====== =====================================================
 
-``#`` comment lines before the header are allowed; other columns are ignored. Parsing (quotes,
-non-numeric and infinite cells, wrong widths) is that of :func:`uasnav.io.table.read_csv_table`.
+``#`` comment lines before the header are allowed; other columns are ignored. The file is read
+in chunks by the CSV engine (:mod:`uasnav.io._csvstream`), with the errors of a numeric table
+(:func:`uasnav.io.table.read_csv_table`: quotes, non-numeric and infinite cells, wrong widths).
 """
 
 from __future__ import annotations
@@ -24,8 +25,9 @@ import numpy as np
 
 from uasnav.atomicfile import atomic_open
 from uasnav.errors import DataFormatError, InputError
+from uasnav.io._csvstream import read_table
 from uasnav.io.flight import GnssData
-from uasnav.io.table import read_csv_table
+from uasnav.io.table import check_header, write_rows
 
 #: The columns, in order.
 GNSS_COLUMNS = ("t", "lat", "lon", "alt", "vn", "ve", "vd", "h_acc", "v_acc", "s_acc")
@@ -41,12 +43,17 @@ def read_gnss_csv(path: str | os.PathLike[str]) -> GnssData:
         :class:`~uasnav.io.flight.GnssData` refuses (time not increasing, |lat| > 90°,
         accuracies ≤ 0), with the file named.
     """
-    cols, _ = read_csv_table(path)
-    missing = [c for c in GNSS_COLUMNS if c not in cols]
-    if missing:
-        raise DataFormatError(
-            f"GNSS CSV: missing column(s) {', '.join(missing)}", path=str(path), column=missing[0]
-        )
+
+    def select(header: list[str], header_line: int) -> list[str]:
+        check_header(header, header_line, str(path))
+        missing = [c for c in GNSS_COLUMNS if c not in header]
+        if missing:
+            raise DataFormatError(
+                f"GNSS CSV: missing column(s) {', '.join(missing)}", path=str(path), column=missing[0]
+            )
+        return list(GNSS_COLUMNS)
+
+    cols = read_table(path, select, what="GNSS CSV", exact_width=True, nan_ok=True).columns
     if len(cols["t"]) == 0:
         raise DataFormatError("GNSS CSV: no fixes (a header only)", path=str(path))
     try:
@@ -71,5 +78,7 @@ def write_gnss_csv(path: str | os.PathLike[str], gnss: GnssData) -> None:
     )
     with atomic_open(path, "w") as fh:
         fh.write(",".join(GNSS_COLUMNS) + "\n")
-        for row in table:
-            fh.write(",".join(f"{x:.17g}" for x in row) + "\n")
+        write_rows(fh, table)
+
+
+__all__ = ["GNSS_COLUMNS", "read_gnss_csv", "write_gnss_csv"]
