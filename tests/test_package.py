@@ -82,15 +82,21 @@ def venv(tmp_path_factory: pytest.TempPathFactory, wheel: Path) -> Venv:
     return v
 
 
-def test_base_install_runs_help_allan_and_nav(venv: Venv, tmp_path: Path) -> None:
+def test_base_install_runs_help_allan_nav_and_calibrate(venv: Venv, tmp_path: Path) -> None:
     assert venv.run("command -v cargo || command -v rustc", tmp_path).returncode != 0
+    # the base install holds none of the extras' libraries: no Parquet, no Dask, no web, no F3548
+    for mod in ("pyarrow", "fastapi", "distributed", "dask", "uas_standards"):
+        p = venv.run(f"python -c 'import {mod}'", tmp_path)
+        assert p.returncode != 0 and "ModuleNotFoundError" in p.stderr, (mod, p.stderr)
     p = venv.run(
         "python -c 'import uasnav, uasnav._core; print(uasnav.__file__)'\n"
         "uasnav --help\n"
         "uasnav simulate --preset lsm6dsm --profile static --duration 120 --out static.csv\n"
         "uasnav allan static.csv --json > allan.json\n"
         "uasnav simulate --profile flight --seed 3 --out flight.csv\n"
-        "uasnav nav flight.csv --gnss flight_gnss.csv --gnss-outage 60+20 --json > nav.json\n",
+        "uasnav nav flight.csv --gnss flight_gnss.csv --gnss-outage 60+20 --json > nav.json\n"
+        "uasnav simulate --preset ax1 --profile ramp --rate 10 --seed 2 --out ramp.csv\n"
+        "uasnav calibrate ramp.csv --method poly --out model.json --json > calibrate.json\n",
         tmp_path,
     )
     assert p.returncode == 0, p.stderr[-3000:]
@@ -98,14 +104,9 @@ def test_base_install_runs_help_allan_and_nav(venv: Venv, tmp_path: Path) -> Non
     assert "allan" in p.stdout and "nav" in p.stdout
     import json
 
-    allan = json.loads((tmp_path / "allan.json").read_text())
-    nav = json.loads((tmp_path / "nav.json").read_text())
-    assert allan and nav
-    # the base install holds none of the extras
-    p = venv.run("python -c 'import fastapi'", tmp_path)
-    assert p.returncode != 0
-    for mod in ("distributed", "uas_standards"):
-        assert venv.run(f"python -c 'import {mod}'", tmp_path).returncode != 0
+    for name in ("allan", "nav", "calibrate"):
+        assert json.loads((tmp_path / f"{name}.json").read_text()), name
+    assert json.loads((tmp_path / "model.json").read_text())
 
 
 FIELD = '{"type":"Polygon","coordinates":[[[8.54,47.37],[8.544,47.37],[8.544,47.3725],[8.54,47.37]]]}'
@@ -113,13 +114,17 @@ FIELD = '{"type":"Polygon","coordinates":[[[8.54,47.37],[8.544,47.37],[8.544,47.
 
 NEEDS_EXTRA = {
     "web": "uasnav serve --port 8765",
-    "fleet": "uasnav fleet simulate --vehicles 1 --flights 1 --out f\nuasnav fleet scan f --out s.parquet",
+    "fleet": "uasnav fleet simulate --vehicles 1 --flights 1 --out f",
+    "fleet-scan": "mkdir logs\nuasnav fleet scan logs --out s.parquet",
+    # Parquet element datasets need pyarrow, from the fleet extra
+    "fleet-parquet": "printf 'PAR1' > e.parquet\nuasnav trajectory train e.parquet --out m.json",
     "utm": f"printf '%s' '{FIELD}' > a.geojson\nuasnav plan --area a.geojson --out p",
 }
 
 
-@pytest.mark.parametrize(("extra", "command"), sorted(NEEDS_EXTRA.items()))
-def test_missing_extra_names_the_install_line(venv: Venv, tmp_path: Path, extra: str, command: str) -> None:
+@pytest.mark.parametrize(("case", "command"), sorted(NEEDS_EXTRA.items()))
+def test_missing_extra_names_the_install_line(venv: Venv, tmp_path: Path, case: str, command: str) -> None:
+    extra = case.split("-")[0]
     p = venv.run(command, tmp_path)
     assert p.returncode == 1, (p.stdout, p.stderr)
     lines = p.stderr.strip().splitlines()
@@ -188,3 +193,27 @@ def test_wheel_is_portable_abi3_with_licences_and_one_version(wheel: Path) -> No
     auditwheel = Path(sys.executable).parent / "auditwheel"
     p = subprocess.run([str(auditwheel), "show", str(wheel)], capture_output=True, text=True, check=True)
     assert '"manylinux_2_17_x86_64"' in " ".join(p.stdout.split()), p.stdout
+
+
+BLOCK_PYARROW = "import sys; sys.modules['pyarrow'] = None; from uasnav.cli import main; main()"
+
+
+@pytest.mark.parametrize("case", ["fleet-scan", "fleet-parquet"])
+def test_parquet_is_the_fleet_extras_in_the_tree(tmp_path: Path, case: str) -> None:
+    """The same boundaries in this environment with pyarrow made unimportable (a base install)."""
+    import shlex
+
+    prep, command = NEEDS_EXTRA[case].rsplit("\n", 1)
+    subprocess.run(["bash", "-c", prep], cwd=tmp_path, check=True)
+    argv = shlex.split(command)[1:]
+    p = subprocess.run(
+        [sys.executable, "-c", BLOCK_PYARROW, *argv], cwd=tmp_path, capture_output=True, text=True, timeout=120
+    )
+    assert p.returncode == 1, (p.stdout, p.stderr)
+    assert p.stderr.strip().splitlines() == [
+        p.stderr.strip().splitlines()[0]
+    ] and "(pyarrow is not installed): pip install 'uasnav[fleet]'" in p.stderr, p.stderr
+    # training from flight logs alone imports the element table without pyarrow
+    code = BLOCK_PYARROW.replace("from uasnav.cli import main; main()", "")
+    code += "from uasnav.trajectory.element_table import training_samples, is_element_dataset"
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
