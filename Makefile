@@ -61,10 +61,11 @@ dist: wheel
 	for w in $(DIST)/uasnav-*.whl; do $(BIN)/auditwheel show $$w | tr '\n' ' ' | grep -q 'manylinux_2_17' || { echo "error: $$w is not manylinux2014"; exit 1; }; done
 	ls -l $(DIST)
 
-# The documentation site (mkdocs-material, offline: no web fonts, no CDN), warnings as errors.
+# The documentation site (mkdocs-material, offline: no web fonts, no CDN), warnings as errors
+# (not -q: mkdocs drops its warnings below the log level before --strict can count them).
 docs: setup
 	$(BIN)/python docs/gen_reference.py
-	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -q -d build/site
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -d build/site
 	$(BIN)/python docs/check_offline.py build/site
 
 # The core crate as crates.io would receive it, and its docs without warnings.

@@ -75,3 +75,32 @@ def test_offline_check_finds_network_loads(tmp_path: Path) -> None:
     ):
         (tmp_path / "index.html").write_text(f"<html><head>{bad}</head></html>")
         assert check_offline(str(tmp_path)) == 1, bad
+
+
+def test_offline_check_accounts_for_every_url_of_a_script(tmp_path: Path) -> None:
+    page = "<html><body><p>ok</p></body></html>"
+    (tmp_path / "index.html").write_text(page)
+    js = tmp_path / "bundle.js"
+    guarded = 'var a=typeof ResizeObserver=="undefined"?_t("https://unpkg.com/resize-observer-polyfill"):0;'
+    comments = '/*! lib v1 * https://example.org/licence */ var g="**/*.js"; // see http://example.org\n'
+    js.write_text(comments + guarded)
+    assert check_offline(str(tmp_path)) == 0
+    # a URL the table does not know, one that lost its guard, one after a `/*` inside a string
+    for bad in (
+        'fetch("https://cdn.example.org/x.json")',
+        '_t("https://unpkg.com/resize-observer-polyfill")',
+        'var g="**/*.js";fetch("https://cdn.example.org/x.json");',
+        "var r=/\\/*/;fetch('https://cdn.example.org/x.json');",
+    ):
+        js.write_text(comments + bad)
+        assert check_offline(str(tmp_path)) == 1, bad
+    # a dormant request becomes live when a page has what triggers it
+    js.write_text(
+        'function as(){return typeof mermaid=="undefined"||mermaid instanceof Element?'
+        '_t("https://unpkg.com/mermaid@11/dist/mermaid.min.js"):0}'
+        "function Ci(e,t){let r=`https://api.github.com/repos/${e}/${t}`;}"
+    )
+    assert check_offline(str(tmp_path)) == 0
+    for trigger in ('<pre class="mermaid">graph</pre>', '<a href="x" data-md-component="source">'):
+        (tmp_path / "index.html").write_text(f"<html><body>{trigger}</body></html>")
+        assert check_offline(str(tmp_path)) == 1, trigger

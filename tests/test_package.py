@@ -82,30 +82,29 @@ def venv(tmp_path_factory: pytest.TempPathFactory, wheel: Path) -> Venv:
     return v
 
 
-def test_base_install_runs_help_allan_and_nav(venv: Venv, tmp_path: Path) -> None:
+def test_base_install_runs_the_base_quick_starts(venv: Venv, tmp_path: Path) -> None:
+    """Before any extra is installed: `uasnav --help`, and the quick starts that need no extra
+    (`nav`, `allan`, `calibrate` on generated CSV) exactly as the README writes them."""
     assert venv.run("command -v cargo || command -v rustc", tmp_path).returncode != 0
-    p = venv.run(
-        "python -c 'import uasnav, uasnav._core; print(uasnav.__file__)'\n"
-        "uasnav --help\n"
-        "uasnav simulate --preset lsm6dsm --profile static --duration 120 --out static.csv\n"
-        "uasnav allan static.csv --json > allan.json\n"
-        "uasnav simulate --profile flight --seed 3 --out flight.csv\n"
-        "uasnav nav flight.csv --gnss flight_gnss.csv --gnss-outage 60+20 --json > nav.json\n",
-        tmp_path,
-    )
+    # the base install holds none of the extras' libraries: no Parquet, no Dask, no web, no F3548
+    for mod in ("pyarrow", "fastapi", "distributed", "dask", "uas_standards"):
+        p = venv.run(f"python -c 'import {mod}'", tmp_path)
+        assert p.returncode != 0 and "ModuleNotFoundError" in p.stderr, (mod, p.stderr)
+    p = venv.run("python -c 'import uasnav, uasnav._core; print(uasnav.__file__)'\nuasnav --help", tmp_path)
     assert p.returncode == 0, p.stderr[-3000:]
     assert str(venv.path) in p.stdout.splitlines()[0]  # the installed package, not the tree
     assert "allan" in p.stdout and "nav" in p.stdout
-    import json
-
-    allan = json.loads((tmp_path / "allan.json").read_text())
-    nav = json.loads((tmp_path / "nav.json").read_text())
-    assert allan and nav
-    # the base install holds none of the extras
-    p = venv.run("python -c 'import fastapi'", tmp_path)
-    assert p.returncode != 0
-    for mod in ("distributed", "uas_standards"):
-        assert venv.run(f"python -c 'import {mod}'", tmp_path).returncode != 0
+    base = [(title, block) for title, block in quick_starts(README.read_text()) if not PIP.search(block)]
+    commands = " ".join(block for _, block in base)
+    assert all(f"uasnav {c} " in commands for c in ("nav", "allan", "calibrate")), commands
+    for title, block in base:
+        folder = tmp_path / title.split(":")[0].replace(" ", "-")
+        folder.mkdir()
+        p = venv.run(block, folder)
+        assert p.returncode == 0, f"{title}\n{p.stdout[-2000:]}\n{p.stderr[-3000:]}"
+        assert "error:" not in p.stderr, p.stderr
+    assert (tmp_path / "IMU-lab" / "model.json").stat().st_size > 0
+    assert (tmp_path / "Navigation-engineer" / "track.csv").stat().st_size > 0
 
 
 FIELD = '{"type":"Polygon","coordinates":[[[8.54,47.37],[8.544,47.37],[8.544,47.3725],[8.54,47.37]]]}'
@@ -113,13 +112,17 @@ FIELD = '{"type":"Polygon","coordinates":[[[8.54,47.37],[8.544,47.37],[8.544,47.
 
 NEEDS_EXTRA = {
     "web": "uasnav serve --port 8765",
-    "fleet": "uasnav fleet simulate --vehicles 1 --flights 1 --out f\nuasnav fleet scan f --out s.parquet",
+    "fleet": "uasnav fleet simulate --vehicles 1 --flights 1 --out f",
+    "fleet-scan": "mkdir logs\nuasnav fleet scan logs --out s.parquet",
+    # Parquet element datasets need pyarrow, from the fleet extra
+    "fleet-parquet": "printf 'PAR1' > e.parquet\nuasnav trajectory train e.parquet --out m.json",
     "utm": f"printf '%s' '{FIELD}' > a.geojson\nuasnav plan --area a.geojson --out p",
 }
 
 
-@pytest.mark.parametrize(("extra", "command"), sorted(NEEDS_EXTRA.items()))
-def test_missing_extra_names_the_install_line(venv: Venv, tmp_path: Path, extra: str, command: str) -> None:
+@pytest.mark.parametrize(("case", "command"), sorted(NEEDS_EXTRA.items()), ids=sorted(NEEDS_EXTRA))
+def test_missing_extra_names_the_install_line(venv: Venv, tmp_path: Path, case: str, command: str) -> None:
+    extra = case.split("-")[0]
     p = venv.run(command, tmp_path)
     assert p.returncode == 1, (p.stdout, p.stderr)
     lines = p.stderr.strip().splitlines()
@@ -156,13 +159,16 @@ def test_readme_is_short_and_has_a_quick_start_per_user() -> None:
     assert [ln for ln in ci.splitlines() if ln.startswith("make")] == ["make test"]
 
 
-@pytest.mark.parametrize("index", range(5))
-def test_readme_quick_start_runs_as_written(venv: Venv, tmp_path: Path, index: int) -> None:
-    title, block = quick_starts(README.read_text())[index]
+PIP = re.compile(r"pip install 'uasnav\[(\w+)\]'")
+WITH_EXTRA = [t for t, b in quick_starts(README.read_text()) if PIP.search(b)]
+
+
+@pytest.mark.parametrize("title", WITH_EXTRA)
+def test_readme_quick_start_with_an_extra_runs_as_written(venv: Venv, tmp_path: Path, title: str) -> None:
+    """The quick starts that install an extra (those without one run in the base test)."""
+    block = dict(quick_starts(README.read_text()))[title]
     # `pip install 'uasnav[x]'` takes the extra from the wheel under test, dependencies from PyPI
-    script = re.sub(
-        r"pip install 'uasnav\[(\w+)\]'", lambda m: f"pip install -q '{venv.wheel}[{m.group(1)}]'", block
-    )
+    script = PIP.sub(lambda m: f"pip install -q '{venv.wheel}[{m.group(1)}]'", block)
     p = venv.run(script, tmp_path, timeout=900)
     assert p.returncode == 0, f"{title}\n{p.stdout[-2000:]}\n{p.stderr[-3000:]}"
     assert "error:" not in p.stderr, p.stderr
@@ -188,3 +194,30 @@ def test_wheel_is_portable_abi3_with_licences_and_one_version(wheel: Path) -> No
     auditwheel = Path(sys.executable).parent / "auditwheel"
     p = subprocess.run([str(auditwheel), "show", str(wheel)], capture_output=True, text=True, check=True)
     assert '"manylinux_2_17_x86_64"' in " ".join(p.stdout.split()), p.stdout
+
+
+BLOCK_PYARROW = "import sys; sys.modules['pyarrow'] = None; from uasnav.cli import main; main()"
+
+
+@pytest.mark.parametrize("case", ["fleet-scan", "fleet-parquet"])
+def test_parquet_is_the_fleet_extras_in_the_tree(tmp_path: Path, case: str) -> None:
+    """The same boundaries in this environment with pyarrow made unimportable (a base install)."""
+    import shlex
+
+    prep, command = NEEDS_EXTRA[case].rsplit("\n", 1)
+    subprocess.run(["bash", "-c", prep], cwd=tmp_path, check=True)
+    argv = shlex.split(command)[1:]
+    p = subprocess.run(
+        [sys.executable, "-c", BLOCK_PYARROW, *argv],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert p.returncode == 1, (p.stdout, p.stderr)
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and "(pyarrow is not installed): pip install 'uasnav[fleet]'" in lines[0], p.stderr
+    # training from flight logs alone imports the element table without pyarrow
+    code = BLOCK_PYARROW.replace("from uasnav.cli import main; main()", "")
+    code += "from uasnav.trajectory.element_table import training_samples, is_element_dataset"
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)

@@ -10,7 +10,8 @@ web       ``uasnav serve`` (the local web application)           fastapi, uvicor
                                                                  python-multipart
 utm       operational intents (ASTM F3548), ``uasnav utm``,      uas-standards, pyyaml
           ``plan``, ``monitor``, ``trajectory intent``
-fleet     ``uasnav fleet`` on a local Dask cluster               dask[distributed]
+fleet     ``uasnav fleet`` on a local Dask cluster, Parquet      dask[distributed], pyarrow
+          datasets (also read by ``trajectory train``)
 all       everything above
 ========  =====================================================  ==================================
 
@@ -29,7 +30,7 @@ from uasnav.errors import UasnavError
 EXTRAS: dict[str, tuple[str, ...]] = {
     "web": ("fastapi", "uvicorn", "jinja2", "multipart"),
     "utm": ("uas_standards", "yaml"),
-    "fleet": ("dask", "distributed"),
+    "fleet": ("dask", "distributed", "pyarrow"),
 }
 
 

@@ -17,12 +17,17 @@ analysis: :mod:`~uasnav.fleet.scan`, :mod:`~uasnav.fleet.imu_health` (with
 writes synthetic fleets and :mod:`~uasnav.fleet.html` the ``--report`` page.
 """
 
-from uasnav.fleet.anomaly import read_scores
-from uasnav.fleet.imu_health import IMU_HEALTH
-from uasnav.fleet.output import read_dataset, read_errors
-from uasnav.fleet.runner import Analysis, LogRows, RunSummary, local_cluster, run
-from uasnav.fleet.scan import SCAN
-from uasnav.fleet.simulate import simulate_fleet
+from uasnav._extras import require
+
+# the whole package writes and reads Parquet on Dask: one line naming the extra, before any import
+require("fleet", "uasnav fleet")
+
+from uasnav.fleet.anomaly import read_scores  # noqa: E402
+from uasnav.fleet.imu_health import IMU_HEALTH  # noqa: E402
+from uasnav.fleet.output import read_dataset, read_errors  # noqa: E402
+from uasnav.fleet.runner import Analysis, LogRows, RunSummary, local_cluster, run  # noqa: E402
+from uasnav.fleet.scan import SCAN  # noqa: E402
+from uasnav.fleet.simulate import simulate_fleet  # noqa: E402
 
 __all__ = [
     "IMU_HEALTH",

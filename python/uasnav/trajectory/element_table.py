@@ -34,37 +34,58 @@ output of ``uasnav fleet elements``, whose extra key columns are ignored) back i
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pyarrow as pa
 
+from uasnav._extras import require
 from uasnav.errors import InputError
 from uasnav.trajectory.features import Features
 from uasnav.trajectory.samples import ElementSamples
 
-ELEMENT_SCHEMA = pa.schema(
-    [
-        pa.field("run", pa.int32()),
-        pa.field("element", pa.int32()),
-        pa.field("segment_m", pa.float64()),
-        pa.field("theta_deg", pa.float64()),
-        pa.field("theta_w_deg", pa.float64()),
-        pa.field("wind_ms", pa.float64()),
-        pa.field("kind", pa.int8()),
-        pa.field("mirrored", pa.bool_()),
-        pa.field("length_m", pa.float64()),
-        pa.field("t_real_s", pa.float64()),
-        pa.field("v_init_ms", pa.float64()),
-        pa.field("v_ref_ms", pa.float64()),
-        pa.field("dv_ms", pa.float64()),
-        pa.field("element_kind", pa.string()),
-        pa.field("climb_rate_ms", pa.float64()),
-    ]
-)
+if TYPE_CHECKING:
+    import pyarrow as pa
+
+
+@functools.cache
+def _schema() -> pa.Schema:
+    """The element table's Arrow schema (pyarrow, from the fleet extra, is imported here: training
+    from flight logs alone needs none of it)."""
+    require("fleet", "reading or writing element datasets (Parquet)")
+    import pyarrow as pa
+
+    return pa.schema(
+        [
+            pa.field("run", pa.int32()),
+            pa.field("element", pa.int32()),
+            pa.field("segment_m", pa.float64()),
+            pa.field("theta_deg", pa.float64()),
+            pa.field("theta_w_deg", pa.float64()),
+            pa.field("wind_ms", pa.float64()),
+            pa.field("kind", pa.int8()),
+            pa.field("mirrored", pa.bool_()),
+            pa.field("length_m", pa.float64()),
+            pa.field("t_real_s", pa.float64()),
+            pa.field("v_init_ms", pa.float64()),
+            pa.field("v_ref_ms", pa.float64()),
+            pa.field("dv_ms", pa.float64()),
+            pa.field("element_kind", pa.string()),
+            pa.field("climb_rate_ms", pa.float64()),
+        ]
+    )
+
+
+def __getattr__(name: str) -> Any:
+    # ELEMENT_SCHEMA is built on first use, so importing this module needs no pyarrow
+    if name == "ELEMENT_SCHEMA":
+        return _schema()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 #: Columns a table may lack (written before they existed).
 OPTIONAL_COLUMNS = ("element_kind", "climb_rate_ms")
 
@@ -96,7 +117,7 @@ def from_table(table: pa.Table, run_key: Sequence[str] = ("run",)) -> tuple[Elem
     InputError
         Missing columns, no rows, or elements cut with different segment lengths.
     """
-    missing = [n for n in ELEMENT_SCHEMA.names if n not in table.column_names and n not in OPTIONAL_COLUMNS]
+    missing = [n for n in _schema().names if n not in table.column_names and n not in OPTIONAL_COLUMNS]
     if missing:
         raise InputError(f"element table: missing column(s) {', '.join(missing)}")
     if table.num_rows == 0:
@@ -137,10 +158,12 @@ def _conform(table: pa.Table, path: Path) -> pa.Table:
     """``table`` with the element columns cast to :data:`ELEMENT_SCHEMA`'s types; a file of
     another schema (missing columns, text where numbers belong) is an :class:`InputError`
     naming the file and the column."""
-    missing = [n for n in ELEMENT_SCHEMA.names if n not in table.column_names and n not in OPTIONAL_COLUMNS]
+    missing = [n for n in _schema().names if n not in table.column_names and n not in OPTIONAL_COLUMNS]
     if missing:
         raise InputError(f"{path}: not an element dataset: missing column(s) {', '.join(missing)}")
-    for field in ELEMENT_SCHEMA:
+    import pyarrow as pa
+
+    for field in _schema():
         if field.name not in table.column_names:
             continue
         i = table.schema.get_field_index(field.name)
@@ -161,11 +184,13 @@ def read_element_dataset(path: str | os.PathLike[str]) -> tuple[ElementSamples, 
     Rows are ordered by (log_hash, run, element) when the fleet's ``log_hash`` column is there,
     so the result does not depend on the order files were written in.
     """
-    import pyarrow.dataset as pads
-
     p = Path(path)
     if not p.exists():
         raise InputError(f"{p}: no such element dataset")
+    _schema()  # the fleet extra (pyarrow), named in one line when missing
+    import pyarrow as pa
+    import pyarrow.dataset as pads
+
     if p.is_dir():
         files = sorted(
             str(f)
@@ -230,7 +255,7 @@ def training_samples(
 
 
 __all__ = [
-    "ELEMENT_SCHEMA",
+    "ELEMENT_SCHEMA",  # noqa: F822 (module __getattr__)
     "from_table",
     "is_element_dataset",
     "read_element_dataset",
