@@ -94,17 +94,23 @@ def start_pair(receiver: list[str], sender: list[str], port: int, proto: str = "
     return Pair(rx, tx)
 
 
+#: ArduCopter's AUTO in HEARTBEAT.custom_mode.
+AUTO = 3
+
+
 @pytest.fixture(scope="module")
 def flown(shared_data):
-    """From the tlog's own runs: the UTC of the second flight's arming, and the climb and
-    descent speeds the runs achieved from arming to the take-off waypoint and from the last
-    waypoint to disarming (m/s; ArduCopter slows its landing near the ground)."""
+    """From the tlog's own runs: the UTC at which the second flight's mission started (AUTO, the
+    time the runs are measured from), and the climb and descent speeds the runs achieved from
+    the mission's start to the take-off waypoint and from the last waypoint to disarming (m/s;
+    ArduCopter slows its landing near the ground)."""
     from pymavlink import mavutil
 
     m = mavutil.mavlink_connection(str(shared_data / TLOG), dialect="ardupilotmega")
     t0 = offset = None
     armed = False
-    arms: list[tuple[float, float]] = []  # (log s, boot s)
+    starts: list[tuple[float, float]] = []  # (log s, boot s) of each mission start
+    last_arm = -1.0
     climbs, descents, last_wp = [], [], None
     boot = 0.0
     clock: list[tuple[float, float]] = []  # (log s, boot s)
@@ -122,17 +128,19 @@ def flown(shared_data):
         elif msg.get_type() == "HEARTBEAT" and msg.get_srcSystem() == 1:
             now = bool(msg.base_mode & 128)
             if now and not armed:
-                arms.append((t, boot))
-            elif armed and not now and last_wp is not None:
+                last_arm = t
+            if now and msg.custom_mode == AUTO and (not starts or starts[-1][0] < last_arm):
+                starts.append((t, boot))
+            if armed and not now and last_wp is not None:
                 descents.append(t - last_wp)
                 last_wp = None
             armed = now
-        elif msg.get_type() == "MISSION_ITEM_REACHED" and arms:
+        elif msg.get_type() == "MISSION_ITEM_REACHED" and starts:
             if msg.seq == 1:
-                climbs.append(t - arms[-1][0])
+                climbs.append(t - starts[-1][0])
             elif msg.seq == 3:
                 last_wp = t
-    second = next(b for t, b in arms if t > RUN[0])
+    second = next(b for t, b in starts if t > RUN[0])
     alt = 20.0  # the plan's take-off and waypoint altitude above home
     return {
         "utc": datetime.fromtimestamp(offset + second, timezone.utc),
@@ -143,28 +151,40 @@ def flown(shared_data):
 
 
 @pytest.fixture(scope="module")
-def intent(shared_data, flown, tmp_path_factory):
-    """An intent for the tlog's plan departing at the second flight's arming, from a model
-    trained on the tlog's own runs (its autopilot limits and speed), with the climb and descent
-    speeds its runs achieved. The whole plan is filed, including its first waypoint 2.8 m from
-    home (``trajectory intent`` merges such short legs into their neighbours)."""
+def phoenix(shared_data, tmp_path_factory):
+    """The tlog's whole plan (its first waypoint 2.8 m from home included: ``trajectory
+    intent`` merges such short legs into their neighbours) and a model trained on the tlog's
+    own runs (its autopilot limits and speed)."""
     from uasnav.io.plans import read_plan, write_plan
 
     d = tmp_path_factory.mktemp("live")
-    model, out, plan = d / "model.json", d / "phoenix.json", d / "phoenix.plan"
+    model, plan = d / "model.json", d / "phoenix.plan"
     tlog = str(shared_data / TLOG)
-    p = read_plan(tlog)
-    write_plan(p, plan)
+    write_plan(read_plan(tlog), plan)
     r = CliRunner().invoke(main, ["trajectory", "train", tlog, "--out", str(model)])
     assert r.exit_code == 0, r.output
+    return {"model": model, "plan": plan, "dir": d}
+
+
+@pytest.fixture(scope="module")
+def intent(shared_data, flown, phoenix):
+    """An intent for the tlog's plan departing at the second flight's mission start, with the
+    climb and descent speeds its runs achieved and time bounds from how this prediction missed
+    the tlog's own five AUTO runs (``--flights``)."""
+    out = phoenix["dir"] / "phoenix.json"
+    tlog = str(shared_data / TLOG)
     start = flown["utc"].isoformat().replace("+00:00", "Z")
     r = CliRunner().invoke(
         main,
-        ["trajectory", "intent", "--model", str(model), "--plan", str(plan), "--wind", "0@0",
-         "--start", start, "--limits-from", tlog, "--climb-rate", f"{flown['climb_ms']:.3f}",
-         "--descent-rate", f"{flown['descent_ms']:.3f}", "--calibration-runs", "20", "--out", str(out)],
+        ["trajectory", "intent", "--model", str(phoenix["model"]), "--plan", str(phoenix["plan"]),
+         "--wind", "0@0", "--start", start, "--limits-from", tlog, "--climb-rate", f"{flown['climb_ms']:.3f}",
+         "--descent-rate", f"{flown['descent_ms']:.3f}", "--flights", tlog, "--json", "--out", str(out)],
     )  # fmt: skip
     assert r.exit_code == 0, r.output
+    source = json.loads(r.output)["time_bounds_source"]
+    assert source.startswith("5 AUTO runs of the vehicle (phoenix_mission1_arducopter.tlog): Student-t"), (
+        source
+    )
     return out
 
 
@@ -247,6 +267,53 @@ def test_replayed_flight_stays_activated_and_ends_on_landing(monitored):
     assert all(e["latency_ms"] >= 0 for e in ev if e["event"] == "state" and e["state"] != "Accepted")
 
 
+def test_every_flight_conforms_to_an_intent_from_its_other_runs(shared_data, flown, phoenix):
+    """Held out in 4D: each of the tlog's five AUTO flights, its messages fed to the monitor
+    offline, against an intent for its own mission start whose 95 % time bounds come from the
+    other four runs only, stays Activated from arming (it waits on the pad before its first
+    volume opens) and Ends."""
+    from uasnav.io import open_log
+    from uasnav.io.operational_intent import NamedIntent
+    from uasnav.io.plans import read_plan
+    from uasnav.live.conformance import ConformanceMonitor
+    from uasnav.live.source import log_packets
+    from uasnav.trajectory.mission_runs import MISSION_VIEWS
+    from uasnav.trajectory.models import load_model
+    from uasnav.trajectory.timebounds import PaceBounds
+    from uasnav.utm.intent import build_intent, vehicle_run_times
+
+    log = open_log(shared_data / TLOG, need=("limits", *MISSION_VIEWS))
+    model, plan = load_model(phoenix["model"]), read_plan(phoenix["plan"])
+    kw = {"climb_ms": flown["climb_ms"], "descent_ms": flown["descent_ms"],
+          "accel_z_ms2": log.limits.accel_z_ms2, "cruise_ms": log.limits.cruise_ms}  # fmt: skip
+    runs, _ = vehicle_run_times([log], model, np.zeros(2), **kw)
+    packets = [p for p in log_packets(shared_data / TLOG) if p.msg.get_srcSystem() == 1]
+    flights, armed, boot, to_unix, auto = [], False, 0.0, 0.0, None
+    for k, p in enumerate(packets):  # (first packet, mission start UTC, last packet) of each flight
+        m = p.msg
+        boot = m.time_boot_ms * 1e-3 if getattr(m, "time_boot_ms", None) is not None else boot
+        if m.get_type() == "SYSTEM_TIME" and m.time_unix_usec:
+            to_unix = m.time_unix_usec * 1e-6 - boot
+        if m.get_type() == "HEARTBEAT" and m.autopilot != 8:
+            now = bool(m.base_mode & 128)
+            if now and not armed:
+                first, auto = max(k - 200, 0), None
+            if now and m.custom_mode == AUTO and auto is None:
+                auto = to_unix + boot
+            if armed and not now and auto is not None:
+                flights.append((first, auto, k + 1))
+            armed = now
+    assert len(flights) == len(runs) == 5
+    for j, (a, start, b) in enumerate(flights):
+        model.time_bounds_ = PaceBounds.of_runs([r for i, r in enumerate(runs) if i != j], 10.0, "four runs")
+        built = build_intent(plan, model, np.zeros(2), datetime.fromtimestamp(start, timezone.utc), **kw)
+        monitor = ConformanceMonitor([NamedIntent("phoenix", built.details)])
+        events = [e for p in packets[a:b] for e in monitor.on_message(p.msg, p.t_s)]
+        assert states(events) == ["Accepted", "Activated", "Ended"], (j, transitions(events))
+        act = transitions(events)[1]
+        assert act["reason"] == "armed" and act["volume"] == 0 and act["margin_m"] > 0
+
+
 @pytest.fixture(scope="module")
 def recorded_gaps(shared_data) -> int:
     """Gaps in the tlog's own MAVLink sequence numbers over the replayed window: packets its
@@ -284,6 +351,9 @@ def test_monitor_receives_every_packet_sent(monitored, recorded_gaps, scenario):
     if kernel == 0:
         assert count(r"(\d+) lost by sequence number", m.summary) == recorded_gaps > 0
     assert states(m.events) == ["Accepted", "Activated", "Ended"], m.events
+    if scenario == "tcp":  # every report arrives: Ended at the first one on the ground, before disarming
+        end = transitions(m.events)[-1]
+        assert end["reason"].startswith("landed") and end["time_boot_s"] < 147.0, end
 
 
 def test_offset_goes_nonconforming_and_back(monitored, flown):
