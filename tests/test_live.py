@@ -422,6 +422,80 @@ def test_replay_tcpin_serves_the_first_receiver(shared_data):
     assert len(msgs) == sent > 100 and count(r"\((\d+) bytes", err) == len(data)
 
 
+def _packets(n: int) -> bytes:
+    """``n`` HEARTBEAT + GLOBAL_POSITION_INT pairs from vehicle 1 as bytes on the wire."""
+    from uasnav.live.source import mavlink_dialect
+
+    d = mavlink_dialect()
+    mav = d.MAVLink(None, srcSystem=1, srcComponent=1)
+    out = bytearray()
+    for k in range(n):
+        out += mav.heartbeat_encode(2, 3, 0, 0, 4).pack(mav)
+        pos = mav.global_position_int_encode(1000 * k, 492574131, -1232431096, 92000, 0, 0, 0, 0, 0)
+        out += pos.pack(mav)
+    return bytes(out)
+
+
+@pytest.mark.parametrize("mode", ["tcp", "tcpin"])
+def test_monitor_tcp_stream_ends_when_the_sender_closes(intent, mode):
+    """Over TCP the monitor ends by itself when the sender closes (no --idle-exit: neither a
+    reconnecting nor a spinning receiver would end), and its standard output holds only the
+    JSON lines (pymavlink's own TCP connections print "EOF on TCP socket" there)."""
+    payload = _packets(20)
+    if mode == "tcp":  # the monitor connects to this listening sender
+        server = socket.create_server(("127.0.0.1", 0))
+        port = server.getsockname()[1]
+        rx = subprocess.Popen(
+            [*uasnav_command(), "monitor", f"tcp:127.0.0.1:{port}", "--intent", str(intent),
+             "--json-lines"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        server.settimeout(60)
+        with server, server.accept()[0] as conn:
+            conn.sendall(payload)
+    else:  # the monitor listens; this sender connects
+        port = free_port(socket.SOCK_STREAM)
+        rx = subprocess.Popen(
+            [*uasnav_command(), "monitor", f"tcpin:127.0.0.1:{port}", "--intent", str(intent),
+             "--json-lines"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        deadline = time.monotonic() + 60.0
+        while not listening(port, "tcp"):
+            assert rx.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        with socket.create_connection(("127.0.0.1", port), timeout=60) as conn:
+            conn.sendall(payload)
+    try:
+        out, err = rx.communicate(timeout=60)
+    finally:
+        if rx.poll() is None:
+            rx.kill()
+            rx.wait()
+    assert rx.returncode == 0, err
+    events = [json.loads(line) for line in out.splitlines()]  # every line is JSON
+    assert states(events) == ["Accepted"], events
+    summary = err.strip().splitlines()[-1]
+    assert count(r"(\d+) messages received", summary) == 40, summary
+    assert summary.endswith("; the sender closed the connection"), summary
+    assert "EOF" not in out + err
+
+
+def test_tcp_stream_errors_are_one_line(intent, monkeypatch):
+    import uasnav.live.stream as st
+
+    monkeypatch.setattr(st, "CONNECT_WAIT_S", 0.3)
+    port = free_port(socket.SOCK_STREAM)  # closed again: nobody listens
+    r = CliRunner().invoke(main, ["monitor", f"tcp:127.0.0.1:{port}", "--intent", str(intent)])
+    assert r.exit_code == 1 and r.output.count("\n") == 1, r.output
+    assert r.output.startswith(f"error: connection 'tcp:127.0.0.1:{port}': cannot connect"), r.output
+    with pytest.raises(Exception, match="expected tcpin:HOST:PORT"):
+        st.open_connection("tcpin:127.0.0.1:http")
+    with socket.create_server(("127.0.0.1", 0)) as busy:  # the port is taken
+        with pytest.raises(Exception, match="cannot listen"):
+            st.open_connection(f"tcpin:127.0.0.1:{busy.getsockname()[1]}")
+
+
 def test_nav_live_equals_causal_bit_for_bit(shared_data, tmp_path):
     log = str(shared_data / LOG171)
     port = free_port()

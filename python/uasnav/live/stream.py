@@ -4,12 +4,20 @@
 ``tcp:HOST:PORT`` (connect), ``tcpin:HOST:PORT`` (listen for one sender), ``/dev/ttyX,BAUD`` (a
 serial port and its baud rate). Messages are decoded
 with the ``ardupilotmega`` dialect; packets that fail their checksum are dropped by pymavlink.
+
+UDP and serial ports are pymavlink's connections. The TCP forms are :class:`TcpStream`, owned
+here: pymavlink's TCP connections print to standard output (which carries ``monitor
+--json-lines``) and reconnect, or poll a closed socket, after the sender closes. A TCP stream
+ends when its sender closes it, and :func:`receive` returns then.
 """
 
 from __future__ import annotations
 
+import select
 import signal
+import socket
 import time
+from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -18,6 +26,114 @@ from uasnav.errors import InputError
 
 #: How long one wait for a message lasts (s): the granularity of ticks (telemetry loss).
 POLL_S = 0.02
+
+
+#: How long ``tcp:`` keeps trying to connect to a sender that is not listening yet (s).
+CONNECT_WAIT_S = 10.0
+
+
+class TcpStream:
+    """A MAVLink stream over TCP: ``tcp`` connects to a sender, ``tcpin`` listens and takes the
+    first sender that connects. The stream is over (:attr:`closed`, :attr:`end`) when the sender
+    closes it; nothing is printed, nothing reconnects.
+
+    It offers what :func:`receive` and the commands use of a pymavlink connection:
+    :meth:`recv_match`, :meth:`close` and ``port`` (the connected socket, ``None`` before a
+    ``tcpin`` sender connects).
+    """
+
+    def __init__(self, scheme: str, host: str, port: int, *, wait_s: float | None = None) -> None:
+        from uasnav.live.source import mavlink_dialect
+
+        where = f"{scheme}:{host}:{port}"
+        self.port: socket.socket | None = None
+        self._server: socket.socket | None = None
+        self.closed = False
+        self.end: str | None = None
+        self._pending: deque[Any] = deque()
+        self._mav = mavlink_dialect().MAVLink(None)
+        self._mav.robust_parsing = True
+        try:
+            family, kind, proto, _, addr = socket.getaddrinfo(
+                host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE if scheme == "tcpin" else 0
+            )[0]
+        except (OSError, UnicodeError) as e:
+            raise InputError(f"connection {where!r}: cannot resolve {host} ({e})") from None
+        if scheme == "tcpin":
+            server = socket.socket(family, kind, proto)
+            server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                server.bind(addr)
+            except OSError as e:
+                server.close()
+                raise InputError(f"connection {where!r}: cannot listen ({e.strerror or e})") from None
+            server.listen(1)
+            self._server = server
+            return
+        wait_s = CONNECT_WAIT_S if wait_s is None else wait_s
+        deadline = time.monotonic() + wait_s
+        while True:
+            sock = socket.socket(family, kind, proto)
+            try:
+                sock.connect(addr)
+                break
+            except OSError as e:
+                sock.close()
+                if not isinstance(e, ConnectionRefusedError) or time.monotonic() >= deadline:
+                    raise InputError(
+                        f"connection {where!r}: cannot connect ({e.strerror or e}; waited {wait_s:g} s)"
+                    ) from None
+                time.sleep(0.1)  # the sender is not listening yet
+        self._connected(sock)
+
+    def _connected(self, sock: socket.socket) -> None:
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        sock.setblocking(False)
+        self.port = sock
+
+    def recv_match(self, blocking: bool = True, timeout: float | None = None) -> Any:
+        """The next message, or ``None`` when none came within ``timeout`` (s) or the stream
+        is over."""
+        wait = (timeout if timeout is not None else 1e9) if blocking else 0.0
+        deadline = time.monotonic() + wait
+        while not self._pending and not self.closed:
+            if self.port is None:  # tcpin: no sender yet
+                assert self._server is not None
+                ready, _, _ = select.select([self._server], [], [], max(deadline - time.monotonic(), 0.0))
+                if ready:
+                    sock, _ = self._server.accept()
+                    self._server.close()
+                    self._server = None
+                    self._connected(sock)
+                elif time.monotonic() >= deadline:
+                    return None
+                continue
+            ready, _, _ = select.select([self.port], [], [], max(deadline - time.monotonic(), 0.0))
+            if not ready:
+                return None
+            try:
+                data = self.port.recv(65536)
+            except BlockingIOError:
+                continue
+            except OSError as e:
+                self._over(f"the connection failed ({e.strerror or e})")
+                break
+            if not data:
+                self._over("the sender closed the connection")
+                break
+            self._pending.extend(m for m in self._mav.parse_buffer(data) or [] if m.get_type() != "BAD_DATA")
+        return self._pending.popleft() if self._pending else None
+
+    def _over(self, why: str) -> None:
+        self.closed, self.end = True, why
+
+    def close(self) -> None:
+        for sock in (self.port, self._server):
+            if sock is not None:
+                sock.close()
+        self._server = None
+        if not self.closed:
+            self._over("closed by this receiver")
 
 
 def open_connection(text: str) -> Any:
@@ -30,6 +146,11 @@ def open_connection(text: str) -> Any:
             f"connection {text!r}: expected udpin:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT, "
             "tcpin:HOST:PORT or /dev/ttyX,BAUD"
         )
+    if head in ("tcp", "tcpin"):
+        host, _, port = text.split(":", 1)[1].rpartition(":")
+        if not host or not port.isdigit() or not 0 < int(port) < 65536:
+            raise InputError(f"connection {text!r}: expected {head}:HOST:PORT")
+        return TcpStream(head, host, int(port))
     kw: dict[str, Any] = {"dialect": "ardupilotmega", "autoreconnect": True}
     if text.startswith("/dev/"):
         dev, _, baud = text.partition(",")
@@ -69,7 +190,6 @@ UDP_RCVBUF = 8 * 1024 * 1024
 
 def _enlarge_buffer(conn: Any) -> None:
     import contextlib
-    import socket
 
     sock = getattr(conn, "port", None)
     if isinstance(sock, socket.socket) and sock.type == socket.SOCK_DGRAM:
@@ -82,7 +202,6 @@ def kernel_drops(conn: Any) -> int | None:
     was full (Linux: the ``drops`` column of ``/proc/net/udp{,6}`` for the socket's inode);
     None when unknown (not UDP, not Linux, or the socket is closed)."""
     import os
-    import socket
 
     sock = getattr(conn, "port", None)
     if not isinstance(sock, socket.socket) or sock.type != socket.SOCK_DGRAM or sock.fileno() < 0:
@@ -111,8 +230,10 @@ def receive(
     done: Callable[[], bool] = lambda: False,
 ) -> int:
     """Call ``on_message(msg, wall_s)`` for every message and ``on_tick(wall_s)`` at least every
-    :data:`POLL_S`, until ``stop[0]``, ``done()``, or ``idle_timeout_s`` of wall time without a
-    message (after the first). Returns the messages dropped from a full queue.
+    :data:`POLL_S`, until ``stop[0]``, ``done()``, ``idle_timeout_s`` of wall time without a
+    message (after the first), or the end of a stream that can end (a :class:`TcpStream`
+    closed by its sender, every message processed). Returns the messages dropped from a full
+    queue.
 
     A thread only reads and decodes (``wall_s`` is its receive time), so the processing never
     keeps the socket waiting: a slow step (the filter releases the GIL) does not lose packets.
@@ -127,7 +248,7 @@ def receive(
     polled = [time.monotonic()]  # when the reader last finished a wait on the socket
 
     def reader() -> None:
-        while not halt.is_set():
+        while not halt.is_set() and not getattr(conn, "closed", False):
             polled[0] = time.monotonic()
             try:
                 msg = conn.recv_match(blocking=True, timeout=POLL_S)
@@ -159,6 +280,8 @@ def receive(
             if q.empty() and now - polled[0] <= 3 * POLL_S:
                 on_tick(now)
             if idle_timeout_s is not None and last_msg is not None and now - last_msg > idle_timeout_s:
+                break
+            if not th.is_alive() and q.empty():  # the stream is over and fully processed
                 break
     finally:
         halt.set()
