@@ -280,13 +280,13 @@ def test_every_flight_conforms_to_an_intent_from_its_other_runs(shared_data, flo
     from uasnav.trajectory.mission_runs import MISSION_VIEWS
     from uasnav.trajectory.models import load_model
     from uasnav.trajectory.timebounds import PaceBounds
-    from uasnav.utm.intent import build_intent, vehicle_run_times
+    from uasnav.utm.intent import build_intent, vehicle_run_bounds
 
     log = open_log(shared_data / TLOG, need=("limits", *MISSION_VIEWS))
     model, plan = load_model(phoenix["model"]), read_plan(phoenix["plan"])
     kw = {"climb_ms": flown["climb_ms"], "descent_ms": flown["descent_ms"],
           "accel_z_ms2": log.limits.accel_z_ms2, "cruise_ms": log.limits.cruise_ms}  # fmt: skip
-    runs, _ = vehicle_run_times([log], model, np.zeros(2), **kw)
+    runs = list(vehicle_run_bounds([log], model, np.zeros(2), **kw).runs)
     packets = [p for p in log_packets(shared_data / TLOG) if p.msg.get_srcSystem() == 1]
     flights, armed, boot, to_unix, auto = [], False, 0.0, 0.0, None
     for k, p in enumerate(packets):  # (first packet, mission start UTC, last packet) of each flight

@@ -24,6 +24,7 @@ from typing import Any
 
 from uasnav.errors import InputError, UasnavError
 from uasnav.live.source import Packet, mavlink_dialect
+from uasnav.live.stream import connect_tcp, listen_tcp
 
 #: Messages whose ``lat``/``lon`` (1e-7 deg) an offset shifts.
 POSITION_MESSAGES = ("GLOBAL_POSITION_INT", "GPS_RAW_INT", "GPS2_RAW")
@@ -239,7 +240,7 @@ def open_sender(
 
         return send_datagram, sock
     if target.scheme == "tcp":
-        sock = _tcp_connect(target, infos[0], wait_s)
+        sock = connect_tcp(infos[0], wait_s, f"--to {target}")
     else:
         sock = _tcp_accept(target, infos[0], wait_s, on_wait)
     sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -253,32 +254,8 @@ def open_sender(
     return send_stream, sock
 
 
-def _tcp_connect(target: Target, info: Any, wait_s: float) -> socket.socket:
-    family, kind, proto, _, addr = info
-    deadline = time.monotonic() + wait_s
-    while True:
-        sock = socket.socket(family, kind, proto)
-        try:
-            sock.connect(addr)
-            return sock
-        except OSError as e:
-            sock.close()
-            if not isinstance(e, ConnectionRefusedError) or time.monotonic() >= deadline:
-                raise InputError(
-                    f"--to {target}: cannot connect ({e.strerror or e}; waited {wait_s:g} s)"
-                ) from None
-            time.sleep(0.1)  # the receiver is not listening yet
-
-
 def _tcp_accept(target: Target, info: Any, wait_s: float, on_wait: Callable[[str], Any]) -> socket.socket:
-    family, kind, proto, _, addr = info
-    with socket.socket(family, kind, proto) as server:
-        server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            server.bind(addr)
-        except OSError as e:
-            raise InputError(f"--to {target}: cannot listen ({e.strerror or e})") from None
-        server.listen(1)
+    with listen_tcp(info, f"--to {target}") as server:
         server.settimeout(wait_s)
         on_wait(f"waiting up to {wait_s:g} s for a receiver to connect to {target.host}:{target.port}")
         try:

@@ -32,6 +32,41 @@ POLL_S = 0.02
 CONNECT_WAIT_S = 10.0
 
 
+def connect_tcp(info: Any, wait_s: float, where: str) -> socket.socket:
+    """A TCP socket connected to ``info`` (a ``getaddrinfo`` row), trying again while the peer
+    refuses (it is not listening yet) for up to ``wait_s``; an :class:`InputError` that starts
+    with ``where`` otherwise."""
+    family, kind, proto, _, addr = info
+    deadline = time.monotonic() + wait_s
+    while True:
+        sock = socket.socket(family, kind, proto)
+        try:
+            sock.connect(addr)
+            return sock
+        except OSError as e:
+            sock.close()
+            if not isinstance(e, ConnectionRefusedError) or time.monotonic() >= deadline:
+                raise InputError(
+                    f"{where}: cannot connect ({e.strerror or e}; waited {wait_s:g} s)"
+                ) from None
+            time.sleep(0.1)
+
+
+def listen_tcp(info: Any, where: str) -> socket.socket:
+    """A TCP socket listening for one peer at ``info``; an :class:`InputError` that starts
+    with ``where`` when the address cannot be bound."""
+    family, kind, proto, _, addr = info
+    server = socket.socket(family, kind, proto)
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        server.bind(addr)
+    except OSError as e:
+        server.close()
+        raise InputError(f"{where}: cannot listen ({e.strerror or e})") from None
+    server.listen(1)
+    return server
+
+
 class TcpStream:
     """A MAVLink stream over TCP: ``tcp`` connects to a sender, ``tcpin`` listens and takes the
     first sender that connects. The stream is over (:attr:`closed`, :attr:`end`) when the sender
@@ -54,36 +89,15 @@ class TcpStream:
         self._mav = mavlink_dialect().MAVLink(None)
         self._mav.robust_parsing = True
         try:
-            family, kind, proto, _, addr = socket.getaddrinfo(
+            info = socket.getaddrinfo(
                 host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE if scheme == "tcpin" else 0
             )[0]
         except (OSError, UnicodeError) as e:
             raise InputError(f"connection {where!r}: cannot resolve {host} ({e})") from None
         if scheme == "tcpin":
-            server = socket.socket(family, kind, proto)
-            server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            try:
-                server.bind(addr)
-            except OSError as e:
-                server.close()
-                raise InputError(f"connection {where!r}: cannot listen ({e.strerror or e})") from None
-            server.listen(1)
-            self._server = server
+            self._server = listen_tcp(info, f"connection {where!r}")
             return
-        wait_s = CONNECT_WAIT_S if wait_s is None else wait_s
-        deadline = time.monotonic() + wait_s
-        while True:
-            sock = socket.socket(family, kind, proto)
-            try:
-                sock.connect(addr)
-                break
-            except OSError as e:
-                sock.close()
-                if not isinstance(e, ConnectionRefusedError) or time.monotonic() >= deadline:
-                    raise InputError(
-                        f"connection {where!r}: cannot connect ({e.strerror or e}; waited {wait_s:g} s)"
-                    ) from None
-                time.sleep(0.1)  # the sender is not listening yet
+        sock = connect_tcp(info, CONNECT_WAIT_S if wait_s is None else wait_s, f"connection {where!r}")
         self._connected(sock)
 
     def _connected(self, sock: socket.socket) -> None:

@@ -156,7 +156,7 @@ def _predict_plan(
     return pts, en, z, rp
 
 
-def vehicle_run_times(
+def vehicle_run_bounds(
     logs: Sequence[Any],
     predictor: Predictor,
     wind_ne: np.ndarray,
@@ -165,16 +165,22 @@ def vehicle_run_times(
     descent_ms: float | None = None,
     accel_z_ms2: float | None = None,
     cruise_ms: float | None = None,
-) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[str]]:
-    """The vehicle's own earlier flights against ``predictor``: for every AUTO run of each log
-    (:func:`uasnav.trajectory.mission_runs.mission_runs`), its true and predicted times (s from
-    the run's start) at the items it reached and at its touch-down (a land item counts at the
-    touch-down), with the predictor's times for the log's own plan; and the logs' names.
+    tau_s: float = DEFAULT_TAU_S,
+) -> PaceBounds:
+    """Time bounds of ``predictor`` from the vehicle's own earlier flights: for every AUTO run
+    of each log (:func:`uasnav.trajectory.mission_runs.mission_runs`), its true and predicted
+    times (s from the run's start) at the items it reached and at its touch-down (a land item
+    counts at the touch-down), with the predictor's times for the log's own plan (``runs`` of
+    the result); the bounds are the Student-t prediction bounds of each run's slowest and
+    fastest log pace ratio (:class:`uasnav.trajectory.timebounds.PaceBounds`), which follow the
+    vehicle's own bias and hold from few runs under their stated assumption; ``describe`` adds
+    the leave-one-run-out check.
 
     Raises
     ------
     InputError
-        A log without a mission or without an AUTO run that reaches an item.
+        A log without a mission or without an AUTO run that reaches an item; fewer runs than
+        :data:`uasnav.trajectory.timebounds.MIN_PACE_RUNS` at the first use of the bounds.
     """
     from pathlib import Path
 
@@ -205,36 +211,6 @@ def vehicle_run_times(
         names.append(Path(str(log.path)).name)
     if not runs:
         raise InputError("no AUTO run of the vehicle reaches an item of its mission")
-    return runs, names
-
-
-def vehicle_run_bounds(
-    logs: Sequence[Any],
-    predictor: Predictor,
-    wind_ne: np.ndarray,
-    *,
-    climb_ms: float | None = None,
-    descent_ms: float | None = None,
-    accel_z_ms2: float | None = None,
-    cruise_ms: float | None = None,
-    tau_s: float = DEFAULT_TAU_S,
-) -> PaceBounds:
-    """Time bounds of ``predictor`` from the vehicle's own earlier flights
-    (:func:`vehicle_run_times`): the Student-t prediction bounds of each run's slowest and
-    fastest log pace ratio (:class:`uasnav.trajectory.timebounds.PaceBounds`), which follow the
-    vehicle's own bias and hold from few runs under their stated assumption; its
-    :meth:`~uasnav.trajectory.timebounds.PaceBounds.describe` adds the leave-one-run-out check.
-
-    Raises
-    ------
-    InputError
-        A log without a mission, without an AUTO run that reaches an item, or fewer runs than
-        :data:`uasnav.trajectory.timebounds.MIN_PACE_RUNS` (at the first use of the bounds).
-    """
-    runs, names = vehicle_run_times(
-        logs, predictor, wind_ne, climb_ms=climb_ms, descent_ms=descent_ms, accel_z_ms2=accel_z_ms2,
-        cruise_ms=cruise_ms,
-    )  # fmt: skip
     return PaceBounds.of_runs(runs, tau_s, f"{len(runs)} AUTO runs of the vehicle ({', '.join(names)})")
 
 
@@ -385,5 +361,4 @@ __all__ = [
     "IntentBuild",
     "build_intent",
     "vehicle_run_bounds",
-    "vehicle_run_times",
 ]
