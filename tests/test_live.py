@@ -639,3 +639,32 @@ def test_live_page_shows_the_state_change_in_chromium(shared_data, intent):
         finally:
             browser.close()
     assert outside == []
+
+
+def test_both_filter_entry_points_check_their_arrays_alike():
+    """``ins_run`` and ``InsStream.step`` view and check the IMU and GNSS arrays through one
+    extractor: the same mismatch gives the same message from either."""
+    from uasnav import _core
+    from uasnav.errors import InputError
+    from uasnav.ins.core import InsConfig
+
+    cfg = InsConfig.for_logged_imu().filter_config(0.0)
+    t = np.arange(200) * 0.01
+    rows = np.zeros((200, 3))
+    fix_t, fix = np.array([0.5]), np.zeros((1, 3))
+    stream = _core.InsStream(config=cfg)
+    for short in ("gyro", "gnss_vel"):
+        args = {"imu_t": t, "gyro": rows, "accel": rows, "gnss_t": fix_t, "gnss_llh": fix, "gnss_vel": fix,
+                "gnss_acc": fix}  # fmt: skip
+        args[short] = args[short][:-1] if short == "gyro" else np.zeros((2, 3))
+        want = (
+            "gyro/accel: expected 200 rows"
+            if short == "gyro"
+            else "gnss_llh/gnss_vel/gnss_acc: expected 1 rows"
+        )
+        with pytest.raises(InputError, match=want):
+            _core.ins_run(*args.values(), config=cfg)
+        with pytest.raises(InputError, match=want):
+            stream.step(*args.values(), np.zeros(1, dtype=np.uint64))
+    with pytest.raises(InputError, match="gnss_before: expected 1 rows like gnss_t"):
+        stream.step(t, rows, rows, fix_t, fix, fix, fix, np.zeros(2, dtype=np.uint64))
