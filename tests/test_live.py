@@ -546,7 +546,7 @@ def test_bad_input_is_one_error_line(tmp_path):
     r = CliRunner().invoke(main, ["replay", str(tmp_path / "x.tlog"), "--to", "tcp:x"])
     assert r.exit_code == 1 and "--to: expected udp:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT" in r.output
     r = CliRunner().invoke(main, ["replay", str(tmp_path / "x.tlog"), "--to", "serial:127.0.0.1:5760"])
-    assert r.exit_code == 1 and "tcpin:HOST:PORT, got 'serial:" in r.output
+    assert r.exit_code == 1 and "/dev/ttyX,BAUD, got 'serial:" in r.output
     r = CliRunner().invoke(main, ["monitor", "bogus", "--intent", str(tmp_path / "none.json")])
     assert r.exit_code == 1 and "error:" in r.output
     r = CliRunner().invoke(main, ["nav", "--causal"])
@@ -668,3 +668,76 @@ def test_both_filter_entry_points_check_their_arrays_alike():
             stream.step(*args.values(), np.zeros(1, dtype=np.uint64))
     with pytest.raises(InputError, match="gnss_before: expected 1 rows like gnss_t"):
         stream.step(t, rows, rows, fix_t, fix, fix, fix, np.zeros(2, dtype=np.uint64))
+
+
+def _read_pty(master: int, until: subprocess.Popen[str], timeout_s: float = 120.0) -> bytes:
+    """Bytes from a pseudo-terminal's master side until ``until`` exits and the line is empty."""
+    import os
+    import select
+
+    data = bytearray()
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([master], [], [], 0.2)
+        if ready:
+            data += os.read(master, 65536)
+        elif until.poll() is not None:
+            return bytes(data)
+    pytest.fail("the replay did not end")
+
+
+def test_replay_to_a_serial_port_and_monitor_from_one(shared_data, intent):
+    """``replay --to /dev/ttyX,BAUD`` writes the packets whole to a serial line, and ``monitor
+    /dev/ttyX,BAUD`` reads one (a pseudo-terminal pair stands for the radio link)."""
+    import os
+    import tty
+
+    from uasnav.live.source import mavlink_dialect
+
+    master, slave = os.openpty()
+    tty.setraw(master)
+    try:
+        tx = subprocess.Popen(
+            [*uasnav_command(), "replay", str(shared_data / TLOG), "--to", f"{os.ttyname(slave)},57600",
+             "--speed", "100", "--from", str(RUN[0]), "--stop-after", str(RUN[0] + 10)],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        data = _read_pty(master, tx)
+        _, err = tx.communicate(timeout=60)
+        assert tx.returncode == 0, err
+        mav = mavlink_dialect().MAVLink(None)
+        mav.robust_parsing = True
+        msgs = [m for m in mav.parse_buffer(data) or [] if m.get_type() != "BAD_DATA"]
+        assert len(msgs) == count(r"sent (\d+) packets", err) > 100 and count(r"\((\d+) bytes", err) == len(
+            data
+        )
+
+        rx = subprocess.Popen(
+            [*uasnav_command(), "monitor", f"{os.ttyname(slave)},57600", "--intent", str(intent),
+             "--json-lines", "--idle-exit", "1"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        os.write(master, _packets(20))  # the line holds them until the monitor reads
+        out, err = rx.communicate(timeout=60)
+        assert rx.returncode == 0, err
+        assert states([json.loads(line) for line in out.splitlines()]) == ["Accepted"]
+        assert count(r"(\d+) messages received", err.strip().splitlines()[-1]) == 40, err
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+def test_serial_errors_are_one_line(shared_data, intent, tmp_path):
+    tlog = str(shared_data / TLOG)
+    for to, want in (
+        (str(tmp_path / "ttyNONE"), f"tcpin:HOST:PORT or /dev/ttyX,BAUD, got '{tmp_path / 'ttyNONE'}'"),
+        ("/dev/ttyNONE,57600", "error: --to /dev/ttyNONE,57600: cannot open /dev/ttyNONE"),
+        ("/dev/null,57600", "error: --to /dev/null,57600: /dev/null is not a serial port"),
+        ("/dev/ttyS0,fast", "--to: expected /dev/ttyX,BAUD (the baud rate a number), got '/dev/ttyS0,fast'"),
+        ("/dev/ttyS0,12345", "--to /dev/ttyS0,12345: baud rate 12345 is not one this system's serial ports"),
+    ):
+        r = CliRunner().invoke(main, ["replay", tlog, "--to", to])
+        assert r.exit_code == 1 and want in r.output and r.output.count("\n") == 1, (to, r.output)
+    r = CliRunner().invoke(main, ["monitor", "/dev/null,57600", "--intent", str(intent)])
+    assert r.exit_code == 1 and r.output.count("\n") == 1, r.output
+    assert r.output.startswith("error: connection '/dev/null,57600': /dev/null is not a serial"), r.output

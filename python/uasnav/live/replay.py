@@ -15,7 +15,9 @@ loss).
 from __future__ import annotations
 
 import math
+import os
 import random
+import select
 import socket
 import time
 from collections.abc import Callable, Iterable, Iterator
@@ -62,34 +64,46 @@ def parse_offset(text: str, until_s: float | None = None) -> Offset:
 
 #: Forms of ``--to``: ``udp``/``udpout`` send datagrams to HOST:PORT; ``tcp`` connects to a
 #: listening receiver; ``tcpin`` listens and sends to the first receiver that connects (as a
-#: vehicle or simulator serving ``tcp:5760``).
-TARGET_SCHEMES = ("udp", "udpout", "tcp", "tcpin")
+#: vehicle or simulator serving ``tcp:5760``); ``serial`` writes to ``/dev/ttyX,BAUD`` (a
+#: telemetry radio's port, or a pseudo-terminal).
+TARGET_SCHEMES = ("udp", "udpout", "tcp", "tcpin", "serial")
 
 
 @dataclass(frozen=True)
 class Target:
-    """Where a replay sends: ``scheme`` (one of :data:`TARGET_SCHEMES`), ``host``, ``port``."""
+    """Where a replay sends: ``scheme`` (one of :data:`TARGET_SCHEMES`), ``host`` and ``port``
+    (for ``serial``: the device and its baud rate)."""
 
     scheme: str
     host: str
     port: int
 
     def __str__(self) -> str:
+        if self.scheme == "serial":
+            return f"{self.host},{self.port}"
         return f"{self.scheme}:{self.host}:{self.port}"
 
 
 def parse_target(text: str) -> Target:
-    """``udp:HOST:PORT``, ``udpout:HOST:PORT``, ``tcp:HOST:PORT`` or ``tcpin:HOST:PORT`` →
-    :class:`Target` (pymavlink's connection strings, seen from the sender).
+    """``udp:HOST:PORT``, ``udpout:HOST:PORT``, ``tcp:HOST:PORT``, ``tcpin:HOST:PORT`` or
+    ``/dev/ttyX,BAUD`` → :class:`Target` (pymavlink's connection strings, seen from the sender).
 
     >>> parse_target("tcpin:127.0.0.1:5760")
     Target(scheme='tcpin', host='127.0.0.1', port=5760)
+    >>> parse_target("/dev/ttyUSB0,57600")
+    Target(scheme='serial', host='/dev/ttyUSB0', port=57600)
     """
+    from uasnav.live.stream import parse_serial
+
+    if text.startswith("/dev/"):
+        dev, baud = parse_serial(text, "--to")
+        return Target("serial", dev, baud)
     scheme, _, rest = text.partition(":")
     host, _, port = rest.rpartition(":")
-    if scheme not in TARGET_SCHEMES or not host or not port.isdigit() or not 0 < int(port) < 65536:
+    if scheme not in TARGET_SCHEMES[:4] or not host or not port.isdigit() or not 0 < int(port) < 65536:
         raise InputError(
-            f"--to: expected udp:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT or tcpin:HOST:PORT, got {text!r}"
+            "--to: expected udp:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT, tcpin:HOST:PORT or "
+            f"/dev/ttyX,BAUD, got {text!r}"
         )
     return Target(scheme, host.strip("[]"), int(port))
 
@@ -210,8 +224,8 @@ CONNECT_WAIT_S = 30.0
 
 def open_sender(
     target: Target, *, wait_s: float | None = None, on_wait: Callable[[str], Any] = lambda _: None
-) -> tuple[Callable[[bytes], Any], socket.socket]:
-    """A sender of encoded packets to ``target`` and its socket (close it when done).
+) -> tuple[Callable[[bytes], Any], Any]:
+    """A sender of encoded packets to ``target`` and its socket or port (close it when done).
 
     UDP is fire and forget (nobody listening is not an error). TCP is a byte stream: the
     packets are written whole, in order; a receiver that closes the connection ends the
@@ -219,6 +233,8 @@ def open_sender(
     ``wait_s`` defaults to :data:`CONNECT_WAIT_S`.
     """
     wait_s = CONNECT_WAIT_S if wait_s is None else wait_s
+    if target.scheme == "serial":
+        return _serial_sender(target)
     try:
         infos = socket.getaddrinfo(
             target.host,
@@ -252,6 +268,36 @@ def open_sender(
             raise LinkClosed(f"--to {target}: the receiver closed the connection") from None
 
     return send_stream, sock
+
+
+class _SerialPort:
+    """The replay's serial port: a file descriptor with ``close`` (as the sockets have)."""
+
+    def __init__(self, fd: int) -> None:
+        self.fd = fd
+
+    def close(self) -> None:
+        if self.fd >= 0:
+            os.close(self.fd)
+            self.fd = -1
+
+
+def _serial_sender(target: Target) -> tuple[Callable[[bytes], Any], Any]:
+    """Write whole packets to a serial port: a full output buffer (the line's baud rate, or a
+    reader that is behind) waits until it drains; the line holds back, it does not drop."""
+    from uasnav.live.stream import open_serial
+
+    port = _SerialPort(open_serial(target.host, target.port, f"--to {target}"))
+
+    def send_serial(data: bytes) -> None:
+        view = memoryview(data)
+        while view:
+            try:
+                view = view[os.write(port.fd, view) :]
+            except BlockingIOError:
+                select.select([], [port.fd], [], 1.0)
+
+    return send_serial, port
 
 
 def _tcp_accept(target: Target, info: Any, wait_s: float, on_wait: Callable[[str], Any]) -> socket.socket:

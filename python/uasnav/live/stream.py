@@ -5,14 +5,17 @@
 serial port and its baud rate). Messages are decoded
 with the ``ardupilotmega`` dialect; packets that fail their checksum are dropped by pymavlink.
 
-UDP and serial ports are pymavlink's connections. The TCP forms are :class:`TcpStream`, owned
-here: pymavlink's TCP connections print to standard output (which carries ``monitor
---json-lines``) and reconnect, or poll a closed socket, after the sender closes. A TCP stream
-ends when its sender closes it, and :func:`receive` returns then.
+UDP is pymavlink's connection. TCP (:class:`TcpStream`) and serial ports
+(:class:`SerialStream`) are byte streams owned here: pymavlink's TCP connections print to
+standard output (which carries ``monitor --json-lines``) and reconnect, or poll a closed
+socket, after the sender closes, and its serial connection needs pyserial. A TCP stream ends
+when its sender closes it, and :func:`receive` returns then; a serial line has no end.
 """
 
 from __future__ import annotations
 
+import errno
+import os
 import select
 import signal
 import socket
@@ -67,27 +70,84 @@ def listen_tcp(info: Any, where: str) -> socket.socket:
     return server
 
 
-class TcpStream:
-    """A MAVLink stream over TCP: ``tcp`` connects to a sender, ``tcpin`` listens and takes the
-    first sender that connects. The stream is over (:attr:`closed`, :attr:`end`) when the sender
-    closes it; nothing is printed, nothing reconnects.
+class ByteStream:
+    """A MAVLink byte stream decoded here (pymavlink's parser, the ``ardupilotmega`` dialect).
 
     It offers what :func:`receive` and the commands use of a pymavlink connection:
-    :meth:`recv_match`, :meth:`close` and ``port`` (the connected socket, ``None`` before a
-    ``tcpin`` sender connects).
+    :meth:`recv_match`, :meth:`close` and ``port``. A subclass supplies :meth:`_source` (what
+    to wait on, ``None`` while there is nothing yet), :meth:`_read` (bytes; ``b""`` when the
+    peer closed) and may override :meth:`_idle` (called while :meth:`_source` is ``None``).
     """
 
-    def __init__(self, scheme: str, host: str, port: int, *, wait_s: float | None = None) -> None:
+    def __init__(self) -> None:
         from uasnav.live.source import mavlink_dialect
 
-        where = f"{scheme}:{host}:{port}"
-        self.port: socket.socket | None = None
-        self._server: socket.socket | None = None
         self.closed = False
         self.end: str | None = None
         self._pending: deque[Any] = deque()
         self._mav = mavlink_dialect().MAVLink(None)
         self._mav.robust_parsing = True
+
+    def _source(self) -> Any:
+        raise NotImplementedError
+
+    def _read(self) -> bytes:
+        raise NotImplementedError
+
+    def _idle(self, timeout_s: float) -> None:
+        time.sleep(timeout_s)
+
+    def recv_match(self, blocking: bool = True, timeout: float | None = None) -> Any:
+        """The next message, or ``None`` when none came within ``timeout`` (s) or the stream
+        is over."""
+        wait = (timeout if timeout is not None else 1e9) if blocking else 0.0
+        deadline = time.monotonic() + wait
+        while not self._pending and not self.closed:
+            left = max(deadline - time.monotonic(), 0.0)
+            src = self._source()
+            if src is None:
+                self._idle(left)
+                if self._source() is None and time.monotonic() >= deadline:
+                    return None
+                continue
+            ready, _, _ = select.select([src], [], [], left)
+            if not ready:
+                return None
+            try:
+                data = self._read()
+            except BlockingIOError:  # nothing after all (or a line without its other side yet)
+                if time.monotonic() >= deadline:
+                    return None
+                continue
+            except OSError as e:
+                self._over(f"the connection failed ({e.strerror or e})")
+                break
+            if not data:
+                self._over("the sender closed the connection")
+                break
+            self._pending.extend(m for m in self._mav.parse_buffer(data) or [] if m.get_type() != "BAD_DATA")
+        return self._pending.popleft() if self._pending else None
+
+    def _over(self, why: str) -> None:
+        self.closed, self.end = True, why
+
+    def close(self) -> None:
+        if not self.closed:
+            self._over("closed by this receiver")
+
+
+class TcpStream(ByteStream):
+    """A MAVLink stream over TCP: ``tcp`` connects to a sender, ``tcpin`` listens and takes the
+    first sender that connects. The stream is over (:attr:`closed`, :attr:`end`) when the sender
+    closes it; nothing is printed, nothing reconnects. ``port`` is the connected socket,
+    ``None`` before a ``tcpin`` sender connects.
+    """
+
+    def __init__(self, scheme: str, host: str, port: int, *, wait_s: float | None = None) -> None:
+        super().__init__()
+        where = f"{scheme}:{host}:{port}"
+        self.port: socket.socket | None = None
+        self._server: socket.socket | None = None
         try:
             info = socket.getaddrinfo(
                 host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE if scheme == "tcpin" else 0
@@ -105,49 +165,92 @@ class TcpStream:
         sock.setblocking(False)
         self.port = sock
 
-    def recv_match(self, blocking: bool = True, timeout: float | None = None) -> Any:
-        """The next message, or ``None`` when none came within ``timeout`` (s) or the stream
-        is over."""
-        wait = (timeout if timeout is not None else 1e9) if blocking else 0.0
-        deadline = time.monotonic() + wait
-        while not self._pending and not self.closed:
-            if self.port is None:  # tcpin: no sender yet
-                assert self._server is not None
-                ready, _, _ = select.select([self._server], [], [], max(deadline - time.monotonic(), 0.0))
-                if ready:
-                    sock, _ = self._server.accept()
-                    self._server.close()
-                    self._server = None
-                    self._connected(sock)
-                elif time.monotonic() >= deadline:
-                    return None
-                continue
-            ready, _, _ = select.select([self.port], [], [], max(deadline - time.monotonic(), 0.0))
-            if not ready:
-                return None
-            try:
-                data = self.port.recv(65536)
-            except BlockingIOError:
-                continue
-            except OSError as e:
-                self._over(f"the connection failed ({e.strerror or e})")
-                break
-            if not data:
-                self._over("the sender closed the connection")
-                break
-            self._pending.extend(m for m in self._mav.parse_buffer(data) or [] if m.get_type() != "BAD_DATA")
-        return self._pending.popleft() if self._pending else None
+    def _source(self) -> Any:
+        return self.port
 
-    def _over(self, why: str) -> None:
-        self.closed, self.end = True, why
+    def _idle(self, timeout_s: float) -> None:
+        """tcpin: wait up to ``timeout_s`` for the sender to connect."""
+        assert self._server is not None
+        ready, _, _ = select.select([self._server], [], [], timeout_s)
+        if ready:
+            sock, _ = self._server.accept()
+            self._server.close()
+            self._server = None
+            self._connected(sock)
+
+    def _read(self) -> bytes:
+        assert self.port is not None
+        return self.port.recv(65536)
 
     def close(self) -> None:
         for sock in (self.port, self._server):
             if sock is not None:
                 sock.close()
         self._server = None
-        if not self.closed:
-            self._over("closed by this receiver")
+        super().close()
+
+
+def open_serial(device: str, baud: int, where: str) -> int:
+    """A file descriptor of the serial device (or pseudo-terminal) ``device`` opened for
+    reading and writing in raw mode at ``baud`` (POSIX termios: 8 data bits, no parity, no
+    flow control); an :class:`InputError` that starts with ``where`` otherwise."""
+    import termios
+    import tty
+
+    speed = getattr(termios, f"B{baud}", None)
+    if speed is None:
+        raise InputError(f"{where}: baud rate {baud} is not one this system's serial ports support")
+    try:
+        fd = os.open(device, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+    except OSError as e:
+        raise InputError(f"{where}: cannot open {device} ({e.strerror or e})") from None
+    try:
+        tty.setraw(fd, termios.TCSANOW)  # keep what the line already holds
+        attrs = termios.tcgetattr(fd)
+        attrs[4] = attrs[5] = speed
+        attrs[2] &= ~termios.CRTSCTS
+        termios.tcsetattr(fd, termios.TCSANOW, attrs)
+    except (OSError, termios.error) as e:
+        os.close(fd)
+        raise InputError(f"{where}: {device} is not a serial port ({e})") from None
+    return fd
+
+
+def parse_serial(text: str, where: str) -> tuple[str, int]:
+    """``/dev/ttyX,BAUD`` (``BAUD`` default 57600) → (device, baud)."""
+    dev, _, baud = text.partition(",")
+    if not dev.startswith("/dev/") or (baud and not baud.isdigit()):
+        raise InputError(f"{where}: expected /dev/ttyX,BAUD (the baud rate a number), got {text!r}")
+    return dev, int(baud or 57600)
+
+
+class SerialStream(ByteStream):
+    """A MAVLink stream from a serial port or pseudo-terminal (``/dev/ttyX,BAUD``), read with the
+    standard library (no pyserial). A serial line has no end: the stream lasts until closed."""
+
+    def __init__(self, text: str) -> None:
+        super().__init__()
+        dev, baud = parse_serial(text, f"connection {text!r}")
+        self.fd = open_serial(dev, baud, f"connection {text!r}")
+        self.port = None  # no socket (kernel_drops: unknown)
+
+    def _source(self) -> Any:
+        return self.fd
+
+    def _read(self) -> bytes:
+        try:
+            return os.read(self.fd, 65536)
+        except OSError as e:  # a pseudo-terminal whose other side is not open reads as EIO
+            if e.errno == errno.EIO:
+                time.sleep(POLL_S)
+                raise BlockingIOError from None
+            raise
+
+    def close(self) -> None:
+        if self.fd >= 0:
+            os.close(self.fd)
+            self.fd = -1
+        super().close()
 
 
 def open_connection(text: str) -> Any:
@@ -165,12 +268,9 @@ def open_connection(text: str) -> Any:
         if not host or not port.isdigit() or not 0 < int(port) < 65536:
             raise InputError(f"connection {text!r}: expected {head}:HOST:PORT")
         return TcpStream(head, host, int(port))
-    kw: dict[str, Any] = {"dialect": "ardupilotmega", "autoreconnect": True}
     if text.startswith("/dev/"):
-        dev, _, baud = text.partition(",")
-        if baud and not baud.isdigit():
-            raise InputError(f"connection {text!r}: the baud rate must be a number")
-        text, kw["baud"] = dev, int(baud or 57600)
+        return SerialStream(text)
+    kw: dict[str, Any] = {"dialect": "ardupilotmega", "autoreconnect": True}
     try:
         return mavutil.mavlink_connection(text, **kw)
     except OSError as e:
