@@ -290,9 +290,8 @@ def utm_earliest_delays(
 __all__ += ["utm_earliest_delays", "utm_encounters"]
 # ---- GNSS/INS ---------------------------------------------------------------------------
 
-# The IMU and GNSS arrays of both filter entry points: IMU times (n,) s, gyro (n, 3) rad/s,
-# accel (n, 3) m/s²; GNSS times (m,) s, llh (m, 3) rad/rad/m, NED velocity (m, 3) m/s,
-# accuracies (m, 3) = horizontal m, vertical m, speed m/s.
+# Times (k,) s and rows (k, 3) of the IMU and GNSS arrays both filter entry points take (units
+# in ins_run's docstring).
 _Times = NDArray[np.float64]
 _Rows = NDArray[np.float64]
 
@@ -321,10 +320,12 @@ def ins_run(
 ) -> dict[str, Any]:
     """Run the GNSS/INS filter over a whole flight (one call, GIL released).
 
-    The IMU and GNSS arrays as noted above ``_Times``; the rows must match their times. Returns
-    decimated ``llh``, ``vel``, ``attitude``, ``gyro_bias``, ``accel_bias``, ``cov_diag``,
-    ``protection`` (HPL, VPL m), ``gnss_used``; per fix ``fix_status`` (0 used, 1/2 excluded,
-    3 masked, 4 unused, 5 reset) and ``fix_nis``; and the update counts. ``config`` is one
+    IMU times (n,) s, gyro (n, 3) rad/s, accel (n, 3) m/s²; GNSS times (m,) s, llh (m, 3)
+    rad/rad/m, NED velocity (m, 3) m/s, accuracies (m, 3) = horizontal m, vertical m, speed m/s;
+    each array's rows match its times (checked). Returns decimated ``llh``, ``vel``,
+    ``attitude``, ``gyro_bias``, ``accel_bias``, ``cov_diag``, ``protection`` (HPL, VPL m),
+    ``gnss_used``; per fix ``fix_status`` (0 used, 1/2 excluded, 3 masked, 4 unused, 5 reset)
+    and ``fix_nis``; and the update counts. ``config`` is one
     :class:`uasnav.ins.core.FilterConfig`, read by attribute (nav-core's field names; ``None``
     keeps nav-core's default); a missing attribute or a wrong type is an ``InputError`` naming
     the field.
