@@ -94,17 +94,23 @@ def start_pair(receiver: list[str], sender: list[str], port: int, proto: str = "
     return Pair(rx, tx)
 
 
+#: ArduCopter's AUTO in HEARTBEAT.custom_mode.
+AUTO = 3
+
+
 @pytest.fixture(scope="module")
 def flown(shared_data):
-    """From the tlog's own runs: the UTC of the second flight's arming, and the climb and
-    descent speeds the runs achieved from arming to the take-off waypoint and from the last
-    waypoint to disarming (m/s; ArduCopter slows its landing near the ground)."""
+    """From the tlog's own runs: the UTC at which the second flight's mission started (AUTO, the
+    time the runs are measured from), and the climb and descent speeds the runs achieved from
+    the mission's start to the take-off waypoint and from the last waypoint to disarming (m/s;
+    ArduCopter slows its landing near the ground)."""
     from pymavlink import mavutil
 
     m = mavutil.mavlink_connection(str(shared_data / TLOG), dialect="ardupilotmega")
     t0 = offset = None
     armed = False
-    arms: list[tuple[float, float]] = []  # (log s, boot s)
+    starts: list[tuple[float, float]] = []  # (log s, boot s) of each mission start
+    last_arm = -1.0
     climbs, descents, last_wp = [], [], None
     boot = 0.0
     clock: list[tuple[float, float]] = []  # (log s, boot s)
@@ -122,17 +128,19 @@ def flown(shared_data):
         elif msg.get_type() == "HEARTBEAT" and msg.get_srcSystem() == 1:
             now = bool(msg.base_mode & 128)
             if now and not armed:
-                arms.append((t, boot))
-            elif armed and not now and last_wp is not None:
+                last_arm = t
+            if now and msg.custom_mode == AUTO and (not starts or starts[-1][0] < last_arm):
+                starts.append((t, boot))
+            if armed and not now and last_wp is not None:
                 descents.append(t - last_wp)
                 last_wp = None
             armed = now
-        elif msg.get_type() == "MISSION_ITEM_REACHED" and arms:
+        elif msg.get_type() == "MISSION_ITEM_REACHED" and starts:
             if msg.seq == 1:
-                climbs.append(t - arms[-1][0])
+                climbs.append(t - starts[-1][0])
             elif msg.seq == 3:
                 last_wp = t
-    second = next(b for t, b in arms if t > RUN[0])
+    second = next(b for t, b in starts if t > RUN[0])
     alt = 20.0  # the plan's take-off and waypoint altitude above home
     return {
         "utc": datetime.fromtimestamp(offset + second, timezone.utc),
@@ -143,28 +151,40 @@ def flown(shared_data):
 
 
 @pytest.fixture(scope="module")
-def intent(shared_data, flown, tmp_path_factory):
-    """An intent for the tlog's plan departing at the second flight's arming, from a model
-    trained on the tlog's own runs (its autopilot limits and speed), with the climb and descent
-    speeds its runs achieved. The whole plan is filed, including its first waypoint 2.8 m from
-    home (``trajectory intent`` merges such short legs into their neighbours)."""
+def phoenix(shared_data, tmp_path_factory):
+    """The tlog's whole plan (its first waypoint 2.8 m from home included: ``trajectory
+    intent`` merges such short legs into their neighbours) and a model trained on the tlog's
+    own runs (its autopilot limits and speed)."""
     from uasnav.io.plans import read_plan, write_plan
 
     d = tmp_path_factory.mktemp("live")
-    model, out, plan = d / "model.json", d / "phoenix.json", d / "phoenix.plan"
+    model, plan = d / "model.json", d / "phoenix.plan"
     tlog = str(shared_data / TLOG)
-    p = read_plan(tlog)
-    write_plan(p, plan)
+    write_plan(read_plan(tlog), plan)
     r = CliRunner().invoke(main, ["trajectory", "train", tlog, "--out", str(model)])
     assert r.exit_code == 0, r.output
+    return {"model": model, "plan": plan, "dir": d}
+
+
+@pytest.fixture(scope="module")
+def intent(shared_data, flown, phoenix):
+    """An intent for the tlog's plan departing at the second flight's mission start, with the
+    climb and descent speeds its runs achieved and time bounds from how this prediction missed
+    the tlog's own five AUTO runs (``--flights``)."""
+    out = phoenix["dir"] / "phoenix.json"
+    tlog = str(shared_data / TLOG)
     start = flown["utc"].isoformat().replace("+00:00", "Z")
     r = CliRunner().invoke(
         main,
-        ["trajectory", "intent", "--model", str(model), "--plan", str(plan), "--wind", "0@0",
-         "--start", start, "--limits-from", tlog, "--climb-rate", f"{flown['climb_ms']:.3f}",
-         "--descent-rate", f"{flown['descent_ms']:.3f}", "--calibration-runs", "20", "--out", str(out)],
+        ["trajectory", "intent", "--model", str(phoenix["model"]), "--plan", str(phoenix["plan"]),
+         "--wind", "0@0", "--start", start, "--limits-from", tlog, "--climb-rate", f"{flown['climb_ms']:.3f}",
+         "--descent-rate", f"{flown['descent_ms']:.3f}", "--flights", tlog, "--json", "--out", str(out)],
     )  # fmt: skip
     assert r.exit_code == 0, r.output
+    source = json.loads(r.output)["time_bounds_source"]
+    assert source.startswith("5 AUTO runs of the vehicle (phoenix_mission1_arducopter.tlog): Student-t"), (
+        source
+    )
     return out
 
 
@@ -247,6 +267,53 @@ def test_replayed_flight_stays_activated_and_ends_on_landing(monitored):
     assert all(e["latency_ms"] >= 0 for e in ev if e["event"] == "state" and e["state"] != "Accepted")
 
 
+def test_every_flight_conforms_to_an_intent_from_its_other_runs(shared_data, flown, phoenix):
+    """Held out in 4D: each of the tlog's five AUTO flights, its messages fed to the monitor
+    offline, against an intent for its own mission start whose 95 % time bounds come from the
+    other four runs only, stays Activated from arming (it waits on the pad before its first
+    volume opens) and Ends."""
+    from uasnav.io import open_log
+    from uasnav.io.operational_intent import NamedIntent
+    from uasnav.io.plans import read_plan
+    from uasnav.live.conformance import ConformanceMonitor
+    from uasnav.live.source import log_packets
+    from uasnav.trajectory.mission_runs import MISSION_VIEWS
+    from uasnav.trajectory.models import load_model
+    from uasnav.trajectory.timebounds import PaceBounds
+    from uasnav.utm.intent import build_intent, vehicle_run_bounds
+
+    log = open_log(shared_data / TLOG, need=("limits", *MISSION_VIEWS))
+    model, plan = load_model(phoenix["model"]), read_plan(phoenix["plan"])
+    kw = {"climb_ms": flown["climb_ms"], "descent_ms": flown["descent_ms"],
+          "accel_z_ms2": log.limits.accel_z_ms2, "cruise_ms": log.limits.cruise_ms}  # fmt: skip
+    runs = list(vehicle_run_bounds([log], model, np.zeros(2), **kw).runs)
+    packets = [p for p in log_packets(shared_data / TLOG) if p.msg.get_srcSystem() == 1]
+    flights, armed, boot, to_unix, auto = [], False, 0.0, 0.0, None
+    for k, p in enumerate(packets):  # (first packet, mission start UTC, last packet) of each flight
+        m = p.msg
+        boot = m.time_boot_ms * 1e-3 if getattr(m, "time_boot_ms", None) is not None else boot
+        if m.get_type() == "SYSTEM_TIME" and m.time_unix_usec:
+            to_unix = m.time_unix_usec * 1e-6 - boot
+        if m.get_type() == "HEARTBEAT" and m.autopilot != 8:
+            now = bool(m.base_mode & 128)
+            if now and not armed:
+                first, auto = max(k - 200, 0), None
+            if now and m.custom_mode == AUTO and auto is None:
+                auto = to_unix + boot
+            if armed and not now and auto is not None:
+                flights.append((first, auto, k + 1))
+            armed = now
+    assert len(flights) == len(runs) == 5
+    for j, (a, start, b) in enumerate(flights):
+        model.time_bounds_ = PaceBounds.of_runs([r for i, r in enumerate(runs) if i != j], 10.0, "four runs")
+        built = build_intent(plan, model, np.zeros(2), datetime.fromtimestamp(start, timezone.utc), **kw)
+        monitor = ConformanceMonitor([NamedIntent("phoenix", built.details)])
+        events = [e for p in packets[a:b] for e in monitor.on_message(p.msg, p.t_s)]
+        assert states(events) == ["Accepted", "Activated", "Ended"], (j, transitions(events))
+        act = transitions(events)[1]
+        assert act["reason"] == "armed" and act["volume"] == 0 and act["margin_m"] > 0
+
+
 @pytest.fixture(scope="module")
 def recorded_gaps(shared_data) -> int:
     """Gaps in the tlog's own MAVLink sequence numbers over the replayed window: packets its
@@ -284,6 +351,9 @@ def test_monitor_receives_every_packet_sent(monitored, recorded_gaps, scenario):
     if kernel == 0:
         assert count(r"(\d+) lost by sequence number", m.summary) == recorded_gaps > 0
     assert states(m.events) == ["Accepted", "Activated", "Ended"], m.events
+    if scenario == "tcp":  # every report arrives: Ended at the first one on the ground, before disarming
+        end = transitions(m.events)[-1]
+        assert end["reason"].startswith("landed") and end["time_boot_s"] < 147.0, end
 
 
 def test_offset_goes_nonconforming_and_back(monitored, flown):
@@ -352,6 +422,80 @@ def test_replay_tcpin_serves_the_first_receiver(shared_data):
     assert len(msgs) == sent > 100 and count(r"\((\d+) bytes", err) == len(data)
 
 
+def _packets(n: int) -> bytes:
+    """``n`` HEARTBEAT + GLOBAL_POSITION_INT pairs from vehicle 1 as bytes on the wire."""
+    from uasnav.live.source import mavlink_dialect
+
+    d = mavlink_dialect()
+    mav = d.MAVLink(None, srcSystem=1, srcComponent=1)
+    out = bytearray()
+    for k in range(n):
+        out += mav.heartbeat_encode(2, 3, 0, 0, 4).pack(mav)
+        pos = mav.global_position_int_encode(1000 * k, 492574131, -1232431096, 92000, 0, 0, 0, 0, 0)
+        out += pos.pack(mav)
+    return bytes(out)
+
+
+@pytest.mark.parametrize("mode", ["tcp", "tcpin"])
+def test_monitor_tcp_stream_ends_when_the_sender_closes(intent, mode):
+    """Over TCP the monitor ends by itself when the sender closes (no --idle-exit: neither a
+    reconnecting nor a spinning receiver would end), and its standard output holds only the
+    JSON lines (pymavlink's own TCP connections print "EOF on TCP socket" there)."""
+    payload = _packets(20)
+    if mode == "tcp":  # the monitor connects to this listening sender
+        server = socket.create_server(("127.0.0.1", 0))
+        port = server.getsockname()[1]
+        rx = subprocess.Popen(
+            [*uasnav_command(), "monitor", f"tcp:127.0.0.1:{port}", "--intent", str(intent),
+             "--json-lines"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        server.settimeout(60)
+        with server, server.accept()[0] as conn:
+            conn.sendall(payload)
+    else:  # the monitor listens; this sender connects
+        port = free_port(socket.SOCK_STREAM)
+        rx = subprocess.Popen(
+            [*uasnav_command(), "monitor", f"tcpin:127.0.0.1:{port}", "--intent", str(intent),
+             "--json-lines"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        deadline = time.monotonic() + 60.0
+        while not listening(port, "tcp"):
+            assert rx.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        with socket.create_connection(("127.0.0.1", port), timeout=60) as conn:
+            conn.sendall(payload)
+    try:
+        out, err = rx.communicate(timeout=60)
+    finally:
+        if rx.poll() is None:
+            rx.kill()
+            rx.wait()
+    assert rx.returncode == 0, err
+    events = [json.loads(line) for line in out.splitlines()]  # every line is JSON
+    assert states(events) == ["Accepted"], events
+    summary = err.strip().splitlines()[-1]
+    assert count(r"(\d+) messages received", summary) == 40, summary
+    assert summary.endswith("; the sender closed the connection"), summary
+    assert "EOF" not in out + err
+
+
+def test_tcp_stream_errors_are_one_line(intent, monkeypatch):
+    import uasnav.live.stream as st
+
+    monkeypatch.setattr(st, "CONNECT_WAIT_S", 0.3)
+    port = free_port(socket.SOCK_STREAM)  # closed again: nobody listens
+    r = CliRunner().invoke(main, ["monitor", f"tcp:127.0.0.1:{port}", "--intent", str(intent)])
+    assert r.exit_code == 1 and r.output.count("\n") == 1, r.output
+    assert r.output.startswith(f"error: connection 'tcp:127.0.0.1:{port}': cannot connect"), r.output
+    with pytest.raises(Exception, match="expected tcpin:HOST:PORT"):
+        st.open_connection("tcpin:127.0.0.1:http")
+    with socket.create_server(("127.0.0.1", 0)) as busy:  # the port is taken
+        with pytest.raises(Exception, match="cannot listen"):
+            st.open_connection(f"tcpin:127.0.0.1:{busy.getsockname()[1]}")
+
+
 def test_nav_live_equals_causal_bit_for_bit(shared_data, tmp_path):
     log = str(shared_data / LOG171)
     port = free_port()
@@ -402,7 +546,7 @@ def test_bad_input_is_one_error_line(tmp_path):
     r = CliRunner().invoke(main, ["replay", str(tmp_path / "x.tlog"), "--to", "tcp:x"])
     assert r.exit_code == 1 and "--to: expected udp:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT" in r.output
     r = CliRunner().invoke(main, ["replay", str(tmp_path / "x.tlog"), "--to", "serial:127.0.0.1:5760"])
-    assert r.exit_code == 1 and "tcpin:HOST:PORT, got 'serial:" in r.output
+    assert r.exit_code == 1 and "/dev/ttyX,BAUD, got 'serial:" in r.output
     r = CliRunner().invoke(main, ["monitor", "bogus", "--intent", str(tmp_path / "none.json")])
     assert r.exit_code == 1 and "error:" in r.output
     r = CliRunner().invoke(main, ["nav", "--causal"])
@@ -495,3 +639,105 @@ def test_live_page_shows_the_state_change_in_chromium(shared_data, intent):
         finally:
             browser.close()
     assert outside == []
+
+
+def test_both_filter_entry_points_check_their_arrays_alike():
+    """``ins_run`` and ``InsStream.step`` view and check the IMU and GNSS arrays through one
+    extractor: the same mismatch gives the same message from either."""
+    from uasnav import _core
+    from uasnav.errors import InputError
+    from uasnav.ins.core import InsConfig
+
+    cfg = InsConfig.for_logged_imu().filter_config(0.0)
+    t = np.arange(200) * 0.01
+    rows = np.zeros((200, 3))
+    fix_t, fix = np.array([0.5]), np.zeros((1, 3))
+    stream = _core.InsStream(config=cfg)
+    for short in ("gyro", "gnss_vel"):
+        args = {"imu_t": t, "gyro": rows, "accel": rows, "gnss_t": fix_t, "gnss_llh": fix, "gnss_vel": fix,
+                "gnss_acc": fix}  # fmt: skip
+        args[short] = args[short][:-1] if short == "gyro" else np.zeros((2, 3))
+        want = (
+            "gyro/accel: expected 200 rows"
+            if short == "gyro"
+            else "gnss_llh/gnss_vel/gnss_acc: expected 1 rows"
+        )
+        with pytest.raises(InputError, match=want):
+            _core.ins_run(*args.values(), config=cfg)
+        with pytest.raises(InputError, match=want):
+            stream.step(*args.values(), np.zeros(1, dtype=np.uint64))
+    with pytest.raises(InputError, match="gnss_before: expected 1 rows like gnss_t"):
+        stream.step(t, rows, rows, fix_t, fix, fix, fix, np.zeros(2, dtype=np.uint64))
+
+
+def _read_pty(master: int, until: subprocess.Popen[str], timeout_s: float = 120.0) -> bytes:
+    """Bytes from a pseudo-terminal's master side until ``until`` exits and the line is empty."""
+    import os
+    import select
+
+    data = bytearray()
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([master], [], [], 0.2)
+        if ready:
+            data += os.read(master, 65536)
+        elif until.poll() is not None:
+            return bytes(data)
+    pytest.fail("the replay did not end")
+
+
+def test_replay_to_a_serial_port_and_monitor_from_one(shared_data, intent):
+    """``replay --to /dev/ttyX,BAUD`` writes the packets whole to a serial line, and ``monitor
+    /dev/ttyX,BAUD`` reads one (a pseudo-terminal pair stands for the radio link)."""
+    import os
+    import tty
+
+    from uasnav.live.source import mavlink_dialect
+
+    master, slave = os.openpty()
+    tty.setraw(master)
+    try:
+        tx = subprocess.Popen(
+            [*uasnav_command(), "replay", str(shared_data / TLOG), "--to", f"{os.ttyname(slave)},57600",
+             "--speed", "100", "--from", str(RUN[0]), "--stop-after", str(RUN[0] + 10)],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        data = _read_pty(master, tx)
+        _, err = tx.communicate(timeout=60)
+        assert tx.returncode == 0, err
+        mav = mavlink_dialect().MAVLink(None)
+        mav.robust_parsing = True
+        msgs = [m for m in mav.parse_buffer(data) or [] if m.get_type() != "BAD_DATA"]
+        assert len(msgs) == count(r"sent (\d+) packets", err) > 100 and count(r"\((\d+) bytes", err) == len(
+            data
+        )
+
+        rx = subprocess.Popen(
+            [*uasnav_command(), "monitor", f"{os.ttyname(slave)},57600", "--intent", str(intent),
+             "--json-lines", "--idle-exit", "1"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        os.write(master, _packets(20))  # the line holds them until the monitor reads
+        out, err = rx.communicate(timeout=60)
+        assert rx.returncode == 0, err
+        assert states([json.loads(line) for line in out.splitlines()]) == ["Accepted"]
+        assert count(r"(\d+) messages received", err.strip().splitlines()[-1]) == 40, err
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+def test_serial_errors_are_one_line(shared_data, intent, tmp_path):
+    tlog = str(shared_data / TLOG)
+    for to, want in (
+        (str(tmp_path / "ttyNONE"), f"tcpin:HOST:PORT or /dev/ttyX,BAUD, got '{tmp_path / 'ttyNONE'}'"),
+        ("/dev/ttyNONE,57600", "error: --to /dev/ttyNONE,57600: cannot open /dev/ttyNONE"),
+        ("/dev/null,57600", "error: --to /dev/null,57600: /dev/null is not a serial port"),
+        ("/dev/ttyS0,fast", "--to: expected /dev/ttyX,BAUD (the baud rate a number), got '/dev/ttyS0,fast'"),
+        ("/dev/ttyS0,12345", "--to /dev/ttyS0,12345: baud rate 12345 is not one this system's serial ports"),
+    ):
+        r = CliRunner().invoke(main, ["replay", tlog, "--to", to])
+        assert r.exit_code == 1 and want in r.output and r.output.count("\n") == 1, (to, r.output)
+    r = CliRunner().invoke(main, ["monitor", "/dev/null,57600", "--intent", str(intent)])
+    assert r.exit_code == 1 and r.output.count("\n") == 1, r.output
+    assert r.output.startswith("error: connection '/dev/null,57600': /dev/null is not a serial"), r.output

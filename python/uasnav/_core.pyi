@@ -290,14 +290,19 @@ def utm_earliest_delays(
 __all__ += ["utm_earliest_delays", "utm_encounters"]
 # ---- GNSS/INS ---------------------------------------------------------------------------
 
+# Times (k,) s and rows (k, 3) of the IMU and GNSS arrays both filter entry points take (units
+# in ins_run's docstring).
+_Times = NDArray[np.float64]
+_Rows = NDArray[np.float64]
+
 def ins_run(
-    imu_t: NDArray[np.float64],
-    gyro: NDArray[np.float64],
-    accel: NDArray[np.float64],
-    gnss_t: NDArray[np.float64],
-    gnss_llh: NDArray[np.float64],
-    gnss_vel: NDArray[np.float64],
-    gnss_acc: NDArray[np.float64],
+    imu_t: _Times,
+    gyro: _Rows,
+    accel: _Rows,
+    gnss_t: _Times,
+    gnss_llh: _Rows,
+    gnss_vel: _Rows,
+    gnss_acc: _Rows,
     *,
     gnss_use: NDArray[np.bool_] | None = None,
     baro_t: NDArray[np.float64] | None = None,
@@ -315,11 +320,12 @@ def ins_run(
 ) -> dict[str, Any]:
     """Run the GNSS/INS filter over a whole flight (one call, GIL released).
 
-    IMU times (s), gyro (n, 3) rad/s, accel (n, 3) m/s²; GNSS times (s), llh (m, 3) rad/rad/m,
-    NED velocity (m, 3) m/s, accuracies (m, 3) = horizontal m, vertical m, speed m/s. Returns
-    decimated ``llh``, ``vel``, ``attitude``, ``gyro_bias``, ``accel_bias``, ``cov_diag``,
-    ``protection`` (HPL, VPL m), ``gnss_used``; per fix ``fix_status`` (0 used, 1/2 excluded,
-    3 masked, 4 unused, 5 reset) and ``fix_nis``; and the update counts. ``config`` is one
+    IMU times (n,) s, gyro (n, 3) rad/s, accel (n, 3) m/s²; GNSS times (m,) s, llh (m, 3)
+    rad/rad/m, NED velocity (m, 3) m/s, accuracies (m, 3) = horizontal m, vertical m, speed m/s;
+    each array's rows match its times (checked). Returns decimated ``llh``, ``vel``,
+    ``attitude``, ``gyro_bias``, ``accel_bias``, ``cov_diag``, ``protection`` (HPL, VPL m),
+    ``gnss_used``; per fix ``fix_status`` (0 used, 1/2 excluded, 3 masked, 4 unused, 5 reset)
+    and ``fix_nis``; and the update counts. ``config`` is one
     :class:`uasnav.ins.core.FilterConfig`, read by attribute (nav-core's field names; ``None``
     keeps nav-core's default); a missing attribute or a wrong type is an ``InputError`` naming
     the field.
@@ -335,18 +341,18 @@ class InsStream:
     def __new__(cls, *, config: FilterConfig, levelling_samples: int = 100) -> InsStream: ...
     def step(
         self,
-        imu_t: NDArray[np.float64],
-        gyro: NDArray[np.float64],
-        accel: NDArray[np.float64],
-        gnss_t: NDArray[np.float64],
-        gnss_llh: NDArray[np.float64],
-        gnss_vel: NDArray[np.float64],
-        gnss_acc: NDArray[np.float64],
+        imu_t: _Times,
+        gyro: _Rows,
+        accel: _Rows,
+        gnss_t: _Times,
+        gnss_llh: _Rows,
+        gnss_vel: _Rows,
+        gnss_acc: _Rows,
         gnss_before: NDArray[np.uint64],
     ) -> dict[str, NDArray[Any]]:
-        """Process one batch in arrival order (GIL released): IMU times (s), gyro (n, 3) rad/s,
-        accel (n, 3) m/s²; fixes as for :func:`ins_run`, fix ``j`` having arrived after
-        ``gnss_before[j]`` of the batch's IMU samples. Returns, per processed IMU sample, ``t``,
+        """Process one batch in arrival order (GIL released): the IMU and GNSS arrays as for
+        :func:`ins_run`, fix ``j`` having arrived after ``gnss_before[j]`` of the batch's IMU
+        samples. Returns, per processed IMU sample, ``t``,
         ``llh``, ``vel``, ``attitude``, ``protection`` (HPL, VPL m), ``gyro_bias``,
         ``accel_bias``, ``fixes_used``, ``fixes_excluded``."""
     @property

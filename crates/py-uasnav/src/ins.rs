@@ -154,7 +154,9 @@ struct Samples<'a> {
     gnss_acc: &'a [[f64; 3]],
 }
 
-/// Views the IMU and GNSS arguments (zero-copy); a wrong shape or layout names the argument.
+/// Views the IMU and GNSS arguments both entry points take (zero-copy) and checks that the
+/// IMU rows match `imu_t` and the GNSS rows `gnss_t`; a wrong shape or layout names the
+/// argument.
 #[allow(clippy::too_many_arguments)]
 fn samples<'a>(
     py: Python<'_>,
@@ -166,7 +168,7 @@ fn samples<'a>(
     gnss_vel: &'a PyReadonlyArray2<'_, f64>,
     gnss_acc: &'a PyReadonlyArray2<'_, f64>,
 ) -> PyResult<Samples<'a>> {
-    Ok(Samples {
+    let s = Samples {
         imu_t: slice1(py, "imu_t", imu_t)?,
         gyro: rows::<3>(py, "gyro", gyro)?,
         accel: rows::<3>(py, "accel", accel)?,
@@ -174,7 +176,26 @@ fn samples<'a>(
         gnss_llh: rows::<3>(py, "gnss_llh", gnss_llh)?,
         gnss_vel: rows::<3>(py, "gnss_vel", gnss_vel)?,
         gnss_acc: rows::<3>(py, "gnss_acc", gnss_acc)?,
-    })
+    };
+    let n = s.imu_t.len();
+    if s.gyro.len() != n || s.accel.len() != n {
+        return Err(input_error(
+            py,
+            format!(
+                "gyro/accel: expected {n} rows like imu_t, got {} and {}",
+                s.gyro.len(),
+                s.accel.len()
+            ),
+        ));
+    }
+    let m = s.gnss_t.len();
+    if s.gnss_llh.len() != m || s.gnss_vel.len() != m || s.gnss_acc.len() != m {
+        return Err(input_error(
+            py,
+            format!("gnss_llh/gnss_vel/gnss_acc: expected {m} rows like gnss_t"),
+        ));
+    }
+    Ok(s)
 }
 
 type Hist = (
@@ -381,36 +402,17 @@ impl PyInsStream {
         gnss_acc: PyReadonlyArray2<'py, f64>,
         gnss_before: PyReadonlyArray1<'py, u64>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let Samples {
-            imu_t: it,
-            gyro: g,
-            accel: a,
-            gnss_t: gt,
-            gnss_llh: gl,
-            gnss_vel: gv,
-            gnss_acc: ga,
-        } = samples(
+        let s = samples(
             py, &imu_t, &gyro, &accel, &gnss_t, &gnss_llh, &gnss_vel, &gnss_acc,
         )?;
         let gb = gnss_before.as_slice().map_err(|_| {
             input_error(py, "gnss_before: expected a contiguous uint64 array".into())
         })?;
-        let n = it.len();
-        if g.len() != n || a.len() != n {
+        let (n, m) = (s.imu_t.len(), s.gnss_t.len());
+        if gb.len() != m {
             return Err(input_error(
                 py,
-                format!(
-                    "gyro/accel: expected {n} rows like imu_t, got {} and {}",
-                    g.len(),
-                    a.len()
-                ),
-            ));
-        }
-        let m = gt.len();
-        if gl.len() != m || gv.len() != m || ga.len() != m || gb.len() != m {
-            return Err(input_error(
-                py,
-                format!("gnss_llh/gnss_vel/gnss_acc/gnss_before: expected {m} rows like gnss_t"),
+                format!("gnss_before: expected {m} rows like gnss_t"),
             ));
         }
         if gb.windows(2).any(|w| matches!(w, [x, y] if y < x)) || gb.iter().any(|&b| b as usize > n)
@@ -423,8 +425,11 @@ impl PyInsStream {
         let inner = &mut self.inner;
         let out = py.detach(|| -> Result<Vec<StreamSolution<f64>>, nav_core::NavError> {
             let mut out = Vec::with_capacity(n);
-            let mut fixes = gt.iter().zip(gl).zip(gv).zip(ga).zip(gb).peekable();
-            let mut imu = it.iter().zip(g).zip(a);
+            let mut fixes = (s.gnss_t.iter().zip(s.gnss_llh).zip(s.gnss_vel))
+                .zip(s.gnss_acc)
+                .zip(gb)
+                .peekable();
+            let mut imu = s.imu_t.iter().zip(s.gyro).zip(s.accel);
             for k in 0..=n {
                 while let Some(((((t, l), v), acc), _)) =
                     fixes.next_if(|(_, b)| usize::try_from(**b).is_ok_and(|b| b == k))

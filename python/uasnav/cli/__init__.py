@@ -67,7 +67,7 @@ SUBCOMMANDS: Mapping[str, tuple[str, str]] = {
     "replay": (
         "uasnav.cli.replay",
         "Send LOG (.tlog as recorded; .bin/.ulg converted to the MAVLink messages a ground station "
-        "receives) over UDP or TCP in its recorded timing, scaled by --speed.",
+        "receives) over UDP, TCP or a serial port in its recorded timing, scaled by --speed.",
     ),
     "report": (
         "uasnav.cli.report",

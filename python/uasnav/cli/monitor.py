@@ -130,11 +130,19 @@ def command(  # type: ignore[no-untyped-def]
         if out is not None:
             out.close()
         conn.close()
-    click.echo(summary(monitor.stats, queue_dropped, kernel_dropped, latencies, ended=done()), err=True)
+    end = getattr(conn, "end", None)  # why a stream that can end (TCP) ended
+    line = summary(monitor.stats, queue_dropped, kernel_dropped, latencies, ended=done(), end=end)
+    click.echo(line, err=True)
 
 
 def summary(
-    s: Any, queue_dropped: int, kernel_dropped: int | None, latencies: list[float], *, ended: bool
+    s: Any,
+    queue_dropped: int,
+    kernel_dropped: int | None,
+    latencies: list[float],
+    *,
+    ended: bool,
+    end: str | None = None,
 ) -> str:
     """The closing line: what was received and what was lost where. Losses ``by sequence
     number`` are gaps in each sender's MAVLink sequence, so they include what the link lost
@@ -144,7 +152,7 @@ def summary(
     if kernel_dropped is not None:
         here = f"{kernel_dropped} dropped by a full kernel receive buffer, {here}"
     worst = f", latency ≤ {max(latencies):.1f} ms" if latencies else ""
-    stop = "; stopped once every intent had Ended" if ended else ""
+    stop = "; stopped once every intent had Ended" if ended else f"; {end}" if end else ""
     return (
         f"{s.messages} messages received ({here}), {s.position_reports} position reports "
         f"({s.stale_reports} duplicated/late skipped, {s.seq_lost} lost by sequence number), "

@@ -15,7 +15,8 @@ from uasnav.cli._common import POSITIVE, SEED, Real
     required=True,
     help="Where to send: udp:HOST:PORT (or udpout:HOST:PORT) as datagrams; tcp:HOST:PORT to a "
     "listening receiver (retried until it listens, 30 s at most); tcpin:HOST:PORT to the first "
-    "receiver that connects (waits 30 s at most).",
+    "receiver that connects (waits 30 s at most); /dev/ttyX,BAUD to a serial port (a telemetry "
+    "radio) at BAUD (default 57600).",
 )
 @click.option("--speed", type=POSITIVE, default=1.0, show_default=True, help="Times real time.")
 @click.option("--loop", is_flag=True, help="Start again at the end, until interrupted.")
@@ -45,7 +46,7 @@ from uasnav.cli._common import POSITIVE, SEED, Real
 @click.option("--seed", type=SEED, default=0, show_default=True, help="Seed of --drop/--duplicate.")
 def command(log, target, speed, loop, offset_text, offset_until, drop, duplicate, start_s, stop_after, seed):  # type: ignore[no-untyped-def]
     """Send LOG (.tlog as recorded; .bin/.ulg converted to the MAVLink messages a ground station
-    receives) over UDP or TCP in its recorded timing, scaled by --speed."""
+    receives) over UDP, TCP or a serial port in its recorded timing, scaled by --speed."""
     from uasnav.live.replay import open_sender, parse_offset, parse_target, replay
     from uasnav.live.source import log_packets
 

@@ -7,14 +7,22 @@ States (F3548 §4.4 operational intent states), per vehicle:
 
 - **Accepted** — the intent is known, the vehicle is heard but not flying it yet.
 - **Activated** — inferred from arming inside a volume alive at that time (activation is the
-  operator's act; the monitor sees its effect).
+  operator's act; the monitor sees its effect). A vehicle armed on the ground before the
+  intent's first volume opens waits in Accepted and is Activated when it opens; one that leaves
+  the ground before then is Activated and Nonconforming at once.
 - **Nonconforming** — a position report outside every volume alive at its time: horizontally,
   vertically or in time. Back to Activated when a report is inside again.
 - **Contingent** — by the operator's rule: nonconforming for longer than
   ``contingent_after_outside_s``, telemetry lost for longer than ``contingent_after_loss_s``,
   or the vehicle reporting a failsafe (``HEARTBEAT.system_status`` CRITICAL or EMERGENCY, MAVLink's
   way to report a lost C2 link). Stays until Ended.
-- **Ended** — disarm after the flight.
+- **Ended** — landing (a report within :data:`GROUND_M` of home's height after the flight
+  rose above :data:`AIRBORNE_M`) or disarm after the flight; a vehicle that lands is not
+  activated again before it disarms and arms.
+
+On the ground is ``GLOBAL_POSITION_INT.relative_alt`` (height above home, which the autopilot
+zeroes at arming) ≤ :data:`GROUND_M`: the vehicle sitting on its pad before the start and after
+touch-down is not flying outside its intent.
 
 Telemetry loss (no message from the vehicle for ``telemetry_timeout_s`` of vehicle time) is
 its own event, ``telemetry_lost``/``telemetry_restored``, not a C2 loss: the ground station's
@@ -60,6 +68,13 @@ STATES = (ACCEPTED, ACTIVATED, NONCONFORMING, CONTINGENT, ENDED)
 
 #: A vehicle clock that goes back by more than this (s) is a reboot.
 REBOOT_JUMP_S = 30.0
+#: Height above home (m, ``relative_alt``) at or below which the vehicle is on the ground: a
+#: barometer's drift over a flight stays within it, a multirotor's final descent (≤ 0.5 m/s)
+#: covers it in about 3 s.
+GROUND_M = 1.5
+#: Height above home (m) above which the vehicle has taken off (a later report on the ground
+#: is its landing).
+AIRBORNE_M = 5.0
 #: 95 % of a normal distribution in one dimension, in σ.
 K95 = 1.96
 _MAV_MODE_FLAG_SAFETY_ARMED = 128
@@ -141,6 +156,9 @@ class _Vehicle:
     telemetry_lost: bool = False
     failsafe: bool = False
     last_position: tuple[float, float, float] | None = None
+    height_above_home_m: float | None = None
+    airborne: bool = False
+    landed: bool = False
     stale: int = 0
     reports: int = 0
 
@@ -309,7 +327,7 @@ class ConformanceMonitor:
                 return  # judged at the first position report
             self._judge_armed(v, t, out)
         elif not armed and v.armed:
-            v.armed = False
+            v.armed = v.airborne = v.landed = False
             if v.state in (ACTIVATED, NONCONFORMING, CONTINGENT):
                 self._to(v, ENDED, t, "disarmed after the flight", out)
         failsafe = msg.system_status in (_MAV_STATE_CRITICAL, _MAV_STATE_EMERGENCY)
@@ -317,10 +335,18 @@ class ConformanceMonitor:
             self._to(v, CONTINGENT, t, f"vehicle reports failsafe (system status {msg.system_status})", out)
         v.failsafe = failsafe
 
+    def _on_ground(self, v: _Vehicle) -> bool:
+        h = v.height_above_home_m
+        return h is not None and h <= GROUND_M
+
     def _judge_armed(self, v: _Vehicle, t: float | None, out: list[dict[str, Any]]) -> None:
         m = self._check(v, t)
-        if m is None:
+        if m is None or v.landed:
             return
+        if m["volume"] is None and t is not None and self._on_ground(v):
+            assert v.boot_to_unix_s is not None  # _check needs it
+            if t + v.boot_to_unix_s < float(v.geometry.time_s[:, 0].min()):
+                return  # armed on the pad before the intent's first volume opens: waits
         self._to(v, ACTIVATED, t, "armed", out, **m)
         if not m["inside"]:
             v.outside_since_s = t
@@ -367,6 +393,14 @@ class ConformanceMonitor:
         lat, lon = msg.lat * 1e-7, msg.lon * 1e-7
         h = msg.alt * 1e-3 + float(geoid_height(lat, lon))  # AMSL → W84
         v.last_position = (lat, lon, h)
+        v.height_above_home_m = msg.relative_alt * 1e-3
+        if v.armed and v.state in (ACTIVATED, NONCONFORMING, CONTINGENT):
+            if v.height_above_home_m > AIRBORNE_M:
+                v.airborne = True
+            elif v.airborne and self._on_ground(v):
+                v.landed, v.outside_since_s = True, None
+                self._to(v, ENDED, t, f"landed ({v.height_above_home_m:.1f} m above home)", out)
+                return
         if v.armed and v.state in (ACCEPTED, ENDED):
             self._judge_armed(v, t, out)
             return

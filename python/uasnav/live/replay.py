@@ -15,7 +15,9 @@ loss).
 from __future__ import annotations
 
 import math
+import os
 import random
+import select
 import socket
 import time
 from collections.abc import Callable, Iterable, Iterator
@@ -24,6 +26,7 @@ from typing import Any
 
 from uasnav.errors import InputError, UasnavError
 from uasnav.live.source import Packet, mavlink_dialect
+from uasnav.live.stream import connect_tcp, listen_tcp
 
 #: Messages whose ``lat``/``lon`` (1e-7 deg) an offset shifts.
 POSITION_MESSAGES = ("GLOBAL_POSITION_INT", "GPS_RAW_INT", "GPS2_RAW")
@@ -61,34 +64,46 @@ def parse_offset(text: str, until_s: float | None = None) -> Offset:
 
 #: Forms of ``--to``: ``udp``/``udpout`` send datagrams to HOST:PORT; ``tcp`` connects to a
 #: listening receiver; ``tcpin`` listens and sends to the first receiver that connects (as a
-#: vehicle or simulator serving ``tcp:5760``).
-TARGET_SCHEMES = ("udp", "udpout", "tcp", "tcpin")
+#: vehicle or simulator serving ``tcp:5760``); ``serial`` writes to ``/dev/ttyX,BAUD`` (a
+#: telemetry radio's port, or a pseudo-terminal).
+TARGET_SCHEMES = ("udp", "udpout", "tcp", "tcpin", "serial")
 
 
 @dataclass(frozen=True)
 class Target:
-    """Where a replay sends: ``scheme`` (one of :data:`TARGET_SCHEMES`), ``host``, ``port``."""
+    """Where a replay sends: ``scheme`` (one of :data:`TARGET_SCHEMES`), ``host`` and ``port``
+    (for ``serial``: the device and its baud rate)."""
 
     scheme: str
     host: str
     port: int
 
     def __str__(self) -> str:
+        if self.scheme == "serial":
+            return f"{self.host},{self.port}"
         return f"{self.scheme}:{self.host}:{self.port}"
 
 
 def parse_target(text: str) -> Target:
-    """``udp:HOST:PORT``, ``udpout:HOST:PORT``, ``tcp:HOST:PORT`` or ``tcpin:HOST:PORT`` →
-    :class:`Target` (pymavlink's connection strings, seen from the sender).
+    """``udp:HOST:PORT``, ``udpout:HOST:PORT``, ``tcp:HOST:PORT``, ``tcpin:HOST:PORT`` or
+    ``/dev/ttyX,BAUD`` → :class:`Target` (pymavlink's connection strings, seen from the sender).
 
     >>> parse_target("tcpin:127.0.0.1:5760")
     Target(scheme='tcpin', host='127.0.0.1', port=5760)
+    >>> parse_target("/dev/ttyUSB0,57600")
+    Target(scheme='serial', host='/dev/ttyUSB0', port=57600)
     """
+    from uasnav.live.stream import parse_serial
+
+    if text.startswith("/dev/"):
+        dev, baud = parse_serial(text, "--to")
+        return Target("serial", dev, baud)
     scheme, _, rest = text.partition(":")
     host, _, port = rest.rpartition(":")
-    if scheme not in TARGET_SCHEMES or not host or not port.isdigit() or not 0 < int(port) < 65536:
+    if scheme not in TARGET_SCHEMES[:4] or not host or not port.isdigit() or not 0 < int(port) < 65536:
         raise InputError(
-            f"--to: expected udp:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT or tcpin:HOST:PORT, got {text!r}"
+            "--to: expected udp:HOST:PORT, udpout:HOST:PORT, tcp:HOST:PORT, tcpin:HOST:PORT or "
+            f"/dev/ttyX,BAUD, got {text!r}"
         )
     return Target(scheme, host.strip("[]"), int(port))
 
@@ -209,8 +224,8 @@ CONNECT_WAIT_S = 30.0
 
 def open_sender(
     target: Target, *, wait_s: float | None = None, on_wait: Callable[[str], Any] = lambda _: None
-) -> tuple[Callable[[bytes], Any], socket.socket]:
-    """A sender of encoded packets to ``target`` and its socket (close it when done).
+) -> tuple[Callable[[bytes], Any], Any]:
+    """A sender of encoded packets to ``target`` and its socket or port (close it when done).
 
     UDP is fire and forget (nobody listening is not an error). TCP is a byte stream: the
     packets are written whole, in order; a receiver that closes the connection ends the
@@ -218,6 +233,8 @@ def open_sender(
     ``wait_s`` defaults to :data:`CONNECT_WAIT_S`.
     """
     wait_s = CONNECT_WAIT_S if wait_s is None else wait_s
+    if target.scheme == "serial":
+        return _serial_sender(target)
     try:
         infos = socket.getaddrinfo(
             target.host,
@@ -239,7 +256,7 @@ def open_sender(
 
         return send_datagram, sock
     if target.scheme == "tcp":
-        sock = _tcp_connect(target, infos[0], wait_s)
+        sock = connect_tcp(infos[0], wait_s, f"--to {target}")
     else:
         sock = _tcp_accept(target, infos[0], wait_s, on_wait)
     sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -253,32 +270,38 @@ def open_sender(
     return send_stream, sock
 
 
-def _tcp_connect(target: Target, info: Any, wait_s: float) -> socket.socket:
-    family, kind, proto, _, addr = info
-    deadline = time.monotonic() + wait_s
-    while True:
-        sock = socket.socket(family, kind, proto)
-        try:
-            sock.connect(addr)
-            return sock
-        except OSError as e:
-            sock.close()
-            if not isinstance(e, ConnectionRefusedError) or time.monotonic() >= deadline:
-                raise InputError(
-                    f"--to {target}: cannot connect ({e.strerror or e}; waited {wait_s:g} s)"
-                ) from None
-            time.sleep(0.1)  # the receiver is not listening yet
+class _SerialPort:
+    """The replay's serial port: a file descriptor with ``close`` (as the sockets have)."""
+
+    def __init__(self, fd: int) -> None:
+        self.fd = fd
+
+    def close(self) -> None:
+        if self.fd >= 0:
+            os.close(self.fd)
+            self.fd = -1
+
+
+def _serial_sender(target: Target) -> tuple[Callable[[bytes], Any], Any]:
+    """Write whole packets to a serial port: a full output buffer (the line's baud rate, or a
+    reader that is behind) waits until it drains; the line holds back, it does not drop."""
+    from uasnav.live.stream import open_serial
+
+    port = _SerialPort(open_serial(target.host, target.port, f"--to {target}"))
+
+    def send_serial(data: bytes) -> None:
+        view = memoryview(data)
+        while view:
+            try:
+                view = view[os.write(port.fd, view) :]
+            except BlockingIOError:
+                select.select([], [port.fd], [], 1.0)
+
+    return send_serial, port
 
 
 def _tcp_accept(target: Target, info: Any, wait_s: float, on_wait: Callable[[str], Any]) -> socket.socket:
-    family, kind, proto, _, addr = info
-    with socket.socket(family, kind, proto) as server:
-        server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            server.bind(addr)
-        except OSError as e:
-            raise InputError(f"--to {target}: cannot listen ({e.strerror or e})") from None
-        server.listen(1)
+    with listen_tcp(info, f"--to {target}") as server:
         server.settimeout(wait_s)
         on_wait(f"waiting up to {wait_s:g} s for a receiver to connect to {target.host}:{target.port}")
         try:

@@ -11,8 +11,10 @@ Steps:
    vehicle's log, else ArduPilot's defaults ``WPNAV_SPEED_UP`` 2.5 m/s, ``WPNAV_SPEED_DN``
    1.5 m/s), a sloped leg no faster than its vertical limit allows, hovers for their hold
    time, ``DO_CHANGE_SPEED`` legs at their own speed.
-3. Time bounds: the model's calibrated split-conformal band (:mod:`uasnav.trajectory.timebounds`)
-   at the requested coverage, widened by the predictor's flagged elements.
+3. Time bounds at the requested coverage (:mod:`uasnav.trajectory.timebounds`), widened by the
+   predictor's flagged elements: the model's calibrated split-conformal band, or, from the
+   vehicle's own runs (:func:`vehicle_run_bounds`), the Student-t prediction band of their log
+   pace, which may open the first volume before the filed start.
 4. Volumes: each leg is cut into pieces of at most ``piece_m`` metres; a piece's volume is the
    piece's segment grown by the lateral buffer (a polygon with round caps; a circle for a
    vertical-only piece), between its lowest and highest altitude ∓ the vertical buffer, alive
@@ -41,7 +43,7 @@ from uasnav.io.mission_plan import ItemKind, MissionPlan, RoutePoint, plan_cruis
 from uasnav.io.operational_intent import parse_details, rfc3339
 from uasnav.trajectory.models import Predictor
 from uasnav.trajectory.route3d import Route3D, RoutePrediction, predict_route, vertical_limits
-from uasnav.trajectory.timebounds import DEFAULT_COVERAGE, DEFAULT_TAU_S, TimeBounds
+from uasnav.trajectory.timebounds import DEFAULT_COVERAGE, DEFAULT_TAU_S, PaceBounds
 from uasnav.utm.altitude import w84_altitudes
 
 DEFAULT_LATERAL_BUFFER_M = 15.0
@@ -164,16 +166,21 @@ def vehicle_run_bounds(
     accel_z_ms2: float | None = None,
     cruise_ms: float | None = None,
     tau_s: float = DEFAULT_TAU_S,
-) -> TimeBounds:
-    """Time bounds of ``predictor`` from the vehicle's own earlier flights: every AUTO run of
-    each log (:func:`uasnav.trajectory.mission_runs.mission_runs`) against the predictor's
-    times for the log's own plan, one score per run — the largest |T − T̂|/(T̂ + τ) over the
-    items it reached and its touch-down (a land item counts at the touch-down).
+) -> PaceBounds:
+    """Time bounds of ``predictor`` from the vehicle's own earlier flights: for every AUTO run
+    of each log (:func:`uasnav.trajectory.mission_runs.mission_runs`), its true and predicted
+    times (s from the run's start) at the items it reached and at its touch-down (a land item
+    counts at the touch-down), with the predictor's times for the log's own plan (``runs`` of
+    the result); the bounds are the Student-t prediction bounds of each run's slowest and
+    fastest log pace ratio (:class:`uasnav.trajectory.timebounds.PaceBounds`), which follow the
+    vehicle's own bias and hold from few runs under their stated assumption; ``describe`` adds
+    the leave-one-run-out check.
 
     Raises
     ------
     InputError
-        A log without a mission or without an AUTO run that reaches an item.
+        A log without a mission or without an AUTO run that reaches an item; fewer runs than
+        :data:`uasnav.trajectory.timebounds.MIN_PACE_RUNS` at the first use of the bounds.
     """
     from pathlib import Path
 
@@ -181,7 +188,7 @@ def vehicle_run_bounds(
     from uasnav.trajectory.mission_runs import MISSION_VIEWS, mission_runs
 
     up, down, a_z = vertical_limits(predictor, climb_ms, descent_ms, accel_z_ms2)
-    scores: list[float] = []
+    runs: list[tuple[np.ndarray, np.ndarray]] = []
     names: list[str] = []
     for item in logs:
         log = item if isinstance(item, LogFile) else open_log(item, need=MISSION_VIEWS)
@@ -200,11 +207,11 @@ def vehicle_run_bounds(
             if run.landed:
                 pairs.append((run.duration_s, eta))
             if pairs:
-                scores.append(max(abs(t - p) / (p + tau_s) for t, p in pairs))
+                runs.append((np.array([t for t, _ in pairs]), np.array([p for _, p in pairs])))
         names.append(Path(str(log.path)).name)
-    if not scores:
+    if not runs:
         raise InputError("no AUTO run of the vehicle reaches an item of its mission")
-    return TimeBounds(np.array(scores), tau_s, f"{len(scores)} AUTO runs of the vehicle ({', '.join(names)})")
+    return PaceBounds.of_runs(runs, tau_s, f"{len(runs)} AUTO runs of the vehicle ({', '.join(names)})")
 
 
 def build_intent(
@@ -343,7 +350,7 @@ def build_intent(
         coverage=coverage,
         flags=flags,
         route_prediction=rp,
-        time_bounds_source=bounds.source,
+        time_bounds_source=bounds.describe(coverage),
     )
 
 
