@@ -9,8 +9,10 @@ far above its expected time, so a regression fails instead of stalling CI.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import random
+import re
 import subprocess
 import sys
 import threading
@@ -123,17 +125,86 @@ def test_fleet_has_a_log_timeout() -> None:
     assert res.exit_code == 2
 
 
-def test_the_per_log_deadline_stops_a_python_loop() -> None:
-    from uasnav.fleet.runner import LogTimeout, _deadline
+def _native_sleep(seconds: float) -> str:
+    """A call the interpreter cannot interrupt from inside the process (C code, no bytecode)."""
+    time.sleep(seconds)
+    return "finished"
+
+
+def _fails(_: object) -> None:
+    raise InputError("x.tlog: a bad log")
+
+
+def test_the_per_log_deadline_kills_a_native_call() -> None:
+    from uasnav.fleet.deadline import LogTimeout, call_with_deadline
 
     t0 = time.perf_counter()
-    with pytest.raises(LogTimeout), _deadline(0.2):
-        while True:
-            pass
-    assert time.perf_counter() - t0 < 30
-    with _deadline(5.0):  # a block that ends in time is untouched, and nothing fires later
-        pass
-    time.sleep(0.05)
+    with pytest.raises(LogTimeout):
+        call_with_deadline(_native_sleep, 60.0, 1.0)
+    assert time.perf_counter() - t0 < 30  # killed at 1 s (plus the child's start), not after 60 s
+    # the next call gets a new process; values and exceptions travel back
+    assert call_with_deadline(_native_sleep, 0.0, 30.0) == "finished"
+    with pytest.raises(InputError, match="a bad log"):
+        call_with_deadline(_fails, None, 30.0)
+
+
+def _slow_or_quick(path: str) -> object:
+    from uasnav.fleet.runner import LogRows
+
+    if "slow" in os.path.basename(path):
+        time.sleep(120)  # one native call far past the deadline
+    return LogRows([{"n": 1}], vehicle="V1", day="2026-01-01")
+
+
+@pytest.mark.parametrize("workers", [0, 1])
+def test_a_log_past_its_deadline_is_killed_and_the_run_goes_on(tmp_path: Path, workers: int) -> None:
+    import pyarrow as pa
+
+    from uasnav.fleet import Analysis, read_errors, run
+    from uasnav.fleet.output import MANIFEST
+
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    for name in ("a_slow.csv", "b_quick.csv"):
+        (logs / name).write_text(name)
+    out = tmp_path / "out.parquet"
+    analysis = Analysis("probe", pa.schema([pa.field("n", pa.int64())]), _slow_or_quick)
+    t0 = time.perf_counter()
+    s = run(analysis, [str(logs)], str(out), workers=workers, log_timeout_s=2.0)
+    assert time.perf_counter() - t0 < 90  # bounded: the 120 s sleep was killed
+    assert (s.n_ok, s.n_errors, s.n_timeouts) == (1, 1, 1)
+    errors = read_errors(out).to_pylist()
+    assert [e["error_type"] for e in errors] == ["LogTimeout"]
+    assert "a_slow.csv" in errors[0]["error"] and "--log-timeout" in errors[0]["error"]
+    entries = [json.loads(line) for line in (out / MANIFEST).read_text().splitlines()]
+    status = {Path(e["path"]).name: e["status"] for e in entries}
+    assert status == {"a_slow.csv": "timeout", "b_quick.csv": "ok"}
+
+
+def test_fleet_stops_a_long_real_log_at_its_deadline(tmp_path: Path) -> None:
+    """A 2 MB compressed log of 10⁶ samples (seconds of IMU analysis, mostly in the Rust core)
+    beside a small one: ``--log-timeout 1`` stops the first, the second is written."""
+    import numpy as np
+
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    for name, n in (("long.npz", 1_000_000), ("short.npz", 20_000)):
+        accel = np.zeros((n, 3))
+        accel[:, 2] = -9.80665
+        np.savez_compressed(
+            logs / name, t=np.arange(n) / 100.0, gyro=np.zeros((n, 3)), accel=accel,
+            meta_json=np.array("{}"), format=np.array("uasnav-npz/1"),
+        )  # fmt: skip
+    out = tmp_path / "health.parquet"
+    t0 = time.perf_counter()
+    args = ["fleet", "imu-health", str(logs), "--out", str(out), "--workers", "0", "--log-timeout", "1"]
+    res = _cli([*args, "--json"], timeout=240)
+    assert res.returncode == 0, res.stderr
+    assert time.perf_counter() - t0 < 240
+    summary = json.loads(res.stdout)
+    assert (summary["ok"], summary["errors"], summary["timeouts"]) == (1, 1, 1), summary
+    assert "long.npz" in summary["error_list"][0]["error"]
+    assert "per-log deadline of 1 s" in summary["error_list"][0]["error"]
 
 
 # -- 2. YAML bombs -----------------------------------------------------------------------------
@@ -368,7 +439,7 @@ def test_a_failed_command_changes_no_output(tmp_path: Path) -> None:
     "args,needle",
     [
         (["db", "validate", "http://[::1"], "not a valid URL"),
-        (["simulate", "--profile", "flight", "--duration", "1e308", "--out", "{tmp}/x.csv"], "range"),
+        (["simulate", "--profile", "flight", "--duration", "1e308", "--out", "{tmp}/x.csv"], "--duration"),
     ],
 )
 def test_internal_errors_become_input_errors(tmp_path: Path, args: list[str], needle: str) -> None:
@@ -882,3 +953,143 @@ def test_the_cli_estimates_a_prediction_before_running_it(tmp_path: Path) -> Non
         "a prediction of 1000 plan points needs about 1.5e+09 operations" in line
         and "UASNAV_MAX_WORK" in line
     )
+
+
+# -- 4. numbers at the edge of the range name their option -----------------------------------------
+
+
+@pytest.fixture(scope="module")
+def kinematic_model(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    model = tmp_path_factory.mktemp("model") / "m.json"
+    res = CliRunner().invoke(
+        main, ["trajectory", "train", str(TLOG), "--method", "kinematic", "--out", str(model)]
+    )
+    assert res.exit_code == 0, res.output
+    return model
+
+
+def _hold_plan(tmp_path: Path, hold_s: str) -> Path:
+    rows = [
+        (0, 1, 0, 16, "0", 47.0, 8.0, 400),
+        (1, 0, 3, 22, "0", 47.0, 8.0, 30),
+        (2, 0, 3, 16, hold_s, 47.001, 8.0, 30),
+        (3, 0, 3, 16, "0", 47.002, 8.0, 30),
+    ]
+    p = tmp_path / "hold.waypoints"
+    lines = ["\t".join(map(str, (*r[:5], 0, 0, 0, *r[5:], 1))) for r in rows]
+    p.write_text("QGC WPL 110\n" + "\n".join(lines) + "\n")
+    return p
+
+
+@pytest.mark.parametrize(
+    "extra,plan_hold,needle",
+    [
+        (
+            ["--start", "9999-12-31T23:59:59Z"],
+            "0",
+            "--start: '9999-12-31T23:59:59Z' is outside the years 1970–9000",
+        ),
+        (["--start", "2026-01-01T00:00:00Z"], "1e12", "a hold of 1e+12 s is beyond the 65535 s"),
+    ],
+)
+def test_intent_times_beyond_the_calendar_name_their_cause(
+    tmp_path: Path, kinematic_model: Path, extra: list[str], plan_hold: str, needle: str
+) -> None:
+    out = tmp_path / "i.json"
+    plan = _hold_plan(tmp_path, plan_hold)
+    args = ["trajectory", "intent", "--model", str(kinematic_model), "--plan", str(plan), "--wind", "0@0",
+            "--out", str(out), *extra]  # fmt: skip
+    res = CliRunner().invoke(main, args)
+    errors = [ln for ln in res.stderr.splitlines() if ln.startswith("error")]
+    assert res.exit_code == 1 and errors == [errors[0]] and needle in errors[0], res.stderr
+    assert "representable range" not in res.stderr and "Traceback" not in res.output
+    assert not out.exists()
+    ok = (
+        CliRunner().invoke(main, [*args[:-2], "--start", "2026-01-01T00:00:00Z"])
+        if plan_hold == "0"
+        else None
+    )
+    assert ok is None or ok.exit_code == 0, ok.output if ok else ""
+
+
+@pytest.mark.parametrize("now", ["0001-01-01T00:00:00Z", "0001-01-01T00:00:00+01:00", "9999-12-31T23:59:59Z"])
+def test_deconflict_at_an_absurd_now_names_the_option(now: str) -> None:
+    intents = DATA / "utm" / "interuss_flight_intents_conflicting.yaml"
+    line = _one_error_line(CliRunner().invoke(main, ["utm", "deconflict", str(intents), "--now", now]))
+    assert line == f"error: --now: {now!r} is outside the years 1970–9000"
+
+
+@pytest.mark.parametrize(
+    "cmd,option",
+    [
+        (["trajectory", "intent", "--wind", "0@0", "--start", "2026-01-01T00:00:00Z"], "--lateral-buffer"),
+        (["trajectory", "intent", "--wind", "0@0", "--start", "2026-01-01T00:00:00Z"], "--vertical-buffer"),
+        (
+            ["utm", "deconflict", str(DATA / "utm" / "interuss_flight_intents_conflicting.yaml")],
+            "--horizontal-buffer",
+        ),
+        (
+            ["utm", "deconflict", str(DATA / "utm" / "interuss_flight_intents_conflicting.yaml")],
+            "--vertical-buffer",
+        ),
+    ],
+)
+def test_a_buffer_of_1e308_is_a_usage_error(
+    tmp_path: Path, kinematic_model: Path, cmd: list[str], option: str
+) -> None:
+    plan = _hold_plan(tmp_path, "0")
+    extra = [] if cmd[0] == "utm" else ["--model", str(kinematic_model), "--plan", str(plan), "--out",
+                                         str(tmp_path / "i.json")]  # fmt: skip
+    res = CliRunner().invoke(main, [*cmd, *extra, option, "1e308"])
+    assert res.exit_code == 2 and f"'{option}': 1e308 is not <= 100000" in res.stderr, res.output
+    assert "GEOS" not in res.output and not (tmp_path / "i.json").exists()
+
+
+def test_a_csv_cell_at_the_float_limit_names_the_file_and_sensor(tmp_path: Path) -> None:
+    log = _imu_csv(tmp_path / "imu.csv", n=2000)
+    lines = log.read_text().splitlines()
+    cells = lines[500].split(",")
+    cells[1] = "1.79e308"
+    lines[500] = ",".join(cells)
+    log.write_text("\n".join(lines) + "\n")
+    before = log.read_bytes()
+    line = _one_error_line(CliRunner().invoke(main, ["allan", str(log), "--json"]))
+    assert line.startswith(f"error: {log}: gyro: ") and "not representable as a float" in line
+    assert log.read_bytes() == before
+
+
+@pytest.mark.parametrize(
+    "where", [("layers", 0, "weights", 0, 0), ("layers", 1, "biases", 0), ("layers", 2, "weights", 0, 1)]
+)
+def test_thermal_network_weights_of_1e308_are_refused(tmp_path: Path, where: tuple[object, ...]) -> None:
+    """A hidden weight of 1e308 saturates its tanh and the model still predicts finite numbers:
+    silently a step function. The file is refused naming the value's JSON path."""
+    import copy
+
+    import numpy as np
+
+    from uasnav.thermal import NeuralBiasModel, dumps_model, loads_model
+    from uasnav.thermal.modelfile import ZEROS, file_checksum
+
+    t = np.linspace(-10.0, 40.0, 200)
+    b = np.stack([1e-3 * np.tanh((t - 15) / 10), 2e-4 * np.sin(t / 9), 3e-6 * (t - 5) ** 2], 1)
+    d = json.loads(dumps_model(NeuralBiasModel(2, restarts=1, max_epochs=20).fit(t, b)))
+
+    def signed(doc: dict) -> str:  # type: ignore[type-arg]
+        doc = copy.deepcopy(doc)
+        doc["checksum"] = {"algorithm": "sha256", "value": ZEROS}
+        text = json.dumps(doc)
+        return text.replace(ZEROS, file_checksum(text, ZEROS), 1)
+
+    loads_model(signed(d), "m.json")  # the harness loads the file as trained
+    node = d["models"][0]
+    for k in where[:-1]:
+        node = node[k]
+    node[where[-1]] = 1e308
+    path = "models[0]." + ".".join(f"{k}" if isinstance(k, str) else f"[{k}]" for k in where).replace(
+        ".[", "["
+    )
+    with pytest.raises(
+        DataFormatError, match=re.escape(f"m.json: {path}: 1e+308 is outside the accepted range")
+    ):
+        loads_model(signed(d), "m.json")

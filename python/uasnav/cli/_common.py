@@ -99,6 +99,10 @@ PROBABILITY = Real(0.0, 1.0, lo_open=True, hi_open=True)
 #: elements of 10¹⁰ s) to 150 m/s (above any small UAS; a model asked for 10⁶ m/s returns
 #: negative times).
 UAS_SPEED = Real(0.1, 150.0)
+#: A separation buffer around a flight's volumes (m): 0 to 100 km. Far wider than any airspace
+#: buffer, and small enough that the geometry stays finite (a buffer of 1e308 m turns GEOS's
+#: coordinates into inf).
+BUFFER_M = Real(0.0, 1e5)
 #: A random seed: what every generator of the package (numpy, Rust) accepts.
 SEED = click.IntRange(0, 2**32 - 1)
 

@@ -13,6 +13,7 @@ import click
 import numpy as np
 
 from uasnav.cli._common import (
+    BUFFER_M,
     NON_NEGATIVE,
     POSITIVE,
     PROBABILITY,
@@ -790,13 +791,13 @@ def _own_run_bounds(
 )
 @click.option(
     "--lateral-buffer",
-    type=POSITIVE,
+    type=Real(0.0, 1e5, lo_open=True),
     default=15.0,
     show_default=True,
-    help="Horizontal buffer around the path (m).",
+    help="Horizontal buffer around the path (m, at most 100 km).",
 )
 @click.option(
-    "--vertical-buffer", type=NON_NEGATIVE, default=10.0, show_default=True, help="Vertical buffer (m)."
+    "--vertical-buffer", type=BUFFER_M, default=10.0, show_default=True, help="Vertical buffer (m)."
 )
 @click.option(
     "--geoid-height",

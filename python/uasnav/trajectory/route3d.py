@@ -51,6 +51,12 @@ SAME_PLACE_M = 0.01
 SAME_HEIGHT_M = 0.01
 
 
+#: Longest hold at a waypoint (s): ArduPilot stores a waypoint's hold time (``param1``) as
+#: 16-bit seconds (``AP_Mission`` ``p1``); a longer one is a typing error, and a hold of 10¹² s
+#: would carry the intent's times past the year 9999.
+MAX_HOLD_S = 65535
+
+
 @dataclass(frozen=True)
 class Route3D:
     """A 3D route in a local frame.
@@ -85,6 +91,11 @@ class Route3D:
             raise InputError("route positions and altitudes must be finite")
         if not (np.isfinite(self.hold_s).all() and (self.hold_s >= 0).all()):
             raise InputError("route hold times must be finite and ≥ 0 s")
+        if (long := np.flatnonzero(self.hold_s > MAX_HOLD_S)).size:
+            raise InputError(
+                f"route point {long[0]}: a hold of {self.hold_s[long[0]]:g} s is beyond the {MAX_HOLD_S} s "
+                "an autopilot stores (ArduPilot: 16-bit seconds)"
+            )
         v = self.speed_ms[np.isfinite(self.speed_ms)]
         if (v <= 0).any() or np.isinf(self.speed_ms).any():
             raise InputError("route leg speeds must be > 0 m/s (NaN = cruise)")
