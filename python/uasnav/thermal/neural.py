@@ -45,9 +45,10 @@ from uasnav.thermal.modelfile import dumps_model, save_model
 
 #: Most neurons per hidden layer (the Rust engine's ``MAX_NEURONS``).
 MAX_HIDDEN = 16
-#: Largest weight or bias magnitude a model file may hold. The network sees normalised inputs
-#: (about ±1), so a weight of 10⁶ already turns a tanh into a step a millionth of the
-#: calibrated range wide; larger ones (1e308) are a corrupt or forged file, not a fit.
+#: Largest weight or bias magnitude of a hidden layer in a model file. The network sees
+#: normalised inputs (about ±1), so a weight of 10⁶ already turns a tanh into a step a millionth
+#: of the calibrated range wide; larger ones (1e308: the model still predicts finite numbers,
+#: silently a step function) are a corrupt or forged file, not a fit.
 MAX_PARAMETER = 1e6
 
 
@@ -113,7 +114,8 @@ class Network:
             e = jc.only(jc.obj(layer, q), ("activation", "weights", "biases"), q)
             jc.string(jc.field(e, "activation", q), jc.at(q, "activation"), (act,))
             top = 1 if i == 2 else MAX_HIDDEN
-            lim = {"lo": -MAX_PARAMETER, "hi": MAX_PARAMETER}
+            # hidden layers only: the linear output layer's are bounded by the bias check at load
+            lim = {"lo": -MAX_PARAMETER, "hi": MAX_PARAMETER} if i < 2 else {}
             b = jc.vector(jc.field(e, "biases", q), jc.at(q, "biases"), max_len=top, **lim)
             w = jc.matrix(jc.field(e, "weights", q), jc.at(q, "weights"), rows=b.size, cols=fan_in, **lim)
             ws.append(w)

@@ -101,6 +101,7 @@ def kinematic_times(
             raise InputError(f"leg_speed_ms needs {v_leg.size} speeds > 0 m/s (NaN = cruise), got {ls}")
         v_leg = np.where(np.isfinite(ls), ls, v_leg)
     v = v_leg[np.clip(np.searchsorted(cum, s, side="right") - 1, 0, v_leg.size - 1)]
+    v_top = float(v_leg.max()) if v_leg.size else 0.0
     for k in range(p.shape[0]):
         if k in (0, p.shape[0] - 1):
             vk = 0.0
@@ -108,7 +109,13 @@ def kinematic_times(
             c = d[k - 1] @ d[k] / (np.hypot(*d[k - 1]) * np.hypot(*d[k]))
             theta = np.arccos(np.clip(c, -1.0, 1.0))
             vk = min(v_leg[k - 1], v_leg[k]) * max(np.cos(theta / 2.0), 0.1)
-        v = np.minimum(v, np.sqrt(vk**2 + 2.0 * accel_ms2 * np.abs(s - cum[k])))
+        # The ramp around waypoint k exceeds every leg speed beyond (V_max² − v_k²)/2a of it:
+        # only the grid points within reach (with a margin for rounding) can change, which keeps
+        # the profile linear in the plan's length instead of quadratic in its points.
+        reach = (v_top**2 - vk**2) / (2.0 * accel_ms2) * (1.0 + 1e-9) + 2.0 * ds_m
+        lo, hi = np.searchsorted(s, [cum[k] - reach, cum[k] + reach])
+        w = slice(int(lo), int(hi) + 1)
+        v[w] = np.minimum(v[w], np.sqrt(vk**2 + 2.0 * accel_ms2 * np.abs(s[w] - cum[k])))
     # Time to each grid point: v² is linear in s on every ramp, so each grid interval is flown
     # at constant acceleration and takes exactly 2·Δs / (v₁ + v₂) (exact also from rest, where
     # the trapezoid rule on 1/v diverges; only intervals where the profile changes branch are
