@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import random
 import re
@@ -18,6 +19,7 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from click.testing import CliRunner
@@ -1139,3 +1141,99 @@ def test_the_windowed_kinematic_profile_equals_the_full_grid(seed: int) -> None:
         plan, s0, s1, cruise, accel, leg_speed=np.where(np.isnan(legs), cruise, legs)
     )
     np.testing.assert_array_equal(got, want)  # the same numbers, bit for bit
+
+
+# -- 8/9. the Python API: negative, NaN and infinite arguments (a table) ----------------------------
+
+
+def _api_table() -> list[tuple[str, Any, str]]:
+    import numpy as np
+
+    from uasnav import allan, attitude, stationary, zupt
+    from uasnav.imu import ImuLog
+    from uasnav.io import open_log
+    from uasnav.trajectory import baselines, route3d
+
+    n = 2000
+    rng = np.random.default_rng(0)
+    log = ImuLog(t=np.arange(n) / 100.0, gyro=rng.normal(0, 1e-3, (n, 3)),
+                 accel=rng.normal(0, 1e-2, (n, 3)) + [0, 0, -9.81])  # fmt: skip
+    x = rng.normal(size=200)
+    plan = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0]])
+    kin = lambda *a: lambda: baselines.kinematic_times(plan, np.zeros(1), np.full(1, 50.0), *a)  # noqa: E731
+    nan, inf = math.nan, math.inf
+    z = np.zeros((5, 3))
+    cs, sd, ma, ct = allan.cluster_sizes, stationary.detect_static, zupt.moving_average, zupt.convergence_time
+    return [
+        ("allan.oadev rate -1", lambda: allan.oadev(x, -1.0), "rate: must be finite and > 0"),
+        ("allan.oadev rate nan", lambda: allan.oadev(x, nan), "rate: must be finite and > 0"),
+        ("allan.oadev rate inf", lambda: allan.oadev(x, inf), "rate: must be finite and > 0"),
+        ("allan.oadev tau -1", lambda: allan.oadev(x, 1.0, [-1.0]), "cluster times must be finite and > 0"),
+        ("allan.oadev tau nan", lambda: allan.oadev(x, 1.0, [nan]), "cluster times must be finite and > 0"),
+        ("allan.oadev all-NaN data", lambda: allan.oadev(np.full(100, nan), 1.0), "non-finite value"),
+        ("allan.oadev confidence 2", lambda: allan.oadev(x, 1.0, confidence=2.0), "confidence"),
+        ("allan.oadev confidence nan", lambda: allan.oadev(x, 1.0, confidence=nan), "confidence"),
+        ("allan.cluster_sizes n -1", lambda: cs(-1, 1.0, "octave"), "n: expected an integer"),
+        ("allan.cluster_sizes rate 0", lambda: cs(100, 0.0, "octave"), "rate: must be finite"),
+        ("allan.cluster_sizes rate nan", lambda: cs(100, nan, [1.0]), "rate: must be finite"),
+        ("attitude.drift dt -1", lambda: attitude.drift([1e-3, 0, 0], -1.0, 10.0), "dt: must be finite"),
+        ("attitude.drift duration -1", lambda: attitude.drift([1e-3, 0, 0], 0.01, -1.0), "duration"),
+        ("attitude.drift duration inf", lambda: attitude.drift([1e-3, 0, 0], 0.01, inf), "duration"),
+        ("attitude.drift NaN rate", lambda: attitude.drift([nan, 0, 0], 0.01, 1.0), "non-finite"),
+        ("attitude.propagate dt nan", lambda: attitude.propagate([1, 0, 0, 0], np.zeros((5, 3)), nan), "dt"),
+        ("attitude.propagate |q0| 2", lambda: attitude.propagate([2, 0, 0, 0], np.zeros((5, 3)), 0.01),
+         "q0[0]: a quaternion of norm 2"),
+        ("attitude.rotation_angle |q| 2", lambda: attitude.rotation_angle([2, 0, 0, 0]), "norm 2, not a"),
+        ("attitude.quat_to_euler |q| 1.1", lambda: attitude.quat_to_euler([[1, 0, 0, 0], [1.1, 0, 0, 0]]),
+         "q[1]: a quaternion of norm 1.1"),
+        ("attitude.quat_to_dcm NaN", lambda: attitude.quat_to_dcm([nan, 0, 0, 0]), "non-finite"),
+        ("attitude.euler_to_quat inf", lambda: attitude.euler_to_quat([inf, 0, 0]), "non-finite"),
+        ("stationary window -1", lambda: sd(log, window_s=-1.0), "window_s"),
+        ("stationary threshold -1", lambda: sd(log, threshold=-1.0), "threshold: must be"),
+        ("stationary threshold inf", lambda: sd(log, threshold=inf), "threshold: must be"),
+        ("stationary sigma_a -1", lambda: sd(log, sigma_a=-1.0), "sigma_a"),
+        ("stationary min_duration -1", lambda: sd(log, min_duration_s=-1.0), "min_duration"),
+        ("stationary false_alarm 2", lambda: sd(log, false_alarm=2.0), "false_alarm"),
+        ("zupt.moving_average rate -1", lambda: ma(np.ones((10, 3)), -1.0), "rate_hz"),
+        ("zupt.moving_average window nan", lambda: ma(np.ones((10, 3)), 100.0, nan), "window_s"),
+        ("zupt.convergence_time threshold -1", lambda: ct(np.arange(5.0), z, z, -1.0), "threshold"),
+        ("io.open_log missing", lambda: open_log("/nonexistent/x.ulg").imus, "no such file"),
+        ("io.open_log unknown view", lambda: open_log(str(BIN), need=("bogus",)), "unknown view 'bogus'"),
+        ("trajectory kinematic cruise -1", kin(-1.0), "cruise_ms: must be finite and > 0"),
+        ("trajectory kinematic cruise nan", kin(nan), "cruise_ms: must be finite and > 0"),
+        ("trajectory kinematic accel 0", kin(5.0, 0.0), "accel_ms2: must be finite and > 0"),
+        ("trajectory kinematic step -1", kin(5.0, 1.0, -1.0), "ds_m: must be finite and > 0"),
+        ("trajectory kinematic step 1e-9", kin(5.0, 1.0, 1e-9), "raise the limit with UASNAV_MAX_MEMORY"),
+        ("trajectory vertical_time speed 0", lambda: route3d.vertical_time(50.0, 0.0, 1.0), "must be > 0"),
+        ("trajectory vertical_time accel nan", lambda: route3d.vertical_time(50.0, 2.0, nan), "must be > 0"),
+        ("trajectory route hold 1e12", lambda: route3d.Route3D(plan, np.zeros(3), np.array([0, 1e12, 0]),
+                                                               np.full(3, np.nan)), "a hold of 1e+12 s"),
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize("name,call,needle", _api_table(), ids=[n for n, _, _ in _api_table()])
+def test_public_api_refuses_negative_nan_and_infinite_arguments(name: str, call: Any, needle: str) -> None:
+    """Each call raises an :class:`InputError` (also a ``ValueError``) whose one-line message
+    names the argument: never numbers computed from a meaningless value, never a bare numpy or
+    Python exception."""
+    with pytest.raises(InputError) as e:
+        call()
+    assert isinstance(e.value, ValueError)
+    msg = str(e.value)
+    assert needle in msg and "\n" not in msg, msg
+
+
+def test_the_api_table_controls_answer() -> None:
+    """The same functions with ordinary values return finite numbers (so the table can fail)."""
+    import numpy as np
+
+    from uasnav import allan, attitude, zupt
+    from uasnav.trajectory import baselines, route3d
+
+    plan = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0]])
+    assert np.isfinite(allan.oadev(np.random.default_rng(0).normal(size=200), 1.0).adev).all()
+    assert np.isfinite(attitude.quat_to_euler([[1, 0, 0, 0], [1 + 5e-5, 0, 0, 0]])).all()
+    assert np.isfinite(zupt.moving_average(np.ones((10, 3)), 100.0)).all()
+    assert np.isfinite(baselines.kinematic_times(plan, np.zeros(1), np.full(1, 50.0), 5.0)).all()
+    assert np.isfinite(route3d.vertical_time(50.0, 2.0, 1.0)).all()
+    assert zupt.convergence_time(np.arange(5.0), np.zeros((5, 3)), np.zeros((5, 3))) == [0.0, 0.0, 0.0]

@@ -238,8 +238,9 @@ def detect_static(
         )
     if not 0 < false_alarm < 1:
         raise InputError(f"false_alarm: must be in (0, 1), got {false_alarm!r}")
-    if threshold is not None and math.isnan(threshold):
-        raise InputError("threshold: must not be NaN")
+    if threshold is not None and not (math.isfinite(threshold) and threshold >= 0):
+        # the statistic is >= 0: a negative threshold would silently find nothing, inf everything
+        raise InputError(f"threshold: must be finite and >= 0, got {threshold!r}")
     s_a, s_g, g_mag, b_in = sigma_a, sigma_g, gravity, gyro_bias
     if s_a is None or s_g is None or g_mag is None or b_in is None:
         if w < 3:

@@ -15,12 +15,14 @@ class per element, and the "classifier" then memorises single samples.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from uasnav.errors import InputError
+from uasnav.limits import check_memory
 from uasnav.trajectory.geometry import plan_length
 from uasnav.trajectory.samples import ElementSamples
 
@@ -88,10 +90,18 @@ def kinematic_times(
     NaN = ``cruise_ms``; default every leg at ``cruise_ms``), corner speed
     v_k = min(V_{k−1}, V_k)·max(cos(θ_k/2), 0.1) (the simulator's rule), 0 at the ends. A
     straight leg of length L flown from rest to rest at V takes L/V + V/a (L ≥ V²/a)."""
+    for name, x in (("cruise_ms", cruise_ms), ("accel_ms2", accel_ms2), ("ds_m", ds_m)):
+        if not (math.isfinite(x) and x > 0):
+            raise InputError(f"{name}: must be finite and > 0, got {x!r}")
     p = np.asarray(plan_ne, dtype=float)[:, :2]
     d = np.diff(p, axis=0)
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
     total = plan_length(p)
+    if not math.isfinite(total):
+        raise InputError(f"plan_ne: the plan's length is not finite ({total!r} m)")
+    check_memory(
+        4 * 8 * (total / ds_m + 2), f"a kinematic profile of {total:g} m at {ds_m:g} m steps", option="ds_m"
+    )
     s = np.arange(0.0, total + ds_m, ds_m)
     s[-1] = min(s[-1], total)
     v_leg = np.full(d.shape[0], float(cruise_ms))
