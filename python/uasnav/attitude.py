@@ -46,7 +46,8 @@ UNIT_NORM_TOL = 1e-4
 
 def _unit_quats(name: str, q: ArrayLike) -> NDArray[np.float64]:
     arr = _rows(name, q, 4)
-    norm = np.linalg.norm(arr, axis=1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        norm = np.linalg.norm(arr, axis=1)
     bad = np.flatnonzero(np.abs(norm - 1.0) > UNIT_NORM_TOL)  # NaN rows: the core names them
     if bad.size:
         i = int(bad[0])
@@ -192,7 +193,10 @@ def drift(
         if duration is None or not (np.isfinite(duration) and duration > 0):
             raise InputError("duration: required (> 0) for a constant rate vector")
         # the constant vector becomes n rows, θ(t) and t: refused before any allocation
-        n = check_count(round(duration / dt), 6 * 8, f"attitude drift over {duration:g} s", option="duration")
+        # (the count is checked as a float first: 1e308 s / 1e-300 s is inf, which round() cannot take)
+        what = f"attitude drift over {duration:g} s"
+        check_count(duration / dt, 6 * 8, what, option="duration (or raise dt)")
+        n = round(duration / dt)
         arr = np.broadcast_to(arr, (n, 3))
     r = _rows("rates", arr, 3)
     if r.shape[0] == 0:

@@ -222,7 +222,10 @@ def detect_static(
             bound = "> 0" if lo is not None else ">= 0"
             raise InputError(f"{name}: expected a finite number of seconds {bound}, got {value!r}")
     if window_samples is None:
-        w = max(3, round(window_s * log.uniform_rate(rtol=0.05)))
+        w_f = window_s * log.uniform_rate(rtol=0.05)
+        if not w_f <= log.n:  # (also inf: 1e308 s × 100 Hz, which round() cannot take)
+            raise InputError(f"window_s: {window_s:g} s is longer than the log ({log.n} samples)")
+        w = max(3, round(w_f))
         what = "window_s"
     else:
         w = int(window_samples)
@@ -260,6 +263,8 @@ def detect_static(
         from scipy import stats  # slow to import; only the default threshold needs it
 
         gamma = 1.5 * float(stats.chi2.ppf(1.0 - false_alarm, 6 * w - 2)) / w
+        if not math.isfinite(gamma):  # 1 − false_alarm rounds to 1 below ≈ 1e-16
+            raise InputError(f"false_alarm: {false_alarm!r} is too small for a finite threshold (≥ 1e-15)")
     else:
         gamma = float(threshold)
     stat = _rust_statistic(log.accel, log.gyro - b[None, :], w, s_a, s_g, g_mag)

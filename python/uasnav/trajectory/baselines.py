@@ -90,9 +90,12 @@ def kinematic_times(
     NaN = ``cruise_ms``; default every leg at ``cruise_ms``), corner speed
     v_k = min(V_{k−1}, V_k)·max(cos(θ_k/2), 0.1) (the simulator's rule), 0 at the ends. A
     straight leg of length L flown from rest to rest at V takes L/V + V/a (L ≥ V²/a)."""
-    for name, x in (("cruise_ms", cruise_ms), ("accel_ms2", accel_ms2), ("ds_m", ds_m)):
+    checks = (("cruise_ms", cruise_ms, 1e4), ("accel_ms2", accel_ms2, 1e4), ("ds_m", ds_m, math.inf))
+    for name, x, top in checks:
         if not (math.isfinite(x) and x > 0):
             raise InputError(f"{name}: must be finite and > 0, got {x!r}")
+        if x > top:  # beyond any aircraft; squared, 1e308 would leave the float range
+            raise InputError(f"{name}: {x:g} is beyond {top:g}")
     p = np.asarray(plan_ne, dtype=float)[:, :2]
     d = np.diff(p, axis=0)
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])

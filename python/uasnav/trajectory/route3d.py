@@ -187,7 +187,13 @@ def vertical_time(dz_m: np.ndarray | float, speed_ms: float, accel_ms2: float) -
     v, a = float(speed_ms), float(accel_ms2)
     if not (v > 0 and a > 0 and math.isfinite(v) and math.isfinite(a)):
         raise InputError(f"vertical speed and acceleration limits must be > 0, got {v}, {a}")
-    return np.where(d >= v * v / a, d / v + v / a, 2.0 * np.sqrt(d / a))
+    if not np.isfinite(d).all():
+        raise InputError("vertical move: the height changes must be finite")
+    with np.errstate(over="ignore"):
+        t = np.where(d >= v * v / a, d / v + v / a, 2.0 * np.sqrt(d / a))
+    if not np.isfinite(t).all():  # e.g. 1e308 m at 1e-300 m/s
+        raise InputError(f"vertical move: {float(np.max(d)):g} m at {v:g} m/s: a time beyond the float range")
+    return t
 
 
 @dataclass(frozen=True)
