@@ -266,6 +266,26 @@ def test_an_invalid_limit_is_refused_in_one_line(var: str, value: str) -> None:
     assert var in line and repr(value) in line
 
 
+@pytest.mark.parametrize(
+    "var,value", [("UASNAV_MAX_WORK", "nan"), ("UASNAV_MAX_MEMORY", "-1"), ("UASNAV_MAX_WORK", "")]
+)
+@pytest.mark.parametrize(
+    "args",
+    [["allan", "{imu}", "--taus", "all"],
+     ["fleet", "scan", "{imu}", "--out", "{tmp}/o.parquet", "--workers", "0"],
+     ["trajectory", "predict", "--model", "{imu}", "--plan", "{imu}", "--wind", "0@0"]],
+    ids=["allan", "fleet", "predict"],
+)  # fmt: skip
+def test_every_command_refuses_an_invalid_limit_before_working(
+    tmp_path: Path, args: list[str], var: str, value: str
+) -> None:
+    imu = _imu_csv(tmp_path / "imu.csv")
+    argv = [a.replace("{imu}", str(imu)).replace("{tmp}", str(tmp_path)) for a in args]
+    line = _one_error_line(CliRunner(env={var: value}).invoke(main, argv))
+    assert line.startswith(f"error: {var}: expected a ") and repr(value) in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["imu.csv"]
+
+
 def test_allan_honours_the_work_limit(tmp_path: Path) -> None:
     import numpy as np
 

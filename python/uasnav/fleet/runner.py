@@ -25,6 +25,10 @@ and removed; the rows carry the URL as their ``path``. A URL that cannot be fetc
 timeout, too large, refused redirect) is a row of the errors table; it is not committed to the
 manifest, so ``resume=True`` tries it again, while a finished URL is skipped by its text.
 
+With a per-log deadline (``log_timeout_s``, the CLI's ``--log-timeout``) each worker analyses its
+logs in a child process that is killed at the deadline (:mod:`uasnav.fleet.deadline`): a decoder
+stuck in native code cannot hold the run, and the log is recorded as timed out.
+
 Each task reads its log once, writes its rows to one Parquet file named by the log's content
 hash (atomically, :mod:`uasnav.fleet.output`) and returns a small :class:`TaskResult`; no
 samples travel to the client. A log that cannot be read becomes a row of the errors table and
