@@ -1021,10 +1021,10 @@ def test_intent_times_beyond_the_calendar_name_their_cause(
     plan = _hold_plan(tmp_path, plan_hold)
     args = ["trajectory", "intent", "--model", str(kinematic_model), "--plan", str(plan), "--wind", "0@0",
             "--out", str(out), *extra]  # fmt: skip
-    res = CliRunner().invoke(main, args)
-    errors = [ln for ln in res.stderr.splitlines() if ln.startswith("error")]
-    assert res.exit_code == 1 and errors == [errors[0]] and needle in errors[0], res.stderr
-    assert "representable range" not in res.stderr and "Traceback" not in res.output
+    t0 = time.perf_counter()
+    line = _one_error_line(CliRunner().invoke(main, args))  # refused before the calibration runs
+    assert needle in line and "representable range" not in line
+    assert time.perf_counter() - t0 < 60
     assert not out.exists()
     ok = (
         CliRunner().invoke(main, [*args[:-2], "--start", "2026-01-01T00:00:00Z"])

@@ -859,7 +859,7 @@ def intent(  # type: ignore[no-untyped-def]
     from uasnav.trajectory.calibration import calibrate as fit_bounds
     from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
-    from uasnav.trajectory.route3d import vertical_limits
+    from uasnav.trajectory.route3d import check_holds, vertical_limits
     from uasnav.utm.altitude import geoid_model
     from uasnav.utm.intent import build_intent
 
@@ -868,6 +868,7 @@ def intent(  # type: ignore[no-untyped-def]
     check_outputs([model_path, plan_path, *flight_logs], {"--out": out, "--geojson": geojson})
     model = load_model(model_path)
     plan = read_plan(plan_path)
+    check_holds(plan)  # before the calibration runs: a plan that cannot be timed fails at once
     # vertical limits: the explicit options, else the log's (--limits-from), else the model's
     # own (build_intent → route3d.vertical_limits)
     accel_z: float | None = None

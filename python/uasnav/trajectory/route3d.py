@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -121,6 +121,31 @@ class Route3D:
         return np.diff(self.alt_m)
 
 
+def check_holds(plan: MissionPlan) -> list[Any]:
+    """The plan's route points (:func:`uasnav.io.mission_plan.route_points`), refusing holds
+    without a predictable end (an unlimited loiter, a loiter of N turns) or longer than
+    :data:`MAX_HOLD_S`: cheap, so commands call it before any long work on the plan.
+
+    Raises
+    ------
+    InputError
+        Naming the plan and the item.
+    """
+    from uasnav.io.mission_plan import route_points
+
+    pts = route_points(plan)
+    for p in pts:
+        if not math.isfinite(p.hold_s):
+            what = "an unlimited loiter" if p.hold_s == math.inf else "a loiter of N turns (time unknown)"
+            raise InputError(f"{plan.source}: item {p.item}: {what} has no predictable end")
+        if p.hold_s > MAX_HOLD_S:
+            raise InputError(
+                f"{plan.source}: item {p.item}: a hold of {p.hold_s:g} s is beyond the {MAX_HOLD_S} s "
+                "an autopilot stores (ArduPilot: 16-bit seconds)"
+            )
+    return pts
+
+
 def route_from_plan(plan: MissionPlan, home_amsl_m: float | None = None) -> Route3D:
     """The 3D route of a geodetic mission plan (:func:`uasnav.io.mission_plan.route_points`:
     take-off from the ground, waypoints with holds, ``DO_CHANGE_SPEED``, landing) in the local
@@ -131,14 +156,10 @@ def route_from_plan(plan: MissionPlan, home_amsl_m: float | None = None) -> Rout
     Raises :class:`InputError` for altitudes above terrain (no terrain model), mixed frames
     without a home altitude, and unbounded holds (an unlimited loiter, a loiter of N turns).
     """
-    from uasnav.io.mission_plan import AltitudeFrame, ItemKind, route_points
+    from uasnav.io.mission_plan import AltitudeFrame, ItemKind
     from uasnav.trajectory.geometry import geodetic_to_local
 
-    pts = route_points(plan)
-    for p in pts:
-        if not math.isfinite(p.hold_s):
-            what = "an unlimited loiter" if p.hold_s == math.inf else "a loiter of N turns (time unknown)"
-            raise InputError(f"{plan.source}: item {p.item}: {what} has no predictable end")
+    pts = check_holds(plan)
     frames = {p.frame for p in pts}
     if AltitudeFrame.TERRAIN in frames:
         raise InputError(f"{plan.source}: altitudes above terrain need a terrain model to be timed")
