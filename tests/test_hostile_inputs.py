@@ -1027,7 +1027,7 @@ def test_intent_times_beyond_the_calendar_name_their_cause(
     assert time.perf_counter() - t0 < 60
     assert not out.exists()
     ok = (
-        CliRunner().invoke(main, [*args[:-2], "--start", "2026-01-01T00:00:00Z"])
+        CliRunner().invoke(main, [*args[:-2], "--start", "2026-01-01T00:00:00Z", "--calibration-runs", "20"])
         if plan_hold == "0"
         else None
     )
