@@ -1257,3 +1257,21 @@ def test_the_api_table_controls_answer() -> None:
     assert np.isfinite(baselines.kinematic_times(plan, np.zeros(1), np.full(1, 50.0), 5.0)).all()
     assert np.isfinite(route3d.vertical_time(50.0, 2.0, 1.0)).all()
     assert zupt.convergence_time(np.arange(5.0), np.zeros((5, 3)), np.zeros((5, 3))) == [0.0, 0.0, 0.0]
+
+
+def test_a_large_json_document_is_printed_compact_and_the_same(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--json`` of a 10⁵-element answer: Python's indenting encoder is pure Python (seconds per
+    10⁵ rows); beyond a megabyte the same JSON is printed on one line."""
+    import numpy as np
+
+    from uasnav.cli._common import MAX_INDENTED_JSON, echo_json
+
+    small = {"a": [1.0, float("nan")], "b": np.arange(3)}
+    echo_json(small)
+    out = capsys.readouterr().out
+    assert out == json.dumps({"a": [1.0, None], "b": [0, 1, 2]}, indent=2) + "\n"
+    big = {"rows": [{"i": i, "t": i * 0.5} for i in range(60_000)]}
+    echo_json(big)
+    out = capsys.readouterr().out
+    assert len(out) > MAX_INDENTED_JSON and out.count("\n") == 1
+    assert json.loads(out) == big

@@ -28,9 +28,19 @@ def warnings_after_success() -> Iterator[None]:
         warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
+#: Largest ``--json`` document (characters) printed indented. Python's indenting JSON encoder is
+#: pure Python (only the compact one is in C): a 10⁵-point prediction took longer to indent
+#: than to compute. Larger documents are printed compact: the same JSON, one line.
+MAX_INDENTED_JSON = 1 << 20
+
+
 def echo_json(obj: Any) -> None:
-    """Print ``obj`` as indented JSON on stdout."""
-    click.echo(json.dumps(to_jsonable(obj), indent=2, ensure_ascii=False))
+    """Print ``obj`` as JSON on stdout: indented, or compact beyond :data:`MAX_INDENTED_JSON`."""
+    doc = to_jsonable(obj)
+    text = json.dumps(doc, ensure_ascii=False)
+    if len(text) <= MAX_INDENTED_JSON:
+        text = json.dumps(doc, indent=2, ensure_ascii=False)
+    click.echo(text)
 
 
 def parse_float_list(text: str, what: str) -> list[float]:
