@@ -143,12 +143,57 @@ def build(d: Path) -> tuple[list[Probe], list[Loopback]]:
     big_plan = w(
         "big_plan.csv", "north,east\n" + "".join(f"{(i % 2) * 50.0},{i * 10.0}\n" for i in range(100_000))
     )
+    model = _model(d)
+    hold = w(
+        "hold.waypoints",
+        "QGC WPL 110\n"
+        + "".join(
+            "\t".join(map(str, r)) + "\n"
+            for r in [
+                (0, 1, 0, 16, 0, 0, 0, 0, 47.0, 8.0, 400, 1),
+                (1, 0, 3, 22, 0, 0, 0, 0, 47.0, 8.0, 30, 1),
+                (2, 0, 3, 16, "1e12", 0, 0, 0, 47.001, 8.0, 30, 1),
+                (3, 0, 3, 16, 0, 0, 0, 0, 47.002, 8.0, 30, 1),
+            ]
+        ),
+    )
+    thermal = _thermal_model_with_weight(d, 1e308)
+    long_logs = d / "long_logs"
+    long_logs.mkdir()
+    _npz(long_logs / "long.npz", 1_000_000)
+    _npz(long_logs / "short.npz", 20_000)
+    million = _npz(d / "million.npz", 1_000_000)
+    flight = d / "flight.csv"
+    sim = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            ENTRY,
+            "simulate",
+            "--profile",
+            "flight",
+            "--duration",
+            "60",
+            "--out",
+            str(flight),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    if sim.returncode != 0:
+        raise SystemExit(f"cannot build the simulated flight: {sim.stderr}")
+    sweep = ",".join(f"{1 + 0.05 * i:g}" for i in range(3000))
+    intents = str(DATA / "utm" / "interuss_flight_intents_conflicting.yaml")
+    intent = ["trajectory", "intent", "--model", model, "--plan", str(PLAN), "--wind", "0@0"]
+    start = ["--start", "2026-01-01T00:00:00Z"]
     silent, drip = Loopback("silent"), Loopback("drip")
     urls = w("slow.urls", f"http://127.0.0.1:{drip.port}/a.ulg\n")
     out = str(d / "out")
     P = Probe
     probes = [
         P(1, "allan on a tlog with 10 000 flipped bits", ["allan", bad_tlog, "--json"]),
+        P(1, "fleet: a long log stopped at --log-timeout 1", ["fleet", "imu-health", str(long_logs), "--out",
+                                                              out + "_health.parquet", "--workers", "0", "--log-timeout", "1"]),
         P(2, "billion laughs intent YAML", ["utm", "deconflict", bomb]),
         P(2, "deeply nested intent YAML", ["utm", "deconflict", deep_yaml]),
         P(3, "calibrate --runs 100000", ["trajectory", "calibrate", "--model", p_list, "--runs", "100000",
@@ -156,10 +201,19 @@ def build(d: Path) -> tuple[list[Probe], list[Loopback]]:
         P(3, "UASNAV_MAX_WORK=abc", ["simulate", "--duration", "1", "--out", out + ".csv"], {"UASNAV_MAX_WORK": "abc"}),
         P(3, "UASNAV_MAX_MEMORY=-1", ["simulate", "--duration", "1", "--out", out + ".csv"], {"UASNAV_MAX_MEMORY": "-1"}),
         P(3, "allan --taus all under a small work limit", ["allan", imu, "--taus", "all"], {"UASNAV_MAX_WORK": "1000"}),
+        P(3, "UASNAV_MAX_WORK=nan", ["allan", imu], {"UASNAV_MAX_WORK": "nan"}),
+        P(3, "UASNAV_MAX_MEMORY= (empty)", ["allan", imu], {"UASNAV_MAX_MEMORY": ""}),
+        P(3, "allan --taus all on 10⁶ samples", ["allan", million, "--taus", "all"]),
+        P(3, "fleet simulate --nav-flights 100 × 100 vehicles", ["fleet", "simulate", "--vehicles", "100", "--flights", "1",
+                                                                 "--nav-flights", "100", "--out", out + "_fleet"]),
+        P(3, "nav --outage-sweep of 3000 durations", ["nav", str(flight), "--gnss", str(d / "flight_gnss.csv"),
+                                                      "--outage-sweep", sweep]),
         P(4, "CSV cell 1.79e308 (allan)", ["allan", big]),
-        P(4, "intent --start 9999-12-31T23:59:59Z", ["trajectory", "intent", "--model", p_list, "--plan", str(PLAN),
-                                                     "--wind", "0@0", "--start", "9999-12-31T23:59:59Z",
-                                                     "--out", out + ".json"]),
+        P(4, "intent --start 9999-12-31T23:59:59Z", [*intent, "--start", "9999-12-31T23:59:59Z", "--out", out + ".json"]),
+        P(4, "a plan hold of 10¹² s (intent)", [*intent[:5], hold, *intent[6:], *start, "--out", out + ".json"]),
+        P(4, "utm deconflict --now 0001-01-01T00:00:00Z", ["utm", "deconflict", intents, "--now", "0001-01-01T00:00:00Z"]),
+        P(4, "intent --lateral-buffer 1e308", [*intent, *start, "--lateral-buffer", "1e308", "--out", out + ".json"]),
+        P(4, "utm deconflict --horizontal-buffer 1e308", ["utm", "deconflict", intents, "--horizontal-buffer", "1e308"]),
         P(4, "simulate --duration 1e308", ["simulate", "--profile", "flight", "--duration", "1e308", "--out", out + ".csv"]),
         P(4, "zupt --levelling-s 1e308", ["zupt", imu, "--levelling-s", "1e308"]),
         P(4, "GNSS CSV with only a header", ["nav", imu, "--gnss", g_hdr]),
@@ -180,8 +234,8 @@ def build(d: Path) -> tuple[list[Probe], list[Loopback]]:
           ["fleet", "scan", str(logs), "--out", out + ".parquet", "--scheduler", f"tcp://127.0.0.1:{silent.port}"]),
         P(5, "fleet URL list with a slow-drip server", ["fleet", "scan", urls, "--out", out + "2.parquet",
                                                         "--workers", "0", "--log-timeout", "5"]),
-        P(6, "predict a 10⁵-point plan", ["trajectory", "predict", "--model", p_list, "--plan", big_plan,
-                                          "--wind", "0@0"]),
+        P(6, "predict a 10⁵-point plan", ["trajectory", "predict", "--model", model, "--plan", big_plan,
+                                          "--wind", "0@0", "--json"]),
         P(8, "select --max-distance 1e308", ["select", "--max-distance", "1e308"]),
         P(8, "select --range 1e-320", ["select", "--range", "1e-320"]),
         P(8, "predict --speed 1e6", ["trajectory", "predict", "--model", p_list, "--plan", str(PLAN), "--wind", "0@0",
@@ -191,6 +245,8 @@ def build(d: Path) -> tuple[list[Probe], list[Loopback]]:
         P(8, "GNSS longitude 1000°", ["nav", imu, "--gnss", g_lon]),
         P(8, "GNSS altitude 1e308", ["nav", imu, "--gnss", g_alt]),
         P(8, "die temperature below absolute zero", ["allan", cold]),
+        P(8, "thermal network weight 1e308", ["zupt", imu, "--model", thermal]),
+        P(8, "intent --climb-rate 1e-300", [*intent, *start, "--climb-rate", "1e-300", "--out", out + ".json"]),
         P(8, "--out m.json/", ["simulate", "--duration", "1", "--out", out + "/m.json/"]),
     ]  # fmt: skip
     return probes, [silent, drip]
@@ -210,6 +266,45 @@ def _parquet(d: Path) -> str:
 
     p = d / "wrong.parquet"
     pq.write_table(pa.table({"a": [1, 2], "b": ["x", "y"]}), p)
+    return str(p)
+
+
+def _model(d: Path) -> str:
+    """A kinematic trajectory model trained on the Phoenix log."""
+    p = d / "model.json"
+    res = subprocess.run([sys.executable, "-c", ENTRY, "trajectory", "train", str(TLOG), "--method", "kinematic",
+                          "--out", str(p)], capture_output=True, text=True)  # fmt: skip
+    if res.returncode != 0:
+        raise SystemExit(f"cannot train the probes' model: {res.stderr}")
+    return str(p)
+
+
+def _npz(p: Path, n: int) -> str:
+    """A static IMU log of ``n`` samples at 100 Hz (compressed: a few MB even for 10⁶ samples)."""
+    import numpy as np
+
+    accel = np.zeros((n, 3))
+    accel[:, 2] = -9.80665
+    np.savez_compressed(p, t=np.arange(n) / 100.0, gyro=np.zeros((n, 3)), accel=accel,
+                        meta_json=np.array("{}"), format=np.array("uasnav-npz/1"))  # fmt: skip
+    return str(p)
+
+
+def _thermal_model_with_weight(d: Path, weight: float) -> str:
+    """A neural thermal model file (re-signed) whose first hidden weight is ``weight``."""
+    import numpy as np
+
+    from uasnav.thermal import NeuralBiasModel, dumps_model
+    from uasnav.thermal.modelfile import ZEROS, file_checksum
+
+    t = np.linspace(-10.0, 40.0, 200)
+    b = np.stack([1e-3 * np.tanh((t - 15) / 10), 2e-4 * np.sin(t / 9), 3e-6 * (t - 5) ** 2], 1)
+    doc = json.loads(dumps_model(NeuralBiasModel(2, restarts=1, max_epochs=20).fit(t, b)))
+    doc["models"][0]["layers"][0]["weights"][0][0] = weight
+    doc["checksum"] = {"algorithm": "sha256", "value": ZEROS}
+    text = json.dumps(doc)
+    p = d / "thermal.json"
+    p.write_text(text.replace(ZEROS, file_checksum(text, ZEROS), 1))
     return str(p)
 
 

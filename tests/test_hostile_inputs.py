@@ -9,13 +9,17 @@ far above its expected time, so a regression fails instead of stalling CI.
 from __future__ import annotations
 
 import contextlib
+import json
+import math
 import os
 import random
+import re
 import subprocess
 import sys
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from click.testing import CliRunner
@@ -123,17 +127,86 @@ def test_fleet_has_a_log_timeout() -> None:
     assert res.exit_code == 2
 
 
-def test_the_per_log_deadline_stops_a_python_loop() -> None:
-    from uasnav.fleet.runner import LogTimeout, _deadline
+def _native_sleep(seconds: float) -> str:
+    """A call the interpreter cannot interrupt from inside the process (C code, no bytecode)."""
+    time.sleep(seconds)
+    return "finished"
+
+
+def _fails(_: object) -> None:
+    raise InputError("x.tlog: a bad log")
+
+
+def test_the_per_log_deadline_kills_a_native_call() -> None:
+    from uasnav.fleet.deadline import LogTimeout, call_with_deadline
 
     t0 = time.perf_counter()
-    with pytest.raises(LogTimeout), _deadline(0.2):
-        while True:
-            pass
-    assert time.perf_counter() - t0 < 30
-    with _deadline(5.0):  # a block that ends in time is untouched, and nothing fires later
-        pass
-    time.sleep(0.05)
+    with pytest.raises(LogTimeout):
+        call_with_deadline(_native_sleep, 60.0, 1.0)
+    assert time.perf_counter() - t0 < 30  # killed at 1 s (plus the child's start), not after 60 s
+    # the next call gets a new process; values and exceptions travel back
+    assert call_with_deadline(_native_sleep, 0.0, 30.0) == "finished"
+    with pytest.raises(InputError, match="a bad log"):
+        call_with_deadline(_fails, None, 30.0)
+
+
+def _slow_or_quick(path: str) -> object:
+    from uasnav.fleet.runner import LogRows
+
+    if "slow" in os.path.basename(path):
+        time.sleep(120)  # one native call far past the deadline
+    return LogRows([{"n": 1}], vehicle="V1", day="2026-01-01")
+
+
+@pytest.mark.parametrize("workers", [0, 1])
+def test_a_log_past_its_deadline_is_killed_and_the_run_goes_on(tmp_path: Path, workers: int) -> None:
+    import pyarrow as pa
+
+    from uasnav.fleet import Analysis, read_errors, run
+    from uasnav.fleet.output import MANIFEST
+
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    for name in ("a_slow.csv", "b_quick.csv"):
+        (logs / name).write_text(name)
+    out = tmp_path / "out.parquet"
+    analysis = Analysis("probe", pa.schema([pa.field("n", pa.int64())]), _slow_or_quick)
+    t0 = time.perf_counter()
+    s = run(analysis, [str(logs)], str(out), workers=workers, log_timeout_s=2.0)
+    assert time.perf_counter() - t0 < 90  # bounded: the 120 s sleep was killed
+    assert (s.n_ok, s.n_errors, s.n_timeouts) == (1, 1, 1)
+    errors = read_errors(out).to_pylist()
+    assert [e["error_type"] for e in errors] == ["LogTimeout"]
+    assert "a_slow.csv" in errors[0]["error"] and "--log-timeout" in errors[0]["error"]
+    entries = [json.loads(line) for line in (out / MANIFEST).read_text().splitlines()]
+    status = {Path(e["path"]).name: e["status"] for e in entries}
+    assert status == {"a_slow.csv": "timeout", "b_quick.csv": "ok"}
+
+
+def test_fleet_stops_a_long_real_log_at_its_deadline(tmp_path: Path) -> None:
+    """A 2 MB compressed log of 10⁶ samples (seconds of IMU analysis, mostly in the Rust core)
+    beside a small one: ``--log-timeout 1`` stops the first, the second is written."""
+    import numpy as np
+
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    for name, n in (("long.npz", 1_000_000), ("short.npz", 20_000)):
+        accel = np.zeros((n, 3))
+        accel[:, 2] = -9.80665
+        np.savez_compressed(
+            logs / name, t=np.arange(n) / 100.0, gyro=np.zeros((n, 3)), accel=accel,
+            meta_json=np.array("{}"), format=np.array("uasnav-npz/1"),
+        )  # fmt: skip
+    out = tmp_path / "health.parquet"
+    t0 = time.perf_counter()
+    args = ["fleet", "imu-health", str(logs), "--out", str(out), "--workers", "0", "--log-timeout", "1"]
+    res = _cli([*args, "--json"], timeout=240)
+    assert res.returncode == 0, res.stderr
+    assert time.perf_counter() - t0 < 240
+    summary = json.loads(res.stdout)
+    assert (summary["ok"], summary["errors"], summary["timeouts"]) == (1, 1, 1), summary
+    assert "long.npz" in summary["error_list"][0]["error"]
+    assert "per-log deadline of 1 s" in summary["error_list"][0]["error"]
 
 
 # -- 2. YAML bombs -----------------------------------------------------------------------------
@@ -191,6 +264,26 @@ def test_an_invalid_limit_is_refused_in_one_line(var: str, value: str) -> None:
     )
     line = _one_error_line(res)
     assert var in line and repr(value) in line
+
+
+@pytest.mark.parametrize(
+    "var,value", [("UASNAV_MAX_WORK", "nan"), ("UASNAV_MAX_MEMORY", "-1"), ("UASNAV_MAX_WORK", "")]
+)
+@pytest.mark.parametrize(
+    "args",
+    [["allan", "{imu}", "--taus", "all"],
+     ["fleet", "scan", "{imu}", "--out", "{tmp}/o.parquet", "--workers", "0"],
+     ["trajectory", "predict", "--model", "{imu}", "--plan", "{imu}", "--wind", "0@0"]],
+    ids=["allan", "fleet", "predict"],
+)  # fmt: skip
+def test_every_command_refuses_an_invalid_limit_before_working(
+    tmp_path: Path, args: list[str], var: str, value: str
+) -> None:
+    imu = _imu_csv(tmp_path / "imu.csv")
+    argv = [a.replace("{imu}", str(imu)).replace("{tmp}", str(tmp_path)) for a in args]
+    line = _one_error_line(CliRunner(env={var: value}).invoke(main, argv))
+    assert line.startswith(f"error: {var}: expected a ") and repr(value) in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["imu.csv"]
 
 
 def test_allan_honours_the_work_limit(tmp_path: Path) -> None:
@@ -368,7 +461,7 @@ def test_a_failed_command_changes_no_output(tmp_path: Path) -> None:
     "args,needle",
     [
         (["db", "validate", "http://[::1"], "not a valid URL"),
-        (["simulate", "--profile", "flight", "--duration", "1e308", "--out", "{tmp}/x.csv"], "range"),
+        (["simulate", "--profile", "flight", "--duration", "1e308", "--out", "{tmp}/x.csv"], "--duration"),
     ],
 )
 def test_internal_errors_become_input_errors(tmp_path: Path, args: list[str], needle: str) -> None:
@@ -862,7 +955,7 @@ def test_the_web_refuses_a_plan_too_costly_to_predict_with_its_estimate() -> Non
     from uasnav.web.prediction import FieldError, read_uploaded_plan
 
     t0 = time.perf_counter()
-    with pytest.raises(FieldError, match=r"plan: 100000 plan points need about 1\.5e\+11 operations") as e:
+    with pytest.raises(FieldError, match=r"plan: 100000 plan points need about 1\.5e\+10 operations") as e:
         read_uploaded_plan("big.csv", _big_plan_csv(100_000))
     assert e.value.field == "plan" and "split the plan" in str(e.value)
     assert time.perf_counter() - t0 < 30  # refused before any prediction
@@ -879,6 +972,306 @@ def test_the_cli_estimates_a_prediction_before_running_it(tmp_path: Path) -> Non
     )
     line = _one_error_line(res)
     assert (
-        "a prediction of 1000 plan points needs about 1.5e+09 operations" in line
+        "a prediction of 1000 plan points needs about 1.5e+08 operations" in line
         and "UASNAV_MAX_WORK" in line
     )
+
+
+# -- 4. numbers at the edge of the range name their option -----------------------------------------
+
+
+@pytest.fixture(scope="module")
+def kinematic_model(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    model = tmp_path_factory.mktemp("model") / "m.json"
+    res = CliRunner().invoke(
+        main, ["trajectory", "train", str(TLOG), "--method", "kinematic", "--out", str(model)]
+    )
+    assert res.exit_code == 0, res.output
+    return model
+
+
+def _hold_plan(tmp_path: Path, hold_s: str) -> Path:
+    rows = [
+        (0, 1, 0, 16, "0", 47.0, 8.0, 400),
+        (1, 0, 3, 22, "0", 47.0, 8.0, 30),
+        (2, 0, 3, 16, hold_s, 47.001, 8.0, 30),
+        (3, 0, 3, 16, "0", 47.002, 8.0, 30),
+    ]
+    p = tmp_path / "hold.waypoints"
+    lines = ["\t".join(map(str, (*r[:5], 0, 0, 0, *r[5:], 1))) for r in rows]
+    p.write_text("QGC WPL 110\n" + "\n".join(lines) + "\n")
+    return p
+
+
+@pytest.mark.parametrize(
+    "extra,plan_hold,needle",
+    [
+        (
+            ["--start", "9999-12-31T23:59:59Z"],
+            "0",
+            "--start: '9999-12-31T23:59:59Z' is outside the years 1970–9000",
+        ),
+        (["--start", "2026-01-01T00:00:00Z"], "1e12", "a hold of 1e+12 s is beyond the 65535 s"),
+    ],
+)
+def test_intent_times_beyond_the_calendar_name_their_cause(
+    tmp_path: Path, kinematic_model: Path, extra: list[str], plan_hold: str, needle: str
+) -> None:
+    out = tmp_path / "i.json"
+    plan = _hold_plan(tmp_path, plan_hold)
+    args = ["trajectory", "intent", "--model", str(kinematic_model), "--plan", str(plan), "--wind", "0@0",
+            "--out", str(out), *extra]  # fmt: skip
+    t0 = time.perf_counter()
+    line = _one_error_line(CliRunner().invoke(main, args))  # refused before the calibration runs
+    assert needle in line and "representable range" not in line
+    assert time.perf_counter() - t0 < 60
+    assert not out.exists()
+    ok = (
+        CliRunner().invoke(main, [*args[:-2], "--start", "2026-01-01T00:00:00Z", "--calibration-runs", "20"])
+        if plan_hold == "0"
+        else None
+    )
+    assert ok is None or ok.exit_code == 0, ok.output if ok else ""
+
+
+@pytest.mark.parametrize("now", ["0001-01-01T00:00:00Z", "0001-01-01T00:00:00+01:00", "9999-12-31T23:59:59Z"])
+def test_deconflict_at_an_absurd_now_names_the_option(now: str) -> None:
+    intents = DATA / "utm" / "interuss_flight_intents_conflicting.yaml"
+    line = _one_error_line(CliRunner().invoke(main, ["utm", "deconflict", str(intents), "--now", now]))
+    assert line == f"error: --now: {now!r} is outside the years 1970–9000"
+
+
+@pytest.mark.parametrize(
+    "cmd,option",
+    [
+        (["trajectory", "intent", "--wind", "0@0", "--start", "2026-01-01T00:00:00Z"], "--lateral-buffer"),
+        (["trajectory", "intent", "--wind", "0@0", "--start", "2026-01-01T00:00:00Z"], "--vertical-buffer"),
+        (
+            ["utm", "deconflict", str(DATA / "utm" / "interuss_flight_intents_conflicting.yaml")],
+            "--horizontal-buffer",
+        ),
+        (
+            ["utm", "deconflict", str(DATA / "utm" / "interuss_flight_intents_conflicting.yaml")],
+            "--vertical-buffer",
+        ),
+    ],
+)
+def test_a_buffer_of_1e308_is_a_usage_error(
+    tmp_path: Path, kinematic_model: Path, cmd: list[str], option: str
+) -> None:
+    plan = _hold_plan(tmp_path, "0")
+    extra = [] if cmd[0] == "utm" else ["--model", str(kinematic_model), "--plan", str(plan), "--out",
+                                         str(tmp_path / "i.json")]  # fmt: skip
+    res = CliRunner().invoke(main, [*cmd, *extra, option, "1e308"])
+    assert res.exit_code == 2 and f"'{option}': 1e308 is not <= 100000" in res.stderr, res.output
+    assert "GEOS" not in res.output and not (tmp_path / "i.json").exists()
+
+
+def test_a_csv_cell_at_the_float_limit_names_the_file_and_sensor(tmp_path: Path) -> None:
+    log = _imu_csv(tmp_path / "imu.csv", n=2000)
+    lines = log.read_text().splitlines()
+    cells = lines[500].split(",")
+    cells[1] = "1.79e308"
+    lines[500] = ",".join(cells)
+    log.write_text("\n".join(lines) + "\n")
+    before = log.read_bytes()
+    line = _one_error_line(CliRunner().invoke(main, ["allan", str(log), "--json"]))
+    assert line.startswith(f"error: {log}: gyro: ") and "not representable as a float" in line
+    assert log.read_bytes() == before
+
+
+@pytest.mark.parametrize(
+    "where", [("layers", 0, "weights", 0, 0), ("layers", 1, "biases", 0), ("layers", 1, "weights", 0, 1)]
+)
+def test_thermal_network_weights_of_1e308_are_refused(tmp_path: Path, where: tuple[object, ...]) -> None:
+    """A hidden weight of 1e308 saturates its tanh and the model still predicts finite numbers:
+    silently a step function. The file is refused naming the value's JSON path."""
+    import copy
+
+    import numpy as np
+
+    from uasnav.thermal import NeuralBiasModel, dumps_model, loads_model
+    from uasnav.thermal.modelfile import ZEROS, file_checksum
+
+    t = np.linspace(-10.0, 40.0, 200)
+    b = np.stack([1e-3 * np.tanh((t - 15) / 10), 2e-4 * np.sin(t / 9), 3e-6 * (t - 5) ** 2], 1)
+    d = json.loads(dumps_model(NeuralBiasModel(2, restarts=1, max_epochs=20).fit(t, b)))
+
+    def signed(doc: dict) -> str:  # type: ignore[type-arg]
+        doc = copy.deepcopy(doc)
+        doc["checksum"] = {"algorithm": "sha256", "value": ZEROS}
+        text = json.dumps(doc)
+        return text.replace(ZEROS, file_checksum(text, ZEROS), 1)
+
+    loads_model(signed(d), "m.json")  # the harness loads the file as trained
+    node = d["models"][0]
+    for k in where[:-1]:
+        node = node[k]
+    node[where[-1]] = 1e308
+    path = "models[0]." + ".".join(f"{k}" if isinstance(k, str) else f"[{k}]" for k in where).replace(
+        ".[", "["
+    )
+    with pytest.raises(
+        DataFormatError, match=re.escape(f"m.json: {path}: 1e+308 is outside the accepted range")
+    ):
+        loads_model(signed(d), "m.json")
+
+
+# -- 3. the kinematic profile is linear in the plan's points ---------------------------------------
+
+
+def _kinematic_times_full_grid(plan, s0, s1, cruise, accel=1.0, ds=0.1, leg_speed=None):  # type: ignore[no-untyped-def]
+    """The profile with every waypoint's ramp evaluated over the whole grid (quadratic work)."""
+    import numpy as np
+
+    p = np.asarray(plan, dtype=float)[:, :2]
+    d = np.diff(p, axis=0)
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
+    total = float(np.hypot(*d.T).sum())  # as trajectory.geometry.plan_length sums it
+    s = np.arange(0.0, total + ds, ds)
+    s[-1] = min(s[-1], total)
+    v_leg = np.full(d.shape[0], float(cruise)) if leg_speed is None else np.asarray(leg_speed, dtype=float)
+    v = v_leg[np.clip(np.searchsorted(cum, s, side="right") - 1, 0, v_leg.size - 1)]
+    for k in range(p.shape[0]):
+        vk = 0.0
+        if 0 < k < p.shape[0] - 1:
+            c = d[k - 1] @ d[k] / (np.hypot(*d[k - 1]) * np.hypot(*d[k]))
+            vk = min(v_leg[k - 1], v_leg[k]) * max(np.cos(np.arccos(np.clip(c, -1.0, 1.0)) / 2.0), 0.1)
+        v = np.minimum(v, np.sqrt(vk**2 + 2.0 * accel * np.abs(s - cum[k])))
+    tau = np.concatenate([[0.0], np.cumsum(2.0 * np.diff(s) / np.maximum(v[1:] + v[:-1], 1e-9))])
+    return np.interp(s1, s, tau) - np.interp(s0, s, tau)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_windowed_kinematic_profile_equals_the_full_grid(seed: int) -> None:
+    import numpy as np
+
+    from uasnav.trajectory.baselines import kinematic_times
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 60))
+    plan = np.cumsum(rng.uniform(-40, 40, (n, 2)) * rng.choice([0.05, 1.0, 5.0]), axis=0)
+    legs = np.where(rng.random(n - 1) < 0.3, np.nan, rng.uniform(0.5, 20.0, n - 1))
+    total = float(np.hypot(*np.diff(plan, axis=0).T).sum())
+    s0 = np.sort(rng.uniform(0, total, 20))
+    s1 = np.minimum(s0 + rng.uniform(0, total / 3, 20), total)
+    cruise, accel = float(rng.uniform(1, 15)), float(rng.uniform(0.3, 4))
+    got = kinematic_times(plan, s0, s1, cruise, accel, leg_speed_ms=legs)
+    want = _kinematic_times_full_grid(
+        plan, s0, s1, cruise, accel, leg_speed=np.where(np.isnan(legs), cruise, legs)
+    )
+    np.testing.assert_array_equal(got, want)  # the same numbers, bit for bit
+
+
+# -- 8/9. the Python API: negative, NaN and infinite arguments (a table) ----------------------------
+
+
+def _api_table() -> list[tuple[str, Any, str]]:
+    import numpy as np
+
+    from uasnav import allan, attitude, stationary, zupt
+    from uasnav.imu import ImuLog
+    from uasnav.io import open_log
+    from uasnav.trajectory import baselines, route3d
+
+    n = 2000
+    rng = np.random.default_rng(0)
+    log = ImuLog(t=np.arange(n) / 100.0, gyro=rng.normal(0, 1e-3, (n, 3)),
+                 accel=rng.normal(0, 1e-2, (n, 3)) + [0, 0, -9.81])  # fmt: skip
+    x = rng.normal(size=200)
+    plan = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0]])
+    kin = lambda *a: lambda: baselines.kinematic_times(plan, np.zeros(1), np.full(1, 50.0), *a)  # noqa: E731
+    nan, inf = math.nan, math.inf
+    z = np.zeros((5, 3))
+    cs, sd, ma, ct = allan.cluster_sizes, stationary.detect_static, zupt.moving_average, zupt.convergence_time
+    return [
+        ("allan.oadev rate -1", lambda: allan.oadev(x, -1.0), "rate: must be finite and > 0"),
+        ("allan.oadev rate nan", lambda: allan.oadev(x, nan), "rate: must be finite and > 0"),
+        ("allan.oadev rate inf", lambda: allan.oadev(x, inf), "rate: must be finite and > 0"),
+        ("allan.oadev tau -1", lambda: allan.oadev(x, 1.0, [-1.0]), "cluster times must be finite and > 0"),
+        ("allan.oadev tau nan", lambda: allan.oadev(x, 1.0, [nan]), "cluster times must be finite and > 0"),
+        ("allan.oadev all-NaN data", lambda: allan.oadev(np.full(100, nan), 1.0), "non-finite value"),
+        ("allan.oadev confidence 2", lambda: allan.oadev(x, 1.0, confidence=2.0), "confidence"),
+        ("allan.oadev confidence nan", lambda: allan.oadev(x, 1.0, confidence=nan), "confidence"),
+        ("allan.cluster_sizes n -1", lambda: cs(-1, 1.0, "octave"), "n: expected an integer"),
+        ("allan.cluster_sizes rate 0", lambda: cs(100, 0.0, "octave"), "rate: must be finite"),
+        ("allan.cluster_sizes rate nan", lambda: cs(100, nan, [1.0]), "rate: must be finite"),
+        ("attitude.drift dt -1", lambda: attitude.drift([1e-3, 0, 0], -1.0, 10.0), "dt: must be finite"),
+        ("attitude.drift duration -1", lambda: attitude.drift([1e-3, 0, 0], 0.01, -1.0), "duration"),
+        ("attitude.drift duration inf", lambda: attitude.drift([1e-3, 0, 0], 0.01, inf), "duration"),
+        ("attitude.drift NaN rate", lambda: attitude.drift([nan, 0, 0], 0.01, 1.0), "non-finite"),
+        ("attitude.propagate dt nan", lambda: attitude.propagate([1, 0, 0, 0], np.zeros((5, 3)), nan), "dt"),
+        ("attitude.propagate |q0| 2", lambda: attitude.propagate([2, 0, 0, 0], np.zeros((5, 3)), 0.01),
+         "q0[0]: a quaternion of norm 2"),
+        ("attitude.rotation_angle |q| 2", lambda: attitude.rotation_angle([2, 0, 0, 0]), "norm 2, not a"),
+        ("attitude.quat_to_euler |q| 1.1", lambda: attitude.quat_to_euler([[1, 0, 0, 0], [1.1, 0, 0, 0]]),
+         "q[1]: a quaternion of norm 1.1"),
+        ("attitude.quat_to_dcm NaN", lambda: attitude.quat_to_dcm([nan, 0, 0, 0]), "non-finite"),
+        ("attitude.euler_to_quat inf", lambda: attitude.euler_to_quat([inf, 0, 0]), "non-finite"),
+        ("stationary window -1", lambda: sd(log, window_s=-1.0), "window_s"),
+        ("stationary threshold -1", lambda: sd(log, threshold=-1.0), "threshold: must be"),
+        ("stationary threshold inf", lambda: sd(log, threshold=inf), "threshold: must be"),
+        ("stationary sigma_a -1", lambda: sd(log, sigma_a=-1.0), "sigma_a"),
+        ("stationary min_duration -1", lambda: sd(log, min_duration_s=-1.0), "min_duration"),
+        ("stationary false_alarm 2", lambda: sd(log, false_alarm=2.0), "false_alarm"),
+        ("zupt.moving_average rate -1", lambda: ma(np.ones((10, 3)), -1.0), "rate_hz"),
+        ("zupt.moving_average window nan", lambda: ma(np.ones((10, 3)), 100.0, nan), "window_s"),
+        ("zupt.convergence_time threshold -1", lambda: ct(np.arange(5.0), z, z, -1.0), "threshold"),
+        ("io.open_log missing", lambda: open_log("/nonexistent/x.ulg").imus, "no such file"),
+        ("io.open_log unknown view", lambda: open_log(str(BIN), need=("bogus",)), "unknown view 'bogus'"),
+        ("trajectory kinematic cruise -1", kin(-1.0), "cruise_ms: must be finite and > 0"),
+        ("trajectory kinematic cruise nan", kin(nan), "cruise_ms: must be finite and > 0"),
+        ("trajectory kinematic accel 0", kin(5.0, 0.0), "accel_ms2: must be finite and > 0"),
+        ("trajectory kinematic step -1", kin(5.0, 1.0, -1.0), "ds_m: must be finite and > 0"),
+        ("trajectory kinematic step 1e-9", kin(5.0, 1.0, 1e-9), "raise the limit with UASNAV_MAX_MEMORY"),
+        ("trajectory vertical_time speed 0", lambda: route3d.vertical_time(50.0, 0.0, 1.0), "must be > 0"),
+        ("trajectory vertical_time accel nan", lambda: route3d.vertical_time(50.0, 2.0, nan), "must be > 0"),
+        ("trajectory route hold 1e12", lambda: route3d.Route3D(plan, np.zeros(3), np.array([0, 1e12, 0]),
+                                                               np.full(3, np.nan)), "a hold of 1e+12 s"),
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize("name,call,needle", _api_table(), ids=[n for n, _, _ in _api_table()])
+def test_public_api_refuses_negative_nan_and_infinite_arguments(name: str, call: Any, needle: str) -> None:
+    """Each call raises an :class:`InputError` (also a ``ValueError``) whose one-line message
+    names the argument: never numbers computed from a meaningless value, never a bare numpy or
+    Python exception."""
+    with pytest.raises(InputError) as e:
+        call()
+    assert isinstance(e.value, ValueError)
+    msg = str(e.value)
+    assert needle in msg and "\n" not in msg, msg
+
+
+def test_the_api_table_controls_answer() -> None:
+    """The same functions with ordinary values return finite numbers (so the table can fail)."""
+    import numpy as np
+
+    from uasnav import allan, attitude, zupt
+    from uasnav.trajectory import baselines, route3d
+
+    plan = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0]])
+    assert np.isfinite(allan.oadev(np.random.default_rng(0).normal(size=200), 1.0).adev).all()
+    assert np.isfinite(attitude.quat_to_euler([[1, 0, 0, 0], [1 + 5e-5, 0, 0, 0]])).all()
+    assert np.isfinite(zupt.moving_average(np.ones((10, 3)), 100.0)).all()
+    assert np.isfinite(baselines.kinematic_times(plan, np.zeros(1), np.full(1, 50.0), 5.0)).all()
+    assert np.isfinite(route3d.vertical_time(50.0, 2.0, 1.0)).all()
+    assert zupt.convergence_time(np.arange(5.0), np.zeros((5, 3)), np.zeros((5, 3))) == [0.0, 0.0, 0.0]
+
+
+def test_a_large_json_document_is_printed_compact_and_the_same(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--json`` of a 10⁵-element answer: Python's indenting encoder is pure Python (seconds per
+    10⁵ rows); beyond a megabyte the same JSON is printed on one line."""
+    import numpy as np
+
+    from uasnav.cli._common import MAX_INDENTED_JSON, echo_json
+
+    small = {"a": [1.0, float("nan")], "b": np.arange(3)}
+    echo_json(small)
+    out = capsys.readouterr().out
+    assert out == json.dumps({"a": [1.0, None], "b": [0, 1, 2]}, indent=2) + "\n"
+    big = {"rows": [{"i": i, "t": i * 0.5} for i in range(60_000)]}
+    echo_json(big)
+    out = capsys.readouterr().out
+    assert len(out) > MAX_INDENTED_JSON and out.count("\n") == 1
+    assert json.loads(out) == big

@@ -206,6 +206,8 @@ def cluster_sizes(n: int, rate: float, taus: TauSpec) -> NDArray[np.int64]:
     else ``floor`` (as allantools); duplicates are removed; a τ longer than the series allows
     (fewer than two second differences) raises :class:`InputError`.
     """
+    if not (math.isfinite(rate) and rate > 0):
+        raise InputError(f"rate: must be finite and > 0, got {rate!r}")
     if isinstance(taus, str):
         ms = _core.allan_cluster_sizes(int(n), taus)
         if not ms:

@@ -39,6 +39,22 @@ def _rows(name: str, a: ArrayLike, k: int) -> NDArray[np.float64]:
     return np.ascontiguousarray(arr)
 
 
+#: Largest |‖q‖ − 1| of a quaternion taken as a rotation (filter outputs are normalised each
+#: step; a quaternion of norm 2 is not an attitude, and the conversions would silently use it).
+UNIT_NORM_TOL = 1e-4
+
+
+def _unit_quats(name: str, q: ArrayLike) -> NDArray[np.float64]:
+    arr = _rows(name, q, 4)
+    with np.errstate(over="ignore", invalid="ignore"):
+        norm = np.linalg.norm(arr, axis=1)
+    bad = np.flatnonzero(np.abs(norm - 1.0) > UNIT_NORM_TOL)  # NaN rows: the core names them
+    if bad.size:
+        i = int(bad[0])
+        raise InputError(f"{name}[{i}]: a quaternion of norm {norm[i]:.6g}, not a rotation (norm 1)")
+    return arr
+
+
 def _dt(dt: float) -> float:
     if not (np.isfinite(dt) and dt > 0):
         raise InputError(f"dt: must be finite and > 0, got {dt!r}")
@@ -51,7 +67,8 @@ def propagate(q0: ArrayLike, rates: ArrayLike, dt: float, *, coning: bool = Fals
     Parameters
     ----------
     q0 : array_like, shape (4,)
-        Initial attitude, scalar first, body → NED (normalised on input).
+        Initial attitude, scalar first, body → NED, of unit norm (within :data:`UNIT_NORM_TOL`;
+        renormalised on input).
     rates : array_like, shape (n, 3)
         Body-frame angular rate (rad/s), each sample held for ``dt``.
     dt : float
@@ -67,12 +84,14 @@ def propagate(q0: ArrayLike, rates: ArrayLike, dt: float, *, coning: bool = Fals
     q = np.asarray(q0, dtype=np.float64)
     if q.shape != (4,):
         raise InputError(f"q0: expected shape (4,), got {q.shape}")
+    if np.isfinite(q).all() and q.any():  # (zero and non-finite: the core's own messages)
+        _unit_quats("q0", q)
     return _core.attitude_propagate([float(x) for x in q], _rows("rates", rates, 3), _dt(dt), coning)
 
 
 def rotation_angle(q: ArrayLike) -> NDArray[np.float64]:
     """Rotation angle θ = 2·acos(|q_s|) (rad) of quaternions (n, 4) — eq. (35)."""
-    return _core.attitude_rotation_angle(_rows("q", q, 4))
+    return _core.attitude_rotation_angle(_unit_quats("q", q))
 
 
 def euler_to_quat(euler: ArrayLike) -> NDArray[np.float64]:
@@ -82,12 +101,12 @@ def euler_to_quat(euler: ArrayLike) -> NDArray[np.float64]:
 
 def quat_to_euler(q: ArrayLike) -> NDArray[np.float64]:
     """3-2-1 Euler angles (n, 3) ``[roll, pitch, yaw]`` (rad) of quaternions (n, 4)."""
-    return _core.attitude_quat_to_euler(_rows("q", q, 4))
+    return _core.attitude_quat_to_euler(_unit_quats("q", q))
 
 
 def quat_to_dcm(q: ArrayLike) -> NDArray[np.float64]:
     """Direction cosine matrices C_b^n (n, 3, 3) of quaternions (n, 4)."""
-    return _core.attitude_quat_to_dcm(_rows("q", q, 4))
+    return _core.attitude_quat_to_dcm(_unit_quats("q", q))
 
 
 def dcm_to_quat(dcm: ArrayLike, tol: float = 1e-6) -> NDArray[np.float64]:
@@ -174,7 +193,10 @@ def drift(
         if duration is None or not (np.isfinite(duration) and duration > 0):
             raise InputError("duration: required (> 0) for a constant rate vector")
         # the constant vector becomes n rows, θ(t) and t: refused before any allocation
-        n = check_count(round(duration / dt), 6 * 8, f"attitude drift over {duration:g} s", option="duration")
+        # (the count is checked as a float first: 1e308 s / 1e-300 s is inf, which round() cannot take)
+        what = f"attitude drift over {duration:g} s"
+        check_count(duration / dt, 6 * 8, what, option="duration (or raise dt)")
+        n = round(duration / dt)
         arr = np.broadcast_to(arr, (n, 3))
     r = _rows("rates", arr, 3)
     if r.shape[0] == 0:

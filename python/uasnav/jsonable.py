@@ -16,12 +16,18 @@ from typing import Any
 
 import numpy as np
 
+_PLAIN = (str, int, bool, type(None))
+
 
 def to_jsonable(obj: Any) -> Any:
     """Convert numpy scalars/arrays (recursively) to plain JSON types; non-finite → None.
 
     Dict keys become strings; tuples and lists become lists.
     """
+    if type(obj) in _PLAIN:  # the common leaves first: this runs over every value of a document
+        return obj
+    if type(obj) is float:
+        return obj if math.isfinite(obj) else None
     if isinstance(obj, dict):
         return {str(k): to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):

@@ -178,12 +178,15 @@ def vector(
     return np.array([number(v, at(path, i), **bounds) for i, v in enumerate(a)], dtype=np.float64)
 
 
-def matrix(x: object, path: str, *, rows: int | None = None, cols: int | None = None) -> NDArray[np.float64]:
-    """``x`` as a (rows, cols) float matrix: an array of equally long rows of finite numbers."""
+def matrix(
+    x: object, path: str, *, rows: int | None = None, cols: int | None = None, **bounds: Any
+) -> NDArray[np.float64]:
+    """``x`` as a (rows, cols) float matrix: an array of equally long rows of finite numbers
+    (``bounds`` as for :func:`number`)."""
     a = array(x, path)
     if rows is not None and len(a) != rows:
         raise fail(path, f"expected {rows} rows, got {len(a)}")
-    out = [vector(r, at(path, i), length=cols) for i, r in enumerate(a)]
+    out = [vector(r, at(path, i), length=cols, **bounds) for i, r in enumerate(a)]
     n = out[0].size
     for i, r in enumerate(out):
         if r.size != n:

@@ -44,10 +44,10 @@ DEFAULT_MAX_MEMORY = 4 * 1024**3
 DEFAULT_MAX_WORK = 2e11
 
 #: Cost of predicting one plan point (element) with a trajectory model, in elementary
-#: operations: about 1.5 ms of CPU per point (a 20 000-point plan, kinematic model, `uasnav
-#: trajectory predict`: 30 s of CPU on a loaded 2-core machine), so a plan's work is estimated
-#: before it is predicted.
-PREDICTION_OPS_PER_POINT = 1.5e6
+#: operations: about 0.15 ms of CPU per point, reading and output included (a 10⁵-point plan,
+#: kinematic model, ``uasnav trajectory predict --json``: 16 s of CPU on a loaded 2-core
+#: machine), so a plan's work is estimated before it is predicted.
+PREDICTION_OPS_PER_POINT = 1.5e5
 
 _SUFFIX = {"": 1, "k": 1024, "m": 1024**2, "g": 1024**3, "t": 1024**4}
 _SIZE_RE = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:e[+-]?[0-9]+)?)\s*([kmgt]?)(?:i?b)?\s*$", re.IGNORECASE)

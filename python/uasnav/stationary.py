@@ -222,7 +222,10 @@ def detect_static(
             bound = "> 0" if lo is not None else ">= 0"
             raise InputError(f"{name}: expected a finite number of seconds {bound}, got {value!r}")
     if window_samples is None:
-        w = max(3, round(window_s * log.uniform_rate(rtol=0.05)))
+        w_f = window_s * log.uniform_rate(rtol=0.05)
+        if not w_f <= log.n:  # (also inf: 1e308 s × 100 Hz, which round() cannot take)
+            raise InputError(f"window_s: {window_s:g} s is longer than the log ({log.n} samples)")
+        w = max(3, round(w_f))
         what = "window_s"
     else:
         w = int(window_samples)
@@ -238,8 +241,9 @@ def detect_static(
         )
     if not 0 < false_alarm < 1:
         raise InputError(f"false_alarm: must be in (0, 1), got {false_alarm!r}")
-    if threshold is not None and math.isnan(threshold):
-        raise InputError("threshold: must not be NaN")
+    if threshold is not None and not (math.isfinite(threshold) and threshold >= 0):
+        # the statistic is >= 0: a negative threshold would silently find nothing, inf everything
+        raise InputError(f"threshold: must be finite and >= 0, got {threshold!r}")
     s_a, s_g, g_mag, b_in = sigma_a, sigma_g, gravity, gyro_bias
     if s_a is None or s_g is None or g_mag is None or b_in is None:
         if w < 3:
@@ -259,6 +263,8 @@ def detect_static(
         from scipy import stats  # slow to import; only the default threshold needs it
 
         gamma = 1.5 * float(stats.chi2.ppf(1.0 - false_alarm, 6 * w - 2)) / w
+        if not math.isfinite(gamma):  # 1 − false_alarm rounds to 1 below ≈ 1e-16
+            raise InputError(f"false_alarm: {false_alarm!r} is too small for a finite threshold (≥ 1e-15)")
     else:
         gamma = float(threshold)
     stat = _rust_statistic(log.accel, log.gyro - b[None, :], w, s_a, s_g, g_mag)

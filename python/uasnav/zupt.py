@@ -541,6 +541,9 @@ def _model_rows(name: str, a: ArrayLike, n: int) -> FloatArray:
 
 def moving_average(x: ArrayLike, rate_hz: float, window_s: float = REFERENCE_WINDOW_S) -> FloatArray:
     """Centred moving average (n, k) over ``window_s`` seconds (shrinking at the ends)."""
+    for name, v in (("rate_hz", rate_hz), ("window_s", window_s)):
+        if not (math.isfinite(v) and v > 0):
+            raise InputError(f"{name}: must be finite and > 0, got {v!r}")
     a = np.asarray(x, dtype=np.float64)
     a2 = a[:, None] if a.ndim == 1 else a
     w = max(1, round(window_s * rate_hz))
@@ -605,6 +608,8 @@ def convergence_time(
 ) -> list[float | None]:
     """First time (s from the start) the per-axis error falls below ``threshold`` (Table 11's
     definition: 1e-5 rad/s); ``None`` if it never does."""
+    if not (math.isfinite(threshold) and threshold > 0):
+        raise InputError(f"threshold: must be finite and > 0 (rad/s), got {threshold!r}")
     tt = np.asarray(t, dtype=np.float64)
     e = np.abs(np.asarray(estimate, dtype=np.float64) - np.asarray(reference, dtype=np.float64))
     out: list[float | None] = []

@@ -28,9 +28,19 @@ def warnings_after_success() -> Iterator[None]:
         warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
+#: Largest ``--json`` document (characters) printed indented. Python's indenting JSON encoder is
+#: pure Python (only the compact one is in C): a 10⁵-point prediction took longer to indent
+#: than to compute. Larger documents are printed compact: the same JSON, one line.
+MAX_INDENTED_JSON = 1 << 20
+
+
 def echo_json(obj: Any) -> None:
-    """Print ``obj`` as indented JSON on stdout."""
-    click.echo(json.dumps(to_jsonable(obj), indent=2, ensure_ascii=False))
+    """Print ``obj`` as JSON on stdout: indented, or compact beyond :data:`MAX_INDENTED_JSON`."""
+    doc = to_jsonable(obj)
+    text = json.dumps(doc, ensure_ascii=False)
+    if len(text) <= MAX_INDENTED_JSON:
+        text = json.dumps(doc, indent=2, ensure_ascii=False)
+    click.echo(text)
 
 
 def parse_float_list(text: str, what: str) -> list[float]:
@@ -99,6 +109,10 @@ PROBABILITY = Real(0.0, 1.0, lo_open=True, hi_open=True)
 #: elements of 10¹⁰ s) to 150 m/s (above any small UAS; a model asked for 10⁶ m/s returns
 #: negative times).
 UAS_SPEED = Real(0.1, 150.0)
+#: A separation buffer around a flight's volumes (m): 0 to 100 km. Far wider than any airspace
+#: buffer, and small enough that the geometry stays finite (a buffer of 1e308 m turns GEOS's
+#: coordinates into inf).
+BUFFER_M = Real(0.0, 1e5)
 #: A random seed: what every generator of the package (numpy, Rust) accepts.
 SEED = click.IntRange(0, 2**32 - 1)
 

@@ -34,6 +34,7 @@ def command(log: str, rate: float | None, taus: str, as_json: bool, plot_path: s
     m/s/√h, m/s/h …) with the slope-line readings as a cross-check.
     """
     from uasnav.allan import oadev
+    from uasnav.errors import NumericalError
     from uasnav.io import read_log
 
     spec = taus if taus in ("octave", "decade", "all") else parse_float_list(taus, "--taus")
@@ -41,8 +42,13 @@ def command(log: str, rate: float | None, taus: str, as_json: bool, plot_path: s
     data = read_log(log)
     if rate is None:
         rate = data.uniform_rate()
-    gyro = oadev(data.gyro, rate, spec, unit="rad/s")
-    accel = oadev(data.accel, rate, spec, unit="m/s^2")
+    curves = {}
+    for kind, x, unit in (("gyro", data.gyro, "rad/s"), ("accel", data.accel, "m/s^2")):
+        try:
+            curves[kind] = oadev(x, rate, spec, unit=unit)
+        except NumericalError as e:  # name the file and the sensor
+            raise NumericalError(f"{log}: {kind}: {e}") from None
+    gyro, accel = curves["gyro"], curves["accel"]
     reports = {"gyro": gyro.identify(), "accel": accel.identify()}
     if plot_path:
         _plot(reports, plot_path)

@@ -74,7 +74,8 @@ def _run_options(f: Any) -> Any:
         ),
         click.option(
             "--log-timeout", type=POSITIVE, default=600.0, show_default=True, metavar="SECONDS",
-            help="Deadline of one log (its download, then its analysis); a log past it is an error row.",
+            help="Deadline of one log (its download, then its analysis, run in a process that is killed "
+            "at the deadline); a log past it is an error row and the run goes on.",
         ),
         click.option("--resume", is_flag=True, help="Continue a run in --out: only logs not yet finished."),
         click.option("--json", "as_json", is_flag=True, help="Print the run summary as JSON."),
@@ -144,6 +145,7 @@ def _print(summary: Any, as_json: bool) -> None:
         "ok": summary.n_ok,
         "empty": summary.n_empty,
         "errors": summary.n_errors,
+        "timeouts": summary.n_timeouts,
         "rows": summary.n_rows,
         "bytes_read": summary.bytes_read,
         "wall_s": summary.wall_s,

@@ -175,11 +175,16 @@ def _simulate_flight(
     from uasnav.atomicfile import output_set
     from uasnav.io import write_log
     from uasnav.io.formats.gnss_csv import write_gnss_csv
+    from uasnav.limits import check_memory
     from uasnav.sim import load_preset
     from uasnav.sim.flight import imu_log_with_truth, simulate_flight
 
     gnss_path = out_path.with_name(f"{out_path.stem}_gnss.csv")
     check_outputs([preset], {"--out": [out_path, gnss_path]})
+    if duration is not None:  # 60 float64 columns per sample (IMU, truth, GNSS)
+        check_memory(
+            (duration * rate + 1) * 8 * 60, "simulate --profile flight", option="--duration or --rate"
+        )
     model = load_preset(preset)
     if not -80.0 <= latitude_deg <= 80.0:
         raise click.BadParameter(

@@ -13,6 +13,7 @@ import click
 import numpy as np
 
 from uasnav.cli._common import (
+    BUFFER_M,
     NON_NEGATIVE,
     POSITIVE,
     PROBABILITY,
@@ -793,13 +794,13 @@ def _own_run_bounds(
 )
 @click.option(
     "--lateral-buffer",
-    type=POSITIVE,
+    type=Real(0.0, 1e5, lo_open=True),
     default=15.0,
     show_default=True,
-    help="Horizontal buffer around the path (m).",
+    help="Horizontal buffer around the path (m, at most 100 km).",
 )
 @click.option(
-    "--vertical-buffer", type=NON_NEGATIVE, default=10.0, show_default=True, help="Vertical buffer (m)."
+    "--vertical-buffer", type=BUFFER_M, default=10.0, show_default=True, help="Vertical buffer (m)."
 )
 @click.option(
     "--geoid-height",
@@ -861,7 +862,7 @@ def intent(  # type: ignore[no-untyped-def]
     from uasnav.trajectory.calibration import calibrate as fit_bounds
     from uasnav.trajectory.calibration import simulated_route_runs as simulated_runs
     from uasnav.trajectory.models import load_model, method_of
-    from uasnav.trajectory.route3d import vertical_limits
+    from uasnav.trajectory.route3d import check_holds, vertical_limits
     from uasnav.utm.altitude import geoid_model
     from uasnav.utm.intent import build_intent
 
@@ -870,6 +871,7 @@ def intent(  # type: ignore[no-untyped-def]
     check_outputs([model_path, plan_path, *flight_logs], {"--out": out, "--geojson": geojson})
     model = load_model(model_path)
     plan = read_plan(plan_path)
+    check_holds(plan)  # before the calibration runs: a plan that cannot be timed fails at once
     # vertical limits: the explicit options, else the log's (--limits-from), else the model's
     # own (build_intent → route3d.vertical_limits)
     accel_z: float | None = None

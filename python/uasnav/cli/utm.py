@@ -7,8 +7,11 @@ from pathlib import Path
 
 import click
 
-from uasnav.cli._common import NON_NEGATIVE, echo_json
+from uasnav.cli._common import BUFFER_M, NON_NEGATIVE, echo_json
 from uasnav.errors import InputError
+
+#: Years a flight time may take (the POSIX epoch to far beyond any flight plan).
+FIRST_YEAR, LAST_YEAR = 1970, 9000
 
 
 def parse_time(text: str, option: str) -> datetime:
@@ -21,6 +24,9 @@ def parse_time(text: str, option: str) -> datetime:
         ) from None
     if t.tzinfo is None:
         raise InputError(f"{option}: {text!r} has no time zone (add Z for UTC)")
+    if not FIRST_YEAR <= t.year <= LAST_YEAR:
+        # a flight's times, its delays and the intent's 30-day window must stay representable
+        raise InputError(f"{option}: {text!r} is outside the years {FIRST_YEAR}–{LAST_YEAR}")
     return t.astimezone(timezone.utc)
 
 
@@ -39,14 +45,14 @@ def command() -> None:
 )
 @click.option(
     "--horizontal-buffer",
-    type=NON_NEGATIVE,
+    type=BUFFER_M,
     default=0.0,
     show_default=True,
     help="Report near misses closer than this horizontally (m).",
 )
 @click.option(
     "--vertical-buffer",
-    type=NON_NEGATIVE,
+    type=BUFFER_M,
     default=0.0,
     show_default=True,
     help="… and closer than this vertically (m).",

@@ -11,6 +11,7 @@ The same per-log code runs in this process (``workers=0``), on a ``distributed.L
 
 Modules: :mod:`~uasnav.fleet.runner` (the runner, :class:`Analysis`), :mod:`~uasnav.fleet.output`
 (layout, manifest, errors table), :mod:`~uasnav.fleet.sources` (finding logs),
+:mod:`~uasnav.fleet.deadline` (a log's analysis in a process killed at the per-log deadline),
 :mod:`~uasnav.fleet.logs` (reading one log through :mod:`uasnav.io`), and one module per
 analysis: :mod:`~uasnav.fleet.scan`, :mod:`~uasnav.fleet.imu_health` (with
 :mod:`~uasnav.fleet.anomaly`), :mod:`~uasnav.fleet.elements`; :mod:`~uasnav.fleet.simulate`

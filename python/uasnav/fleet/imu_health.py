@@ -196,6 +196,12 @@ def _finish(out: Any) -> dict[str, Any]:
     return write_scores(out, IMU_HEALTH.full_schema)
 
 
-IMU_HEALTH = Analysis("imu_health", HEALTH_SCHEMA, imu_health_log, finish=_finish)
+IMU_HEALTH = Analysis(
+    "imu_health",
+    HEALTH_SCHEMA,
+    imu_health_log,
+    finish=_finish,
+    imports=("uasnav.io.logfile", "uasnav.allan", "uasnav.earth", "uasnav.stationary", "uasnav.thermal"),
+)
 
 __all__ = ["HEALTH_SCHEMA", "IMU_HEALTH", "MIN_STATIC_S", "imu_health_log", "imu_health_of"]

@@ -130,7 +130,9 @@ class ManifestEntry:
     mtime_ns: int
     log_hash: str | None
     table: str
-    status: str  # "ok", "error" or "empty" (read, but nothing to write for this table)
+    # "ok", "error", "timeout" (stopped at the per-log deadline: --resume with the same deadline
+    # would stop it again) or "empty" (read, but nothing to write for this table)
+    status: str
 
 
 def stat_key(path: str) -> tuple[str, int, int]:

@@ -25,6 +25,10 @@ and removed; the rows carry the URL as their ``path``. A URL that cannot be fetc
 timeout, too large, refused redirect) is a row of the errors table; it is not committed to the
 manifest, so ``resume=True`` tries it again, while a finished URL is skipped by its text.
 
+With a per-log deadline (``log_timeout_s``, the CLI's ``--log-timeout``) each worker analyses its
+logs in a child process that is killed at the deadline (:mod:`uasnav.fleet.deadline`): a decoder
+stuck in native code cannot hold the run, and the log is recorded as timed out.
+
 Each task reads its log once, writes its rows to one Parquet file named by the log's content
 hash (atomically, :mod:`uasnav.fleet.output`) and returns a small :class:`TaskResult`; no
 samples travel to the client. A log that cannot be read becomes a row of the errors table and
@@ -35,18 +39,15 @@ writes the same file again (same name, same bytes): each log is in the output ex
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
 import logging
 import math
 import os
 import re
 import shutil
 import tempfile
-import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -56,6 +57,7 @@ import pyarrow.parquet as pq
 
 from uasnav._extras import require
 from uasnav.errors import InputError
+from uasnav.fleet.deadline import LogTimeout, call_with_deadline
 from uasnav.fleet.output import (
     ERRORS_SCHEMA,
     MANIFEST,
@@ -125,6 +127,9 @@ class Analysis:
     schema: pa.Schema
     compute: Callable[[str], LogRows]
     finish: Callable[[Path], Any] | None = None
+    #: Modules ``compute`` imports when it runs: a run with a per-log deadline imports them in
+    #: each analysing process before the deadline starts (:mod:`uasnav.fleet.deadline`).
+    imports: tuple[str, ...] = ()
 
     @property
     def full_schema(self) -> pa.Schema:
@@ -140,8 +145,8 @@ class TaskResult:
     size: int
     mtime_ns: int
     log_hash: str | None
-    # "ok", "empty", "error" (a bad log), "lost" (the cluster gave up on the task),
-    # "unfetched" (an http(s) log that could not be downloaded)
+    # "ok", "empty", "error" (a bad log), "timeout" (stopped at the per-log deadline), "lost"
+    # (the cluster gave up on the task), "unfetched" (an http(s) log that could not be downloaded)
     status: str
     n_rows: int = 0
     cpu_s: float = 0.0
@@ -229,45 +234,6 @@ def _process_url(
         shutil.rmtree(tmpdir, ignore_errors=True)
 
 
-class LogTimeout(Exception):
-    """A log's analysis ran past the run's per-log deadline (``log_timeout_s``)."""
-
-
-@contextlib.contextmanager
-def _deadline(seconds: float | None) -> Iterator[None]:
-    """Raise :class:`LogTimeout` in this thread once ``seconds`` have passed inside the block.
-
-    The exception is delivered asynchronously (``PyThreadState_SetAsyncExc``) so the same
-    deadline works in the main thread and in a Dask worker's task thread; it lands at the next
-    Python bytecode (a long call into the Rust core finishes first). A timer that fires after the
-    block ended is withdrawn under the lock, so it cannot escape the block.
-    """
-    if seconds is None or not math.isfinite(seconds):
-        yield
-        return
-    tid = threading.get_ident()
-    lock = threading.Lock()
-    state = {"done": False, "fired": False}
-
-    def fire() -> None:
-        with lock:
-            if not state["done"]:
-                state["fired"] = True
-                ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(tid), ctypes.py_object(LogTimeout))
-
-    timer = threading.Timer(seconds, fire)
-    timer.daemon = True
-    timer.start()
-    try:
-        yield
-    finally:
-        with lock:
-            state["done"] = True
-            timer.cancel()
-            if state["fired"]:  # delivered or pending: withdraw a pending one
-                ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(tid), None)
-
-
 def _process_file(
     local: str,
     path: str,
@@ -293,14 +259,16 @@ def _process_file(
         with warnings.catch_warnings():
             # corrupt-record warnings of the readers: the log is salvaged; the run stays quiet
             warnings.simplefilter("ignore")
-            try:
-                with _deadline(log_timeout_s):
-                    result = analysis.compute(local)
-            except LogTimeout:
-                raise LogTimeout(
-                    f"{path}: analysis stopped after the per-log deadline of {log_timeout_s:g} s "
-                    "(--log-timeout)"
-                ) from None
+            if log_timeout_s is None or not math.isfinite(log_timeout_s):
+                result = analysis.compute(local)
+            else:
+                try:
+                    result = call_with_deadline(analysis.compute, local, log_timeout_s, analysis.imports)
+                except LogTimeout:
+                    raise LogTimeout(
+                        f"{path}: analysis stopped after the per-log deadline of {log_timeout_s:g} s "
+                        "(--log-timeout)"
+                    ) from None
         if not result.rows:
             return TaskResult(path, size, mtime_ns, log_hash, "empty", cpu_s=time.process_time() - cpu0)
         table = _rows_table(analysis, result.rows, {"log_hash": log_hash, "path": path, "size_bytes": size})
@@ -309,13 +277,14 @@ def _process_file(
             path, size, mtime_ns, log_hash, "ok", n_rows=table.num_rows, cpu_s=time.process_time() - cpu0
         )
     except Exception as e:  # a corrupt log must never stop the run: record it
+        status = "timeout" if isinstance(e, LogTimeout) else "error"
         row = error_row(path, log_hash, analysis.name, e)
         if local != path:  # the reader names the temporary download: name the URL instead
             row["error"] = row["error"].replace(local, path)
         key = f"{analysis.name}-{log_hash or _path_key(path)}"
         write_table(pa.Table.from_pylist([row], schema=ERRORS_SCHEMA), error_file(out_p, key))
         return TaskResult(
-            path, size, mtime_ns, log_hash, "error", cpu_s=time.process_time() - cpu0, error=row["error"]
+            path, size, mtime_ns, log_hash, status, cpu_s=time.process_time() - cpu0, error=row["error"]
         )
 
 
@@ -337,6 +306,8 @@ class RunSummary:
     n_ok: int = 0
     n_empty: int = 0
     n_errors: int = 0
+    #: Logs stopped at the per-log deadline (counted in ``n_errors`` too).
+    n_timeouts: int = 0
     n_rows: int = 0
     bytes_read: int = 0
     wall_s: float = 0.0
@@ -419,8 +390,11 @@ def run(
         Total deadline (s) and size limit (bytes, default :func:`uasnav.limits.max_memory` on
         the worker) of the download of each http(s) log.
     log_timeout_s : float, optional
-        Deadline of one log's analysis (s); a log past it is an errors-table row and the run
-        goes on. Default: no deadline beyond the decoders' own bounds.
+        Deadline of one log's analysis (s). With a deadline each log is analysed in a child
+        process of the worker (:mod:`uasnav.fleet.deadline`), killed at the deadline whatever
+        it is doing (a long call into native code included); the log is an errors-table row and
+        a ``timeout`` entry of the manifest, and the run goes on. Default: no deadline beyond
+        the decoders' own bounds, the analysis in the worker itself.
     memory_limit : str or int
         Memory limit of each worker process of the local cluster (bytes, or Dask's ``"auto"``:
         the machine's memory ÷ workers); a worker above it is restarted by its nanny.
@@ -505,6 +479,8 @@ def _run(
                 ]
             )
         summary.cpu_s += res.cpu_s
+        if res.status == "timeout":
+            summary.n_timeouts += 1
         if res.status == "ok":
             summary.n_ok += 1
             summary.n_rows += res.n_rows

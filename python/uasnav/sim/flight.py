@@ -199,8 +199,9 @@ def simulate_flight(
     t_end = float(spline.x[-1]) if duration_s is None else float(duration_s)
     if duration_s is not None and not (math.isfinite(t_end) and t_end > static_s):
         raise InputError(f"duration_s: must exceed static_s ({static_s} s), got {duration_s!r}")
+    # estimated before round(): a duration of 1e308 s is refused, not an OverflowError
+    check_memory((t_end * rate_hz + 1) * 8 * 60, "simulated flight", option="duration_s or rate_hz")
     n = round(t_end * rate_hz) + 1
-    check_memory(n * 8 * 60, "simulated flight")
     rng = np.random.default_rng(seed)
     dt = 1.0 / rate_hz
     t = np.arange(n) * dt

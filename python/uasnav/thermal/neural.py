@@ -45,6 +45,11 @@ from uasnav.thermal.modelfile import dumps_model, save_model
 
 #: Most neurons per hidden layer (the Rust engine's ``MAX_NEURONS``).
 MAX_HIDDEN = 16
+#: Largest weight or bias magnitude of a hidden layer in a model file. The network sees
+#: normalised inputs (about ±1), so a weight of 10⁶ already turns a tanh into a step a millionth
+#: of the calibrated range wide; larger ones (1e308: the model still predicts finite numbers,
+#: silently a step function) are a corrupt or forged file, not a fit.
+MAX_PARAMETER = 1e6
 
 
 @dataclass
@@ -109,8 +114,11 @@ class Network:
             e = jc.only(jc.obj(layer, q), ("activation", "weights", "biases"), q)
             jc.string(jc.field(e, "activation", q), jc.at(q, "activation"), (act,))
             top = 1 if i == 2 else MAX_HIDDEN
-            b = jc.vector(jc.field(e, "biases", q), jc.at(q, "biases"), max_len=top)
-            ws.append(jc.matrix(jc.field(e, "weights", q), jc.at(q, "weights"), rows=b.size, cols=fan_in))
+            # hidden layers only: the linear output layer's are bounded by the bias check at load
+            lim = {"lo": -MAX_PARAMETER, "hi": MAX_PARAMETER} if i < 2 else {}
+            b = jc.vector(jc.field(e, "biases", q), jc.at(q, "biases"), max_len=top, **lim)
+            w = jc.matrix(jc.field(e, "weights", q), jc.at(q, "weights"), rows=b.size, cols=fan_in, **lim)
+            ws.append(w)
             bs.append(b)
             fan_in = b.size
         if bs[2].size != 1:

@@ -15,12 +15,14 @@ class per element, and the "classifier" then memorises single samples.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from uasnav.errors import InputError
+from uasnav.limits import check_memory
 from uasnav.trajectory.geometry import plan_length
 from uasnav.trajectory.samples import ElementSamples
 
@@ -88,10 +90,21 @@ def kinematic_times(
     NaN = ``cruise_ms``; default every leg at ``cruise_ms``), corner speed
     v_k = min(V_{k−1}, V_k)·max(cos(θ_k/2), 0.1) (the simulator's rule), 0 at the ends. A
     straight leg of length L flown from rest to rest at V takes L/V + V/a (L ≥ V²/a)."""
+    checks = (("cruise_ms", cruise_ms, 1e4), ("accel_ms2", accel_ms2, 1e4), ("ds_m", ds_m, math.inf))
+    for name, x, top in checks:
+        if not (math.isfinite(x) and x > 0):
+            raise InputError(f"{name}: must be finite and > 0, got {x!r}")
+        if x > top:  # beyond any aircraft; squared, 1e308 would leave the float range
+            raise InputError(f"{name}: {x:g} is beyond {top:g}")
     p = np.asarray(plan_ne, dtype=float)[:, :2]
     d = np.diff(p, axis=0)
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
     total = plan_length(p)
+    if not math.isfinite(total):
+        raise InputError(f"plan_ne: the plan's length is not finite ({total!r} m)")
+    check_memory(
+        4 * 8 * (total / ds_m + 2), f"a kinematic profile of {total:g} m at {ds_m:g} m steps", option="ds_m"
+    )
     s = np.arange(0.0, total + ds_m, ds_m)
     s[-1] = min(s[-1], total)
     v_leg = np.full(d.shape[0], float(cruise_ms))
@@ -101,6 +114,7 @@ def kinematic_times(
             raise InputError(f"leg_speed_ms needs {v_leg.size} speeds > 0 m/s (NaN = cruise), got {ls}")
         v_leg = np.where(np.isfinite(ls), ls, v_leg)
     v = v_leg[np.clip(np.searchsorted(cum, s, side="right") - 1, 0, v_leg.size - 1)]
+    v_top = float(v_leg.max()) if v_leg.size else 0.0
     for k in range(p.shape[0]):
         if k in (0, p.shape[0] - 1):
             vk = 0.0
@@ -108,7 +122,13 @@ def kinematic_times(
             c = d[k - 1] @ d[k] / (np.hypot(*d[k - 1]) * np.hypot(*d[k]))
             theta = np.arccos(np.clip(c, -1.0, 1.0))
             vk = min(v_leg[k - 1], v_leg[k]) * max(np.cos(theta / 2.0), 0.1)
-        v = np.minimum(v, np.sqrt(vk**2 + 2.0 * accel_ms2 * np.abs(s - cum[k])))
+        # The ramp around waypoint k exceeds every leg speed beyond (V_max² − v_k²)/2a of it:
+        # only the grid points within reach (with a margin for rounding) can change, which keeps
+        # the profile linear in the plan's length instead of quadratic in its points.
+        reach = (v_top**2 - vk**2) / (2.0 * accel_ms2) * (1.0 + 1e-9) + 2.0 * ds_m
+        lo, hi = np.searchsorted(s, [cum[k] - reach, cum[k] + reach])
+        w = slice(int(lo), int(hi) + 1)
+        v[w] = np.minimum(v[w], np.sqrt(vk**2 + 2.0 * accel_ms2 * np.abs(s[w] - cum[k])))
     # Time to each grid point: v² is linear in s on every ramp, so each grid interval is flown
     # at constant acceleration and takes exactly 2·Δs / (v₁ + v₂) (exact also from rest, where
     # the trapezoid rule on 1/v diverges; only intervals where the profile changes branch are

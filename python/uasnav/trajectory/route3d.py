@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -49,6 +49,12 @@ ELEMENT_KINDS = ("leg", "turn", "climb", "descent", "hover")
 SAME_PLACE_M = 0.01
 #: Height change (m) below which a move at one place is no vertical move.
 SAME_HEIGHT_M = 0.01
+
+
+#: Longest hold at a waypoint (s): ArduPilot stores a waypoint's hold time (``param1``) as
+#: 16-bit seconds (``AP_Mission`` ``p1``); a longer one is a typing error, and a hold of 10¹² s
+#: would carry the intent's times past the year 9999.
+MAX_HOLD_S = 65535
 
 
 @dataclass(frozen=True)
@@ -85,6 +91,11 @@ class Route3D:
             raise InputError("route positions and altitudes must be finite")
         if not (np.isfinite(self.hold_s).all() and (self.hold_s >= 0).all()):
             raise InputError("route hold times must be finite and ≥ 0 s")
+        if (long := np.flatnonzero(self.hold_s > MAX_HOLD_S)).size:
+            raise InputError(
+                f"route point {long[0]}: a hold of {self.hold_s[long[0]]:g} s is beyond the {MAX_HOLD_S} s "
+                "an autopilot stores (ArduPilot: 16-bit seconds)"
+            )
         v = self.speed_ms[np.isfinite(self.speed_ms)]
         if (v <= 0).any() or np.isinf(self.speed_ms).any():
             raise InputError("route leg speeds must be > 0 m/s (NaN = cruise)")
@@ -110,6 +121,31 @@ class Route3D:
         return np.diff(self.alt_m)
 
 
+def check_holds(plan: MissionPlan) -> list[Any]:
+    """The plan's route points (:func:`uasnav.io.mission_plan.route_points`), refusing holds
+    without a predictable end (an unlimited loiter, a loiter of N turns) or longer than
+    :data:`MAX_HOLD_S`: cheap, so commands call it before any long work on the plan.
+
+    Raises
+    ------
+    InputError
+        Naming the plan and the item.
+    """
+    from uasnav.io.mission_plan import route_points
+
+    pts = route_points(plan)
+    for p in pts:
+        if not math.isfinite(p.hold_s):
+            what = "an unlimited loiter" if p.hold_s == math.inf else "a loiter of N turns (time unknown)"
+            raise InputError(f"{plan.source}: item {p.item}: {what} has no predictable end")
+        if p.hold_s > MAX_HOLD_S:
+            raise InputError(
+                f"{plan.source}: item {p.item}: a hold of {p.hold_s:g} s is beyond the {MAX_HOLD_S} s "
+                "an autopilot stores (ArduPilot: 16-bit seconds)"
+            )
+    return pts
+
+
 def route_from_plan(plan: MissionPlan, home_amsl_m: float | None = None) -> Route3D:
     """The 3D route of a geodetic mission plan (:func:`uasnav.io.mission_plan.route_points`:
     take-off from the ground, waypoints with holds, ``DO_CHANGE_SPEED``, landing) in the local
@@ -120,14 +156,10 @@ def route_from_plan(plan: MissionPlan, home_amsl_m: float | None = None) -> Rout
     Raises :class:`InputError` for altitudes above terrain (no terrain model), mixed frames
     without a home altitude, and unbounded holds (an unlimited loiter, a loiter of N turns).
     """
-    from uasnav.io.mission_plan import AltitudeFrame, ItemKind, route_points
+    from uasnav.io.mission_plan import AltitudeFrame, ItemKind
     from uasnav.trajectory.geometry import geodetic_to_local
 
-    pts = route_points(plan)
-    for p in pts:
-        if not math.isfinite(p.hold_s):
-            what = "an unlimited loiter" if p.hold_s == math.inf else "a loiter of N turns (time unknown)"
-            raise InputError(f"{plan.source}: item {p.item}: {what} has no predictable end")
+    pts = check_holds(plan)
     frames = {p.frame for p in pts}
     if AltitudeFrame.TERRAIN in frames:
         raise InputError(f"{plan.source}: altitudes above terrain need a terrain model to be timed")
@@ -176,7 +208,13 @@ def vertical_time(dz_m: np.ndarray | float, speed_ms: float, accel_ms2: float) -
     v, a = float(speed_ms), float(accel_ms2)
     if not (v > 0 and a > 0 and math.isfinite(v) and math.isfinite(a)):
         raise InputError(f"vertical speed and acceleration limits must be > 0, got {v}, {a}")
-    return np.where(d >= v * v / a, d / v + v / a, 2.0 * np.sqrt(d / a))
+    if not np.isfinite(d).all():
+        raise InputError("vertical move: the height changes must be finite")
+    with np.errstate(over="ignore"):
+        t = np.where(d >= v * v / a, d / v + v / a, 2.0 * np.sqrt(d / a))
+    if not np.isfinite(t).all():  # e.g. 1e308 m at 1e-300 m/s
+        raise InputError(f"vertical move: {float(np.max(d)):g} m at {v:g} m/s: a time beyond the float range")
+    return t
 
 
 @dataclass(frozen=True)

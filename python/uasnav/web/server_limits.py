@@ -63,9 +63,9 @@ def _seconds(env: str, default: float) -> float:
 
 
 #: Work one plan prediction may cost on the server (elementary operations, ≈ 10⁹ per second):
-#: a plan within the upload limit can hold 10⁵ points (minutes of CPU); beyond this it is refused
-#: up front with its estimate. ``UASNAV_WEB_MAX_PLAN_WORK`` overrides it.
-MAX_PLAN_WORK = 2e10
+#: a plan within the upload limit can hold 10⁵ points (15 s of CPU); beyond 3 s of CPU (20 000
+#: points) it is refused up front with its estimate. ``UASNAV_WEB_MAX_PLAN_WORK`` overrides it.
+MAX_PLAN_WORK = 3e9
 
 
 def check_plan_work(n_points: int) -> None:
@@ -74,7 +74,7 @@ def check_plan_work(n_points: int) -> None:
     from uasnav.errors import InputError
     from uasnav.limits import PREDICTION_OPS_PER_POINT, env_positive
 
-    limit = env_positive("UASNAV_WEB_MAX_PLAN_WORK", MAX_PLAN_WORK, "operations such as 2e10")
+    limit = env_positive("UASNAV_WEB_MAX_PLAN_WORK", MAX_PLAN_WORK, "operations such as 3e9")
     ops = n_points * PREDICTION_OPS_PER_POINT
     if ops > limit:
         raise InputError(
