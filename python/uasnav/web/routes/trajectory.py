@@ -44,6 +44,7 @@ def traj_page(
                 "data:application/geo+json;base64," + base64.b64encode(gj.encode()).decode()
             )
     page["suffixes"] = ", ".join(prediction.PLAN_SUFFIXES)
+    page["autopilots"] = prediction.AUTOPILOT_LABELS
     page["max_upload"] = MAX_BODY_BYTES
     return ctx.templates.TemplateResponse(request, "trajectory.html", page, status_code=status)
 
@@ -64,7 +65,18 @@ async def predict_from_form(form: Any) -> prediction.RoutePrediction:
         else None
     )
     tolerance = prediction.parse_number("tolerance", form.get("tolerance") or "5", 0.0, 3600.0)
+    autopilot = str(form.get("autopilot") or "").strip() or None
+    if autopilot is not None and autopilot not in prediction.AUTOPILOTS:
+        raise prediction.FieldError(
+            "autopilot", f"autopilot: {autopilot!r} is not one of {', '.join(prediction.AUTOPILOTS)}"
+        )
     up_plan = prediction.read_uploaded_plan(plan.filename, data)
+    # an autopilot mission file: the mission as the autopilot flies it (`trajectory mission`)
+    flown = (
+        await run_in_threadpool(prediction.predict_autopilot, up_plan.mission, autopilot)
+        if up_plan.mission is not None
+        else None
+    )
     required_text = str(form.get("required") or "")
     required = (
         prediction.parse_required(required_text, up_plan.route_ne.shape[0]) if required_text.strip() else None
@@ -80,8 +92,10 @@ async def predict_from_form(form: Any) -> prediction.RoutePrediction:
         model, name = await run_in_threadpool(default_model), "built-in model (simulated flights)"
     if speed is None and up_plan.cruise_ms is not None:
         speed, name = up_plan.cruise_ms, f"{name}; speed from the plan"
+    elif speed is None and flown is not None:
+        speed, name = flown.cruise_ms, f"{name}; speed the autopilot's {flown.cruise_param}"
     try:
-        return await run_in_threadpool(
+        result = await run_in_threadpool(
             prediction.predict_plan,
             model,
             up_plan.route_ne,
@@ -95,6 +109,8 @@ async def predict_from_form(form: Any) -> prediction.RoutePrediction:
         )
     except UasnavError as e:
         raise prediction.FieldError("plan", f"plan: {e}") from None
+    result.autopilot = flown
+    return result
 
 
 @router.get("/trajectory", response_class=HTMLResponse)
