@@ -435,8 +435,11 @@ def waypoints_geojson(r: RoutePrediction) -> dict[str, Any]:
     return {"type": "FeatureCollection", "features": feats}
 
 
-def route_drawing(r: RoutePrediction, width: float = 640.0, pad: float = 28.0) -> dict[str, Any]:
-    """Screen coordinates of the route drawn to scale (east right, north up) in an SVG box.
+def route_drawing(
+    r: RoutePrediction, width: float = 640.0, pad: float = 28.0, *, with_times: bool = True
+) -> dict[str, Any]:
+    """Screen coordinates of the route drawn to scale (east right, north up) in an SVG box;
+    each waypoint labelled with its number and, ``with_times``, its element-model time.
 
     Returns the view box size, each element's polyline and flag, the waypoints and a scale bar
     of a round length (1, 2 or 5 × 10ⁿ m).
@@ -460,7 +463,8 @@ def route_drawing(r: RoutePrediction, width: float = 640.0, pad: float = 28.0) -
     # one label per drawn point: a closed route's first and last waypoints share theirs
     labels: dict[tuple[float, float], list[str]] = {}
     for w in r.waypoints:
-        labels.setdefault(xy(w["east_m"], w["north_m"]), []).append(f"{w['waypoint']} · {w['time_s']:.1f} s")
+        text = f"{w['waypoint']} · {w['time_s']:.1f} s" if with_times else str(w["waypoint"])
+        labels.setdefault(xy(w["east_m"], w["north_m"]), []).append(text)
     box_width = max(width_used, 160.0)
     wps = [
         # labels right of the point, or left of it near the right edge of the drawn box (not

@@ -36,7 +36,8 @@ def traj_page(
     if result is not None:
         csv_text = prediction.waypoints_csv(result)
         page["result"] = result
-        page["drawing"] = prediction.route_drawing(result)
+        # a mission's times are the autopilot's, in its items table: the drawing names the waypoints
+        page["drawing"] = prediction.route_drawing(result, with_times=result.autopilot is None)
         page["csv_href"] = "data:text/csv;base64," + base64.b64encode(csv_text.encode()).decode()
         if result.origin is not None:
             gj = prediction.to_json_text(prediction.waypoints_geojson(result))
