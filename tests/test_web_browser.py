@@ -373,6 +373,12 @@ def test_autopilot_mission_on_desktop_and_phone(pages, server, shared_data) -> N
         shot(page, f"trajectory-mission-{tag}")
         assert_route_labels_inside(page)
         assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+    with page.expect_download() as d:
+        page.click("a:has-text('Mission item times CSV')")
+    rows = Path(d.value.path()).read_text().splitlines()
+    assert rows[0] == "item,command,name,arrive_s" and len(rows) == len(ref["items"]) + 1
+    last = rows[-1].split(",")
+    assert float(last[-1]) == pytest.approx(ref["items"][-1]["arrive_s"], abs=1e-3)
     page.select_option("#t-autopilot", "arducopter")
     page.set_input_files("#t-plan", str(plan))
     page.click("#trajectory-form button[type=submit]")

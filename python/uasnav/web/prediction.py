@@ -404,6 +404,17 @@ def waypoints_csv(r: RoutePrediction) -> str:
     return out.getvalue()
 
 
+def mission_items_csv(a: AutopilotPrediction) -> str:
+    """The mission items as the autopilot flies them, as CSV: item, command, name, arrive_s
+    (the rows of ``uasnav trajectory mission --json`` ``items``, with the command's name)."""
+    out = io.StringIO()
+    w = csv.DictWriter(out, ["item", "command", "name", "arrive_s"], lineterminator="\n")
+    w.writeheader()
+    for row in a.items:
+        w.writerow({**row, "arrive_s": f"{row['arrive_s']:.3f}"})
+    return out.getvalue()
+
+
 def waypoints_geojson(r: RoutePrediction) -> dict[str, Any]:
     """The 4D waypoints as a GeoJSON FeatureCollection (RFC 7946: lon, lat), with ``time_s``.
 
@@ -504,6 +515,7 @@ __all__ = [
     "RoutePrediction",
     "UploadedPlan",
     "default_autopilot",
+    "mission_items_csv",
     "parse_number",
     "parse_required",
     "predict_autopilot",

@@ -39,6 +39,9 @@ def traj_page(
         # a mission's times are the autopilot's, in its items table: the drawing names the waypoints
         page["drawing"] = prediction.route_drawing(result, with_times=result.autopilot is None)
         page["csv_href"] = "data:text/csv;base64," + base64.b64encode(csv_text.encode()).decode()
+        if result.autopilot is not None:
+            items = prediction.mission_items_csv(result.autopilot)
+            page["items_href"] = "data:text/csv;base64," + base64.b64encode(items.encode()).decode()
         if result.origin is not None:
             gj = prediction.to_json_text(prediction.waypoints_geojson(result))
             page["geojson_href"] = (
