@@ -300,6 +300,31 @@ def test_keyboard_only(pages, server) -> None:
     assert page.get_attribute("#ranking th:has-text('Score')", "aria-sort") == "ascending"
 
 
+def predicted(page, server, plan: Path, **fields: str):  # type: ignore[no-untyped-def]
+    """``page`` with the trajectory form sent for ``plan`` and ``fields`` (form names)."""
+    page.goto(server.url + "/trajectory")
+    page.set_input_files("#t-plan", str(plan))
+    for name, value in fields.items():
+        page.fill(f"#t-{name}", value)
+    page.click("#trajectory-form button[type=submit]")
+    landed(page, "prediction")
+    return page
+
+
+def route_page_fits(page, name: str, viewport: dict[str, int]) -> None:  # type: ignore[no-untyped-def]
+    """Screenshot ``name``; every route label inside the drawing, nothing scrolls sideways."""
+    shot(page, name)
+    assert_route_labels_inside(page)
+    assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+
+
+def downloaded_lines(page, link: str) -> list[str]:  # type: ignore[no-untyped-def]
+    """The lines of the file the link named ``link`` downloads."""
+    with page.expect_download() as d:
+        page.click(f"a:has-text('{link}')")
+    return Path(d.value.path()).read_text().splitlines()
+
+
 def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
     import pymap3d
 
@@ -315,14 +340,7 @@ def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
     ref = default_model().predict(route, wind_vector(2.78, 22.5), 3.33)
     flown = cli_mission(plan)
     for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
-        page = pages.new(viewport)
-        page.goto(server.url + "/trajectory")
-        page.set_input_files("#t-plan", str(plan))
-        page.fill("#t-wind_speed", "2.78")
-        page.fill("#t-wind_from", "22.5")
-        page.fill("#t-speed", "3.33")
-        page.click("#trajectory-form button[type=submit]")
-        landed(page, "prediction")
+        page = predicted(pages.new(viewport), server, plan, wind_speed="2.78", wind_from="22.5", speed="3.33")
         times = [
             float(x)
             for x in page.eval_on_selector_all(
@@ -338,12 +356,8 @@ def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
         low = page.locator("#elements tbody tr.low").count()
         assert low == sum(1 for f in ref.flags if f)
         assert page.locator("svg polyline.seg").count() == len(ref.time_s)
-        shot(page, f"trajectory-{tag}")
-        assert_route_labels_inside(page)
-        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
-    with page.expect_download() as d:
-        page.click("a:has-text('Waypoint times CSV')")
-    lines = Path(d.value.path()).read_text().splitlines()
+        route_page_fits(page, f"trajectory-{tag}", viewport)
+    lines = downloaded_lines(page, "Waypoint times CSV")
     assert lines[0].endswith("time_s") and len(lines) == len(ref.waypoint_times_s) + 1
 
 
@@ -361,21 +375,13 @@ def test_autopilot_mission_on_desktop_and_phone(pages, server, shared_data) -> N
     plan = shared_data / "missions" / "ardupilot_autotest_dalby_obc2016.waypoints"
     ref, as_copter = cli_mission(plan), cli_mission(plan, "--autopilot", "arducopter")
     for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
-        page = pages.new(viewport)
-        page.goto(server.url + "/trajectory")
-        page.set_input_files("#t-plan", str(plan))
-        page.click("#trajectory-form button[type=submit]")
-        landed(page, "prediction")
+        page = predicted(pages.new(viewport), server, plan)
         assert float(page.get_attribute("#eta", "data-eta")) == ref["eta_s"]
         assert float(page.get_attribute("#qgc-eta", "data-eta")) == ref["qgc_estimate_s"]
         assert "ArduPlane" in page.locator("#autopilot").inner_text()
         assert page.locator("#mission-items td[data-arrive]").count() == len(ref["items"])
-        shot(page, f"trajectory-mission-{tag}")
-        assert_route_labels_inside(page)
-        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
-    with page.expect_download() as d:
-        page.click("a:has-text('Mission item times CSV')")
-    rows = Path(d.value.path()).read_text().splitlines()
+        route_page_fits(page, f"trajectory-mission-{tag}", viewport)
+    rows = downloaded_lines(page, "Mission item times CSV")
     assert rows[0] == "item,command,name,arrive_s" and len(rows) == len(ref["items"]) + 1
     last = rows[-1].split(",")
     assert float(last[-1]) == pytest.approx(ref["items"][-1]["arrive_s"], abs=1e-3)
