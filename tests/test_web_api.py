@@ -6,6 +6,7 @@ tests/test_web_browser.py)."""
 from __future__ import annotations
 
 import csv
+import html
 import io
 import json
 import logging
@@ -330,6 +331,89 @@ def test_predict_api_matches_the_predictor(client, tmp_path) -> None:
     )
     rows = list(csv.DictReader(io.StringIO(c.text)))
     assert [float(x["time_s"]) for x in rows] == pytest.approx(out["waypoint_times_s"], abs=1e-3)
+
+
+def cli_mission(plan: Path, *options: str) -> dict:
+    """``uasnav trajectory mission PLAN --json`` (the figure the page must give)."""
+    r = CliRunner().invoke(main, ["trajectory", "mission", str(plan), *options, "--json"])
+    assert r.exit_code == 0, r.output
+    return json.loads(r.output)
+
+
+def page_eta(text: str, ident: str = "eta") -> float:
+    m = re.search(rf'id="{ident}" data-eta="([^"]+)"', text)
+    assert m, text[-3000:]
+    return float(m.group(1))
+
+
+@pytest.mark.parametrize(
+    ("name", "autopilot"),
+    [
+        ("ardupilot_autotest_dalby_obc2016.waypoints", ""),  # the real QuadPlane plan
+        ("mavsdk_qgroundcontrol_sample.plan", ""),  # a QGroundControl multirotor plan
+        ("mavsdk_qgroundcontrol_sample.plan", "px4-mc"),  # the stack chosen on the form
+    ],
+)
+def test_mission_file_gets_the_cli_mission_time(client, shared_data, name, autopilot) -> None:
+    """An autopilot mission file on the page and the API gives exactly the figure of
+    ``uasnav trajectory mission`` (same model, same autopilot default), not the element
+    model at a guessed speed; the element model is shown beside it."""
+    plan = shared_data / "missions" / name
+    ref = cli_mission(plan, *(["--autopilot", autopilot] if autopilot else []))
+    form = {"autopilot": autopilot} if autopilot else {}
+    page = client.post("/trajectory", files={"plan": (name, plan.read_bytes())}, data=form)
+    assert page.status_code == 200, page.text[-2000:]
+    assert page_eta(page.text) == ref["eta_s"]
+    assert page_eta(page.text, "qgc-eta") == ref["qgc_estimate_s"]
+    element_eta = page_eta(page.text, "element-eta")
+    assert element_eta != ref["eta_s"]  # shown apart, not in place of the autopilot's
+    assert 'id="mission-items"' in page.text and page.text.count("data-arrive=") == len(ref["items"])
+    chosen = "autopilot chosen" if autopilot else "autopilot from the plan"
+    assert chosen in page.text and forms_label(ref["autopilot"]) in page.text
+    api = client.post("/api/trajectory/predict", files={"plan": (name, plan.read_bytes())}, data=form).json()
+    flown = api["autopilot"]
+    assert flown.pop("chosen_by") == ("form" if autopilot else "plan")
+    assert flown == ref  # every key of `trajectory mission --json`, equal
+    assert api["eta_s"] == pytest.approx(element_eta)
+
+
+def forms_label(family: str) -> str:
+    from uasnav.web.prediction import AUTOPILOT_LABELS
+
+    return str(jinja_escape(AUTOPILOT_LABELS[family]))
+
+
+def test_dalby_page_is_the_autopilot_figure_not_the_slow_multirotor_one(client, shared_data) -> None:
+    """The QuadPlane plan gives no speed before its first waypoints: the page flies it at the
+    plane's cruise airspeed (about an hour, as QGroundControl says), never at a multirotor's
+    default speed (over four hours)."""
+    plan = shared_data / "missions" / "ardupilot_autotest_dalby_obc2016.waypoints"
+    text = client.post("/trajectory", files={"plan": (plan.name, plan.read_bytes())}).text
+    eta, qgc = page_eta(text), page_eta(text, "qgc-eta")
+    assert abs(eta - qgc) / qgc < 0.05 and eta < 3600.0
+    assert "AIRSPEED_CRUISE" in text and "ArduPlane" in text
+
+
+def test_csv_route_has_no_autopilot_model_and_a_bad_autopilot_is_named(client, tmp_path) -> None:
+    p = _plan_csv(tmp_path)
+    out = client.post("/api/trajectory/predict", files={"plan": ("a.csv", p.read_bytes())}).json()
+    assert out["autopilot"] is None and out["eta_s"] > 0
+    text = client.post("/trajectory", files={"plan": ("a.csv", p.read_bytes())}).text
+    assert 'id="mission-items"' not in text and 'id="element-eta"' not in text
+    assert page_eta(text) == pytest.approx(out["eta_s"])
+    r = client.post(
+        "/trajectory",
+        files={"plan": ("a.csv", p.read_bytes())},
+        data={"autopilot": "betaflight", "wind_speed": "4"},
+    )
+    assert r.status_code == 422
+    msg = re.search(r'id="te-autopilot" role="alert">([^<]*)<', r.text)
+    assert msg and html.unescape(msg.group(1)).startswith("autopilot: 'betaflight' is not one of")
+    assert 'value="4"' in r.text  # the other fields stay as typed
+    a = client.post(
+        "/api/trajectory/predict", files={"plan": ("a.csv", p.read_bytes())}, data={"autopilot": "x"}
+    )
+    assert a.status_code == 422 and "autopilot" in a.text
 
 
 def test_predict_page_without_javascript(client, tmp_path) -> None:

@@ -20,7 +20,9 @@ from pathlib import Path
 
 import pypdf
 import pytest
+from click.testing import CliRunner
 
+from uasnav.cli import main
 from uasnav.io.plans import plan_route, read_plan, write_plan
 from uasnav.trajectory.features import wind_vector
 from uasnav.web.context import plain
@@ -298,6 +300,31 @@ def test_keyboard_only(pages, server) -> None:
     assert page.get_attribute("#ranking th:has-text('Score')", "aria-sort") == "ascending"
 
 
+def predicted(page, server, plan: Path, **fields: str):  # type: ignore[no-untyped-def]
+    """``page`` with the trajectory form sent for ``plan`` and ``fields`` (form names)."""
+    page.goto(server.url + "/trajectory")
+    page.set_input_files("#t-plan", str(plan))
+    for name, value in fields.items():
+        page.fill(f"#t-{name}", value)
+    page.click("#trajectory-form button[type=submit]")
+    landed(page, "prediction")
+    return page
+
+
+def route_page_fits(page, name: str, viewport: dict[str, int]) -> None:  # type: ignore[no-untyped-def]
+    """Screenshot ``name``; every route label inside the drawing, nothing scrolls sideways."""
+    shot(page, name)
+    assert_route_labels_inside(page)
+    assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
+
+
+def downloaded_lines(page, link: str) -> list[str]:  # type: ignore[no-untyped-def]
+    """The lines of the file the link named ``link`` downloads."""
+    with page.expect_download() as d:
+        page.click(f"a:has-text('{link}')")
+    return Path(d.value.path()).read_text().splitlines()
+
+
 def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
     import pymap3d
 
@@ -311,15 +338,9 @@ def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
     write_plan(read_plan(csv), plan)  # a QGroundControl .plan
     route, _ = plan_route(read_plan(plan))
     ref = default_model().predict(route, wind_vector(2.78, 22.5), 3.33)
+    flown = cli_mission(plan)
     for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
-        page = pages.new(viewport)
-        page.goto(server.url + "/trajectory")
-        page.set_input_files("#t-plan", str(plan))
-        page.fill("#t-wind_speed", "2.78")
-        page.fill("#t-wind_from", "22.5")
-        page.fill("#t-speed", "3.33")
-        page.click("#trajectory-form button[type=submit]")
-        landed(page, "prediction")
+        page = predicted(pages.new(viewport), server, plan, wind_speed="2.78", wind_from="22.5", speed="3.33")
         times = [
             float(x)
             for x in page.eval_on_selector_all(
@@ -327,17 +348,49 @@ def test_plan_upload_gives_the_predicted_times(pages, server, tmp_path) -> None:
             )
         ]
         assert times == pytest.approx(list(ref.waypoint_times_s), abs=1e-6)
-        assert float(page.get_attribute("#eta", "data-eta")) == pytest.approx(ref.eta_s)
+        # a .plan is a mission: its ETA is the autopilot's (`trajectory mission`), the element
+        # model's stands beside it
+        assert float(page.get_attribute("#element-eta", "data-eta")) == pytest.approx(ref.eta_s)
+        assert float(page.get_attribute("#eta", "data-eta")) == flown["eta_s"]
+        assert page.locator("#mission-items td[data-arrive]").count() == len(flown["items"])
         low = page.locator("#elements tbody tr.low").count()
         assert low == sum(1 for f in ref.flags if f)
         assert page.locator("svg polyline.seg").count() == len(ref.time_s)
-        shot(page, f"trajectory-{tag}")
-        assert_route_labels_inside(page)
-        assert page.evaluate("document.documentElement.scrollWidth") <= viewport["width"]
-    with page.expect_download() as d:
-        page.click("a:has-text('Waypoint times CSV')")
-    lines = Path(d.value.path()).read_text().splitlines()
+        route_page_fits(page, f"trajectory-{tag}", viewport)
+    lines = downloaded_lines(page, "Waypoint times CSV")
     assert lines[0].endswith("time_s") and len(lines) == len(ref.waypoint_times_s) + 1
+
+
+def cli_mission(plan: Path, *options: str) -> dict:
+    """``uasnav trajectory mission PLAN --json``."""
+    r = CliRunner().invoke(main, ["trajectory", "mission", str(plan), *options, "--json"])
+    assert r.exit_code == 0, r.output
+    return json.loads(r.output)
+
+
+def test_autopilot_mission_on_desktop_and_phone(pages, server, shared_data) -> None:
+    """The real QuadPlane plan: the page's ETA is the CLI's mission figure, the autopilot and
+    QGroundControl's estimate are named; the stack chosen on the form gives the CLI's figure
+    for that stack. Screenshots at 1366 and 390 px."""
+    plan = shared_data / "missions" / "ardupilot_autotest_dalby_obc2016.waypoints"
+    ref, as_copter = cli_mission(plan), cli_mission(plan, "--autopilot", "arducopter")
+    for viewport, tag in ((DESKTOP, "desktop"), (PHONE, "phone")):
+        page = predicted(pages.new(viewport), server, plan)
+        assert float(page.get_attribute("#eta", "data-eta")) == ref["eta_s"]
+        assert float(page.get_attribute("#qgc-eta", "data-eta")) == ref["qgc_estimate_s"]
+        assert "ArduPlane" in page.locator("#autopilot").inner_text()
+        assert page.locator("#mission-items td[data-arrive]").count() == len(ref["items"])
+        route_page_fits(page, f"trajectory-mission-{tag}", viewport)
+    rows = downloaded_lines(page, "Mission item times CSV")
+    assert rows[0] == "item,command,name,arrive_s" and len(rows) == len(ref["items"]) + 1
+    last = rows[-1].split(",")
+    assert float(last[-1]) == pytest.approx(ref["items"][-1]["arrive_s"], abs=1e-3)
+    page.select_option("#t-autopilot", "arducopter")
+    page.set_input_files("#t-plan", str(plan))
+    page.click("#trajectory-form button[type=submit]")
+    landed(page, "prediction")
+    assert float(page.get_attribute("#eta", "data-eta")) == as_copter["eta_s"]
+    assert page.input_value("#t-autopilot") == "arducopter"
 
 
 def test_database_pages_filter_and_sort(pages, server) -> None:

@@ -22,7 +22,9 @@ from typing import Any
 import numpy as np
 
 from uasnav.errors import DataFormatError, InputError, UasnavError
+from uasnav.io.mission_plan import MissionPlan
 from uasnav.io.plans import MAX_PLAN_BYTES, PLAN_EXTENSIONS, plan_cruise_speed, plan_route, read_plan
+from uasnav.trajectory.autopilot import FAMILIES, mission_params, predict_mission, qgc_mission_time
 from uasnav.trajectory.features import wind_vector
 from uasnav.trajectory.models import Predictor, load_model, method_of
 from uasnav.trajectory.predictor import MAX_MODEL_BYTES, Feasibility
@@ -30,6 +32,37 @@ from uasnav.trajectory.predictor import MAX_MODEL_BYTES, Feasibility
 #: Plan formats accepted, by file-name suffix (the readers of :mod:`uasnav.io.plans`):
 #: QGroundControl ``.plan``, Mission Planner ``.waypoints``/``.txt``, uasnav's ``.csv``.
 PLAN_SUFFIXES = PLAN_EXTENSIONS
+#: Plan formats an autopilot flies as a mission (take-off, speed changes, holds, landing):
+#: these get the autopilot's mission execution model as ``uasnav trajectory mission`` runs it;
+#: a CSV is a route of waypoints only, for the element model.
+MISSION_SUFFIXES = tuple(s for s in PLAN_SUFFIXES if s != ".csv")
+#: Autopilot families of the mission model (``uasnav trajectory mission --autopilot``).
+AUTOPILOTS = FAMILIES
+#: What the page calls each family.
+AUTOPILOT_LABELS = {
+    "arducopter": "ArduCopter (multirotor)",
+    "px4-mc": "PX4 multicopter",
+    "plane": "ArduPlane / QuadPlane (fixed wing, VTOL)",
+}
+#: The parameter of each family's horizontal mission speed (:attr:`MissionParams.cruise_ms`).
+CRUISE_PARAM = {"arducopter": "WPNAV_SPEED", "px4-mc": "MPC_XY_CRUISE", "plane": "AIRSPEED_CRUISE"}
+#: MAVLink ``MAV_CMD`` names of the items a mission table shows (MAVLink common.xml).
+MAV_CMD_NAMES = {
+    16: "waypoint",
+    17: "loiter (unlimited)",
+    18: "loiter turns",
+    19: "loiter time",
+    20: "return to launch",
+    21: "land",
+    22: "take-off",
+    31: "loiter to altitude",
+    82: "spline waypoint",
+    84: "VTOL take-off",
+    85: "VTOL land",
+    93: "delay",
+    177: "jump",
+    178: "change speed",
+}
 #: Largest uploaded plan and model (bytes).
 MAX_UPLOAD_PLAN_BYTES = min(MAX_PLAN_BYTES, 4 * 2**20)
 MAX_UPLOAD_MODEL_BYTES = min(MAX_MODEL_BYTES, 8 * 2**20)
@@ -61,11 +94,14 @@ def _write_upload(tmp: Path, stem: str, suffix: str, data: bytes) -> Path:
 @dataclass(frozen=True)
 class UploadedPlan:
     """An uploaded plan's horizontal route (north/east m, shape (n, 2)), geodetic origin (lat
-    deg, lon deg, alt m; None for a local plan) and commanded cruise speed (m/s, if given)."""
+    deg, lon deg, alt m; None for a local plan) and commanded cruise speed (m/s, if given);
+    ``mission`` is the plan itself for an autopilot mission file (:data:`MISSION_SUFFIXES`),
+    None for a route (CSV)."""
 
     route_ne: np.ndarray
     origin: tuple[float, float, float] | None
     cruise_ms: float | None
+    mission: MissionPlan | None = None
 
 
 def read_uploaded_plan(filename: str, data: bytes) -> UploadedPlan:
@@ -103,7 +139,102 @@ def read_uploaded_plan(filename: str, data: bytes) -> UploadedPlan:
         check_plan_work(route.shape[0])
     except InputError as e:
         raise FieldError("plan", f"plan: {e}") from None
-    return UploadedPlan(np.asarray(route, dtype=float)[:, :2], origin, plan_cruise_speed(plan))
+    return UploadedPlan(
+        np.asarray(route, dtype=float)[:, :2],
+        origin,
+        plan_cruise_speed(plan),
+        plan if suffix in MISSION_SUFFIXES else None,
+    )
+
+
+def default_autopilot(plan: MissionPlan) -> str:
+    """The family ``uasnav trajectory mission`` flies a plan with when none is named: a plan
+    with VTOL items (``MAV_CMD`` 84/85) or made for a fixed wing (``MAV_TYPE`` 1) is a plane,
+    any other an ArduCopter."""
+    if any(it.command in (84, 85) for it in plan.items) or plan.vehicle_type == 1:
+        return "plane"
+    return "arducopter"
+
+
+@dataclass(frozen=True)
+class AutopilotPrediction:
+    """The mission as the autopilot flies it (:func:`uasnav.trajectory.autopilot.predict_mission`
+    with the firmware defaults), the numbers of ``uasnav trajectory mission --json``.
+
+    ``chosen_by`` says where the family came from: ``"plan"`` (the CLI's default rule,
+    :func:`default_autopilot`) or ``"form"``.
+    """
+
+    autopilot: str
+    firmware: str | None
+    eta_s: float
+    landed: bool
+    qgc_estimate_s: float
+    items: list[dict[str, Any]]
+    parameters: dict[str, dict[str, Any]]
+    #: The horizontal mission speed the model flies (m/s) and its parameter's name.
+    cruise_ms: float
+    cruise_param: str
+    chosen_by: str = "plan"
+
+    @property
+    def label(self) -> str:
+        return AUTOPILOT_LABELS.get(self.autopilot, self.autopilot)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The keys of ``uasnav trajectory mission --json``, plus ``chosen_by``."""
+        return {
+            "autopilot": self.autopilot,
+            "firmware": self.firmware,
+            "eta_s": self.eta_s,
+            "landed": self.landed,
+            "qgc_estimate_s": self.qgc_estimate_s,
+            "items": [{k: r[k] for k in ("item", "command", "arrive_s")} for r in self.items],
+            "parameters": self.parameters,
+            "chosen_by": self.chosen_by,
+        }
+
+
+def predict_autopilot(plan: MissionPlan, autopilot: str | None = None) -> AutopilotPrediction:
+    """When each item of ``plan`` is reached and the mission ends, as ``uasnav trajectory
+    mission PLAN [--autopilot …]`` computes it (the same functions, firmware defaults, home
+    altitude unknown), beside QGroundControl's own estimate.
+
+    Raises
+    ------
+    FieldError
+        ``field == "autopilot"`` for an unknown family; ``"plan"`` when the model refuses the plan.
+    """
+    if autopilot is not None and autopilot not in AUTOPILOTS:
+        raise FieldError("autopilot", f"autopilot: {autopilot!r} is not one of {', '.join(AUTOPILOTS)}")
+    family = autopilot or default_autopilot(plan)
+    try:
+        params = mission_params(family, None, {})
+        pred = predict_mission(plan, params, home_amsl_m=None)
+        qgc = qgc_mission_time(plan, params.cruise_ms, None)
+    except UasnavError as e:
+        raise FieldError("plan", f"plan: {e}") from None
+    items = [
+        {
+            "item": int(i),
+            "command": int(c),
+            "name": MAV_CMD_NAMES.get(int(c), f"MAV_CMD {int(c)}"),
+            "arrive_s": float(t),
+        }
+        for i, c, t in zip(pred.items, pred.commands, pred.arrive_s, strict=True)
+    ]
+    return AutopilotPrediction(
+        autopilot=family,
+        firmware=params.version,
+        eta_s=float(pred.eta_s),
+        landed=bool(pred.landed),
+        qgc_estimate_s=float(qgc),
+        items=items,
+        parameters={k: {"value": params.values[k], "source": params.sources[k]} for k in params.values},
+        cruise_ms=float(params.cruise_ms),
+        cruise_param=CRUISE_PARAM.get(family, "cruise speed"),
+        chosen_by="plan" if autopilot is None else "form",
+    )
 
 
 def read_uploaded_model(data: bytes) -> Predictor:
@@ -148,6 +279,8 @@ class RoutePrediction:
     method: str = ""
     #: 4D plan check (required time per waypoint within a tolerance), if asked for.
     feasibility: Feasibility | None = None
+    #: For an autopilot mission file: the mission as the autopilot flies it (the page's ETA).
+    autopilot: AutopilotPrediction | None = None
 
     def to_dict(self) -> dict[str, Any]:
         extra: dict[str, Any] = {}
@@ -169,6 +302,7 @@ class RoutePrediction:
             "model": self.model,
             "method": self.method,
             "low_confidence_elements": [e["element"] for e in self.elements if e["low_confidence"]],
+            "autopilot": None if self.autopilot is None else self.autopilot.to_dict(),
         }
 
 
@@ -270,6 +404,17 @@ def waypoints_csv(r: RoutePrediction) -> str:
     return out.getvalue()
 
 
+def mission_items_csv(a: AutopilotPrediction) -> str:
+    """The mission items as the autopilot flies them, as CSV: item, command, name, arrive_s
+    (the rows of ``uasnav trajectory mission --json`` ``items``, with the command's name)."""
+    out = io.StringIO()
+    w = csv.DictWriter(out, ["item", "command", "name", "arrive_s"], lineterminator="\n")
+    w.writeheader()
+    for row in a.items:
+        w.writerow({**row, "arrive_s": f"{row['arrive_s']:.3f}"})
+    return out.getvalue()
+
+
 def waypoints_geojson(r: RoutePrediction) -> dict[str, Any]:
     """The 4D waypoints as a GeoJSON FeatureCollection (RFC 7946: lon, lat), with ``time_s``.
 
@@ -301,8 +446,11 @@ def waypoints_geojson(r: RoutePrediction) -> dict[str, Any]:
     return {"type": "FeatureCollection", "features": feats}
 
 
-def route_drawing(r: RoutePrediction, width: float = 640.0, pad: float = 28.0) -> dict[str, Any]:
-    """Screen coordinates of the route drawn to scale (east right, north up) in an SVG box.
+def route_drawing(
+    r: RoutePrediction, width: float = 640.0, pad: float = 28.0, *, with_times: bool = True
+) -> dict[str, Any]:
+    """Screen coordinates of the route drawn to scale (east right, north up) in an SVG box;
+    each waypoint labelled with its number and, ``with_times``, its element-model time.
 
     Returns the view box size, each element's polyline and flag, the waypoints and a scale bar
     of a round length (1, 2 or 5 × 10ⁿ m).
@@ -326,7 +474,8 @@ def route_drawing(r: RoutePrediction, width: float = 640.0, pad: float = 28.0) -
     # one label per drawn point: a closed route's first and last waypoints share theirs
     labels: dict[tuple[float, float], list[str]] = {}
     for w in r.waypoints:
-        labels.setdefault(xy(w["east_m"], w["north_m"]), []).append(f"{w['waypoint']} · {w['time_s']:.1f} s")
+        text = f"{w['waypoint']} · {w['time_s']:.1f} s" if with_times else str(w["waypoint"])
+        labels.setdefault(xy(w["east_m"], w["north_m"]), []).append(text)
     box_width = max(width_used, 160.0)
     wps = [
         # labels right of the point, or left of it near the right edge of the drawn box (not
@@ -355,15 +504,21 @@ def to_json_text(obj: Any) -> str:
 
 
 __all__ = [
+    "AUTOPILOTS",
     "MAX_UPLOAD_MODEL_BYTES",
     "MAX_UPLOAD_PLAN_BYTES",
+    "MISSION_SUFFIXES",
     "PLAN_SUFFIXES",
+    "AutopilotPrediction",
     "DataFormatError",
     "FieldError",
     "RoutePrediction",
     "UploadedPlan",
+    "default_autopilot",
+    "mission_items_csv",
     "parse_number",
     "parse_required",
+    "predict_autopilot",
     "predict_plan",
     "read_uploaded_model",
     "read_uploaded_plan",

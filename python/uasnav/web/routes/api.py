@@ -41,6 +41,13 @@ PREDICT_SCHEMA: dict[str, Any] = {
                 "format": "binary",
                 "description": "Model JSON of `uasnav trajectory train` (default: the built-in model)",
             },
+            "autopilot": {
+                "type": "string",
+                "enum": ["arducopter", "px4-mc", "plane"],
+                "description": "Autopilot that flies a .plan/.waypoints mission (firmware defaults); "
+                "default from the plan as `uasnav trajectory mission`. The answer's `autopilot` object "
+                "carries the keys of `uasnav trajectory mission --json` (null for a CSV route)",
+            },
             "wind_speed": {"type": "number", "minimum": 0, "maximum": 100, "description": "m/s"},
             "wind_from": {"type": "number", "description": "deg from north, where the wind comes from"},
             "speed": {"type": "number", "exclusiveMinimum": 0, "description": "commanded speed, m/s"},

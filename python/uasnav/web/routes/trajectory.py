@@ -36,14 +36,19 @@ def traj_page(
     if result is not None:
         csv_text = prediction.waypoints_csv(result)
         page["result"] = result
-        page["drawing"] = prediction.route_drawing(result)
+        # a mission's times are the autopilot's, in its items table: the drawing names the waypoints
+        page["drawing"] = prediction.route_drawing(result, with_times=result.autopilot is None)
         page["csv_href"] = "data:text/csv;base64," + base64.b64encode(csv_text.encode()).decode()
+        if result.autopilot is not None:
+            items = prediction.mission_items_csv(result.autopilot)
+            page["items_href"] = "data:text/csv;base64," + base64.b64encode(items.encode()).decode()
         if result.origin is not None:
             gj = prediction.to_json_text(prediction.waypoints_geojson(result))
             page["geojson_href"] = (
                 "data:application/geo+json;base64," + base64.b64encode(gj.encode()).decode()
             )
     page["suffixes"] = ", ".join(prediction.PLAN_SUFFIXES)
+    page["autopilots"] = prediction.AUTOPILOT_LABELS
     page["max_upload"] = MAX_BODY_BYTES
     return ctx.templates.TemplateResponse(request, "trajectory.html", page, status_code=status)
 
@@ -64,7 +69,18 @@ async def predict_from_form(form: Any) -> prediction.RoutePrediction:
         else None
     )
     tolerance = prediction.parse_number("tolerance", form.get("tolerance") or "5", 0.0, 3600.0)
+    autopilot = str(form.get("autopilot") or "").strip() or None
+    if autopilot is not None and autopilot not in prediction.AUTOPILOTS:
+        raise prediction.FieldError(
+            "autopilot", f"autopilot: {autopilot!r} is not one of {', '.join(prediction.AUTOPILOTS)}"
+        )
     up_plan = prediction.read_uploaded_plan(plan.filename, data)
+    # an autopilot mission file: the mission as the autopilot flies it (`trajectory mission`)
+    flown = (
+        await run_in_threadpool(prediction.predict_autopilot, up_plan.mission, autopilot)
+        if up_plan.mission is not None
+        else None
+    )
     required_text = str(form.get("required") or "")
     required = (
         prediction.parse_required(required_text, up_plan.route_ne.shape[0]) if required_text.strip() else None
@@ -80,8 +96,10 @@ async def predict_from_form(form: Any) -> prediction.RoutePrediction:
         model, name = await run_in_threadpool(default_model), "built-in model (simulated flights)"
     if speed is None and up_plan.cruise_ms is not None:
         speed, name = up_plan.cruise_ms, f"{name}; speed from the plan"
+    elif speed is None and flown is not None:
+        speed, name = flown.cruise_ms, f"{name}; speed the autopilot's {flown.cruise_param}"
     try:
-        return await run_in_threadpool(
+        result = await run_in_threadpool(
             prediction.predict_plan,
             model,
             up_plan.route_ne,
@@ -95,6 +113,8 @@ async def predict_from_form(form: Any) -> prediction.RoutePrediction:
         )
     except UasnavError as e:
         raise prediction.FieldError("plan", f"plan: {e}") from None
+    result.autopilot = flown
+    return result
 
 
 @router.get("/trajectory", response_class=HTMLResponse)
