@@ -594,3 +594,17 @@ def test_run_start_heading_is_the_nearest_attitude_sample() -> None:
     assert _heading_at(SimpleNamespace(reference=ref), 0.6) == -179.0
     assert _heading_at(SimpleNamespace(reference=None), 0.6) is None
     assert _heading_at(SimpleNamespace(reference=SimpleNamespace(t=ref.t, euler_deg=None)), 0.6) is None
+
+
+def test_plan_family_is_the_rule_the_cli_and_the_page_share(shared_data: Path) -> None:
+    """VTOL items or a fixed-wing plan fly as a plane; anything else as an ArduCopter."""
+    from uasnav.io.plans import read_plan
+
+    dalby = read_plan(shared_data / "missions" / "ardupilot_autotest_dalby_obc2016.waypoints")
+    assert any(it.command in (84, 85) for it in dalby.items)
+    assert ap.plan_family(dalby) == "plane"
+    copter = MissionPlan(items=(MissionItem(22, 3, alt_m=10.0),), home=HomePosition(47.0, 8.0, 400.0))
+    assert ap.plan_family(copter) == "arducopter"
+    assert ap.plan_family(dataclasses.replace(copter, vehicle_type=1)) == "plane"
+    vtol_land = MissionItem(85, 3, lat_deg=47.0, lon_deg=8.0, alt_m=0.0)
+    assert ap.plan_family(dataclasses.replace(copter, items=(*copter.items, vtol_land))) == "plane"

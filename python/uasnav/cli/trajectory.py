@@ -559,6 +559,7 @@ def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # t
     from uasnav.trajectory.autopilot import (
         family_of,
         mission_params,
+        plan_family,
         predict_mission,
         qgc_mission_time,
     )
@@ -574,10 +575,8 @@ def mission(plan_path, autopilot, firmware, params_log, home_alt, as_json):  # t
     if autopilot is None:
         if ident is not None:
             autopilot = family_of(ident, log_params)
-        elif any(it.command in (84, 85) for it in plan.items) or plan.vehicle_type == 1:
-            autopilot = "plane"
         else:
-            autopilot = "arducopter"
+            autopilot = plan_family(plan)
     version = firmware or (getattr(ident, "firmware_version", None) if ident is not None else None)
     params = mission_params(autopilot, version, log_params)
     pred = predict_mission(plan, params, home_amsl_m=home_alt)

@@ -656,6 +656,16 @@ def family_of(identity: object | None, params: dict[str, float]) -> str:
     return "arducopter"
 
 
+def plan_family(plan: object) -> str:
+    """The family a mission plan is flown with when neither the user nor a log names one: a plan
+    with VTOL items (``MAV_CMD_NAV_VTOL_TAKEOFF``/``LAND``, 84/85) or made for a fixed wing
+    (``MAV_TYPE`` 1) is a plane, any other an ArduCopter."""
+    items = getattr(plan, "items", ())
+    if any(it.command in (84, 85) for it in items) or getattr(plan, "vehicle_type", None) == 1:
+        return "plane"
+    return "arducopter"
+
+
 def mission_params(
     family: str,
     version: str | None = None,

@@ -24,7 +24,13 @@ import numpy as np
 from uasnav.errors import DataFormatError, InputError, UasnavError
 from uasnav.io.mission_plan import MissionPlan
 from uasnav.io.plans import MAX_PLAN_BYTES, PLAN_EXTENSIONS, plan_cruise_speed, plan_route, read_plan
-from uasnav.trajectory.autopilot import FAMILIES, mission_params, predict_mission, qgc_mission_time
+from uasnav.trajectory.autopilot import (
+    FAMILIES,
+    mission_params,
+    plan_family,
+    predict_mission,
+    qgc_mission_time,
+)
 from uasnav.trajectory.features import wind_vector
 from uasnav.trajectory.models import Predictor, load_model, method_of
 from uasnav.trajectory.predictor import MAX_MODEL_BYTES, Feasibility
@@ -147,22 +153,13 @@ def read_uploaded_plan(filename: str, data: bytes) -> UploadedPlan:
     )
 
 
-def default_autopilot(plan: MissionPlan) -> str:
-    """The family ``uasnav trajectory mission`` flies a plan with when none is named: a plan
-    with VTOL items (``MAV_CMD`` 84/85) or made for a fixed wing (``MAV_TYPE`` 1) is a plane,
-    any other an ArduCopter."""
-    if any(it.command in (84, 85) for it in plan.items) or plan.vehicle_type == 1:
-        return "plane"
-    return "arducopter"
-
-
 @dataclass(frozen=True)
 class AutopilotPrediction:
     """The mission as the autopilot flies it (:func:`uasnav.trajectory.autopilot.predict_mission`
     with the firmware defaults), the numbers of ``uasnav trajectory mission --json``.
 
     ``chosen_by`` says where the family came from: ``"plan"`` (the CLI's default rule,
-    :func:`default_autopilot`) or ``"form"``.
+    :func:`uasnav.trajectory.autopilot.plan_family`) or ``"form"``.
     """
 
     autopilot: str
@@ -207,7 +204,7 @@ def predict_autopilot(plan: MissionPlan, autopilot: str | None = None) -> Autopi
     """
     if autopilot is not None and autopilot not in AUTOPILOTS:
         raise FieldError("autopilot", f"autopilot: {autopilot!r} is not one of {', '.join(AUTOPILOTS)}")
-    family = autopilot or default_autopilot(plan)
+    family = autopilot or plan_family(plan)
     try:
         params = mission_params(family, None, {})
         pred = predict_mission(plan, params, home_amsl_m=None)
@@ -514,7 +511,6 @@ __all__ = [
     "FieldError",
     "RoutePrediction",
     "UploadedPlan",
-    "default_autopilot",
     "mission_items_csv",
     "parse_number",
     "parse_required",
