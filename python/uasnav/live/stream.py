@@ -20,6 +20,7 @@ import select
 import signal
 import socket
 import time
+from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -70,7 +71,7 @@ def listen_tcp(info: Any, where: str) -> socket.socket:
     return server
 
 
-class ByteStream:
+class ByteStream(ABC):
     """A MAVLink byte stream decoded here (pymavlink's parser, the ``ardupilotmega`` dialect).
 
     It offers what :func:`receive` and the commands use of a pymavlink connection:
@@ -88,11 +89,13 @@ class ByteStream:
         self._mav = mavlink_dialect().MAVLink(None)
         self._mav.robust_parsing = True
 
+    @abstractmethod
     def _source(self) -> Any:
-        raise NotImplementedError
+        """What to wait on (a file descriptor or socket), ``None`` while there is nothing yet."""
 
+    @abstractmethod
     def _read(self) -> bytes:
-        raise NotImplementedError
+        """The bytes that arrived; ``b""`` when the peer closed."""
 
     def _idle(self, timeout_s: float) -> None:
         time.sleep(timeout_s)
