@@ -107,6 +107,23 @@ def test_base_install_runs_the_base_quick_starts(venv: Venv, tmp_path: Path) -> 
     assert (tmp_path / "Navigation-engineer" / "track.csv").stat().st_size > 0
 
 
+def test_the_installed_wheel_carries_the_geoid(venv: Venv, tmp_path: Path) -> None:
+    """Intents (`trajectory intent`, `plan`) take W84 heights from the EGM96 grid shipped in
+    the wheel: read from the installed package, it gives the tree's geoid heights."""
+    from uasnav.geo.geoid import geoid_height
+
+    code = (
+        "import uasnav.geo.geoid as g; from importlib import resources; "
+        "print(resources.files('uasnav.geo').joinpath('data', g.GEOID_DATA)); "
+        "print(repr(float(g.geoid_height(47.37, 8.54))), repr(float(g.geoid_height(-33.9, 151.2))))"
+    )
+    p = venv.run(f'python -c "{code}"', tmp_path)
+    assert p.returncode == 0, p.stderr[-3000:]
+    where, heights = p.stdout.splitlines()[:2]
+    assert where.startswith(str(venv.path)), where  # the installed package's grid, not the tree's
+    assert [float(h) for h in heights.split()] == [geoid_height(47.37, 8.54), geoid_height(-33.9, 151.2)]
+
+
 FIELD = '{"type":"Polygon","coordinates":[[[8.54,47.37],[8.544,47.37],[8.544,47.3725],[8.54,47.37]]]}'
 
 
