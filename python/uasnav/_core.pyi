@@ -361,3 +361,22 @@ class InsStream:
     def counts(self) -> dict[str, Any]:
         """Running counts: imu_samples, imu_refused, imu_gaps, fixes_used, fixes_excluded,
         fixes_dropped, gnss_resets, course_reset."""
+
+# --- csv: the csv-chunk crate ----------------------------------------------------------------
+
+def csv_parse_chunk(
+    chunk: bytes,
+    width: int,
+    columns: Sequence[int],
+    exact_width: bool,
+    nan_ok: bool = False,
+    threads: int = 0,
+) -> NDArray[np.float64] | None:
+    """The rows of ``chunk`` (bytes of whole CSV lines below a header row of ``width`` cells)
+    as an (m, len(columns)) Fortran-order float64 array of the cells at ``columns``, parsed on
+    ``threads`` threads (0: one per core) with the GIL released; None when some line needs the
+    row-by-row reader (quoting, a non-ASCII or control byte, a line over 64 KiB, a blank line, a
+    row of the wrong width, a cell that is not a plain decimal number, ±inf, NaN unless
+    ``nan_ok``)."""
+
+__all__ += ["csv_parse_chunk"]

@@ -1,20 +1,23 @@
-"""The CSV engine of every numeric CSV reader: chunks of whole lines through numpy's C reader,
-with the row-by-row reader's errors.
+"""The CSV engine of every numeric CSV reader: chunks of whole lines through the extension's
+numeric parser, on every core, with the row-by-row reader's errors.
 
 :class:`NumericCsv` reads a CSV file (``#`` comment lines, a header row, numeric data rows) in
 chunks of whole lines (:func:`chunk_bytes`, at most 16 MiB), each parsed by
-:func:`~uasnav.io._text.loadtxt_rows` (:func:`numpy.loadtxt`) into float64 columns, so memory
-stays bounded by the chunk size whatever the file's length, and a consumer can stream (block
-means while reading, :class:`~uasnav.io.formats.csv_v1.CsvV1Stream`) or concatenate
-(:func:`read_table`: numeric tables, the GNSS, x-io and flight CSVs).
+:func:`~uasnav.io._text.parse_chunk` (the ``csv-chunk`` crate: the chunk cut at line breaks into
+one part per core, parsed with the GIL released) into float64 columns, so memory stays bounded
+by the chunk size whatever the file's length, and a consumer can stream (block means while
+reading, :class:`~uasnav.io.formats.csv_v1.CsvV1Stream`) or concatenate (:func:`read_table`:
+numeric tables, the GNSS, x-io and flight CSVs).
 
-numpy accepts a subset of what the row-by-row reader of :mod:`uasnav.io._text` accepts, never
-more: no quoting (a ``"`` anywhere sends the chunk row by row), no lines of spaces, cells of at
-most 64 KiB, UTF-8 checked, NUL bytes, ±inf (and NaN where it is refused) handed over. Any chunk
-numpy refuses is parsed by the row-by-row reader, which either names the first bad cell (file,
-line, column: the same :class:`~uasnav.errors.DataFormatError` as reading the whole text) or
-accepts what ``float`` accepts and numpy does not (``1_0``, non-ASCII digits). Both paths return
-the same values bit for bit (``tests/test_io_csv_stream.py``).
+The parser accepts a subset of what the row-by-row reader of :mod:`uasnav.io._text` accepts,
+never more: printable ASCII only (a ``"`` anywhere, a NUL, control or non-ASCII byte sends the
+chunk row by row), lines of at most 64 KiB (below the :mod:`csv` module's field limit of 128
+KiB), no lines of spaces, cells in plain decimal syntax, ±inf (and NaN where it is refused)
+handed over. Any chunk it refuses is parsed by the row-by-row reader, which either names the
+first bad cell (file, line, column: the same :class:`~uasnav.errors.DataFormatError` as reading
+the whole text) or accepts what ``float`` accepts beyond plain syntax (``1_0``, non-ASCII
+digits). Both parse correctly rounded and return the same values bit for bit
+(``tests/test_io_csv_stream.py``).
 
 The errors come in the order the whole-text reader finds them: an encoding error anywhere in
 the file (not UTF-8, a NUL byte) wins over any other error, so after the first other error the
@@ -34,7 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from uasnav.errors import DataFormatError
-from uasnav.io._text import csv_rows, decode, decode_part, loadtxt_rows, numeric_rows, read_text, split_lines
+from uasnav.io._text import csv_rows, decode, decode_part, numeric_rows, parse_chunk, read_text, split_lines
 from uasnav.limits import check_memory, max_memory
 
 #: Largest chunk (bytes of text) parsed at once.
@@ -43,10 +46,6 @@ MAX_CHUNK_BYTES = 16 * 1024**2
 #: and the columns: ≈ 4; or the row-by-row reader's Python objects when it takes over: ≈ 6, see
 #: ``_text``).
 CHUNK_MEMORY_FACTOR = 8
-#: A chunk whose lines are all shorter than this is parsed by numpy; a longer line may hold a
-#: cell beyond the :mod:`csv` module's field limit (128 KiB), which only the row-by-row reader
-#: reports as such.
-_MAX_FAST_LINE = 64 * 1024
 #: Text after a chunk given to the row-by-row reader with it when a ``"`` may open a quoted
 #: cell running on: the :mod:`csv` module stops such a cell at its field limit (128 KiB).
 _LOOKAHEAD = 1024**2
@@ -73,16 +72,6 @@ def _cut(buf: bytes) -> int:
         return n
     r = buf.rfind(b"\r", 0, len(buf) - 1)  # a final \r may be the first half of \r\n
     return r + 1
-
-
-def _short_lines(raw: bytes) -> bool:
-    """True if every aligned window of :data:`_MAX_FAST_LINE` bytes of ``raw`` holds a line
-    break: then no line is as long as 2 × 64 KiB, the :mod:`csv` module's field limit."""
-    w = _MAX_FAST_LINE
-    for a in range(0, len(raw), w):
-        if raw.find(b"\n", a, a + w) < 0 and raw.find(b"\r", a, a + w) < 0 and a + w < len(raw):
-            return False
-    return True
 
 
 @dataclass
@@ -279,20 +268,7 @@ class NumericCsv:
     def _fast(
         self, raw: bytes, idx: Sequence[int], exact_width: bool, nan_ok: bool
     ) -> NDArray[np.float64] | None:
-        if b'"' in raw or b"\x00" in raw or not _short_lines(raw):
-            return None
-        if raw.isascii():
-            text = raw.decode("ascii")
-        else:
-            try:
-                text = raw.decode("utf-8")
-            except UnicodeDecodeError:
-                return None  # the row-by-row reader names the line and column
-        lines = text.split("\n") if "\r" not in text else split_lines(text)
-        if lines and not lines[-1]:
-            lines.pop()
-        data = loadtxt_rows(lines, len(self.header), idx, exact_width=exact_width, nan_ok=nan_ok)
-        return None if data is None else np.asfortranarray(data)
+        return parse_chunk(raw, len(self.header), idx, exact_width=exact_width, nan_ok=nan_ok)
 
     def _row_by_row(
         self, raw: bytes, line: int, columns: Sequence[str], exact_width: bool, nan_ok: bool

@@ -1,0 +1,408 @@
+//! Numeric CSV chunks parsed into float64 columns, on every core, or refused.
+//!
+//! A *chunk* is whole lines of a CSV file below its header row: bytes, lines ending at `\n`,
+//! `\r\n` or `\r` (empty lines skipped), cells separated by `,`. [`parse`] returns the cells of
+//! the wanted columns as numbers when every line is *simple*, and `None` otherwise, so that a
+//! row-by-row reader (Python's `csv` module and `float`, in `uasnav.io._text`) judges the
+//! chunk and names the first bad cell. Simple means:
+//!
+//! - the chunk is printable ASCII (tab allowed): no `"` (quoting), no NUL or other control
+//!   byte, no byte ≥ 0x80 (UTF-8 is checked by the row-by-row reader);
+//! - no line is longer than [`MAX_LINE`] bytes (so no cell reaches the `csv` module's field
+//!   limit of 128 KiB) and no line is blank (spaces, tabs and commas only);
+//! - a row has exactly [`Layout::width`] cells if [`Layout::exact_width`], else at least one
+//!   more than the largest wanted column;
+//! - every wanted cell, stripped of spaces and tabs, is a plain decimal number
+//!   (`[+-]? (d+ [. d*] | . d+) ([eE] [+-]? d+)?`) whose value is finite, or with
+//!   [`Layout::nan_ok`] a NaN spelled as Python's `float` spells it (`nan`, any case, signed).
+//!
+//! On simple input the result equals the row-by-row reader's bit for bit: both readers skip the
+//! same lines, split the same cells, and both `f64::from_str` and Python's `float` round
+//! correctly (IEEE 754 round-half-even of the exact decimal value), so they agree on every
+//! number, subnormals and signed zeros included; `float("-nan")` is the quiet NaN with the sign
+//! bit set, as here. Cells of columns not wanted are not parsed (the row-by-row reader does not
+//! parse them either).
+//!
+//! The chunk is cut at line breaks into one part per core ([`parse`] with `parts`), each part
+//! parsed into its own column buffers on a scoped thread, and the parts' columns joined into one
+//! column-major (Fortran-order) buffer.
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+use std::num::NonZeroUsize;
+use std::thread;
+
+/// Longest line (bytes, without its line break) parsed here; a longer line may hold a cell
+/// beyond the `csv` module's field limit (128 KiB), which only the row-by-row reader reports.
+pub const MAX_LINE: usize = 64 * 1024;
+
+/// Smallest part (bytes) given a thread of its own: smaller chunks are parsed on the calling
+/// thread, where spawning would cost more than it saves.
+pub const MIN_PART: usize = 256 * 1024;
+
+/// Which cells of a row are read, and what a row must look like.
+#[derive(Clone, Copy, Debug)]
+pub struct Layout<'a> {
+    /// Cells in the header row.
+    pub width: usize,
+    /// The wanted columns, 0-based positions in the header row, in output order.
+    pub columns: &'a [usize],
+    /// Refuse a row whose cell count differs from `width` (else only a row too short for a
+    /// wanted column is refused).
+    pub exact_width: bool,
+    /// Accept NaN (a missing value); ±inf is always refused.
+    pub nan_ok: bool,
+}
+
+/// The numbers of a chunk: `rows` × `columns.len()` values, column after column.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Table {
+    /// Data rows (non-empty lines) parsed.
+    pub rows: usize,
+    /// Column-major (Fortran-order) values: column `j` is `values[j * rows..(j + 1) * rows]`.
+    pub values: Vec<f64>,
+}
+
+/// The cores to parse on (`std::thread::available_parallelism`, 1 if unknown).
+pub fn cores() -> usize {
+    thread::available_parallelism().map_or(1, NonZeroUsize::get)
+}
+
+/// Parse `chunk` (see the crate docs) on up to `parts` threads; `None`: not simple input.
+pub fn parse(chunk: &[u8], layout: &Layout<'_>, parts: usize) -> Option<Table> {
+    let parts = parts.clamp(1, (chunk.len() / MIN_PART).max(1));
+    let pieces = split(chunk, parts);
+    let done: Vec<Part> = if pieces.len() == 1 {
+        vec![parse_part(chunk, layout)?]
+    } else {
+        thread::scope(|s| {
+            let handles: Vec<_> = pieces
+                .iter()
+                .map(|p| s.spawn(move || parse_part(p, layout)))
+                .collect();
+            // a part that panicked (none can: no unwrap, no slicing out of bounds) refuses
+            handles
+                .into_iter()
+                .map(|h| h.join().ok().flatten())
+                .collect::<Option<Vec<_>>>()
+        })?
+    };
+    let rows = done.iter().map(|p| p.rows).sum();
+    let mut values = Vec::with_capacity(rows * layout.columns.len());
+    for j in 0..layout.columns.len() {
+        for part in &done {
+            values.extend_from_slice(part.cols.get(j).map_or(&[][..], Vec::as_slice));
+        }
+    }
+    Some(Table { rows, values })
+}
+
+/// The rows of one piece: one buffer per wanted column.
+struct Part {
+    rows: usize,
+    cols: Vec<Vec<f64>>,
+}
+
+/// `chunk` cut into at most `parts` pieces of whole lines, about equally long.
+fn split(chunk: &[u8], parts: usize) -> Vec<&[u8]> {
+    let mut out = Vec::with_capacity(parts);
+    let mut start = 0;
+    for p in 1..parts {
+        let target = (chunk.len() * p / parts).max(start);
+        let Some(rest) = chunk.get(target..) else { break };
+        let Some(k) = rest.iter().position(|&b| b == b'\n' || b == b'\r') else {
+            break;
+        };
+        let mut end = target + k + 1;
+        if chunk.get(end - 1) == Some(&b'\r') && chunk.get(end) == Some(&b'\n') {
+            end += 1; // never between the halves of \r\n
+        }
+        out.push(&chunk[start..end]);
+        start = end;
+    }
+    out.push(&chunk[start..]);
+    out
+}
+
+/// One piece of whole lines parsed into one buffer per wanted column; `None`: not simple.
+fn parse_part(text: &[u8], layout: &Layout<'_>) -> Option<Part> {
+    let guess = text.len() / (8 * layout.width.max(1)) + 1;
+    let mut cols: Vec<Vec<f64>> = (0..layout.columns.len())
+        .map(|_| Vec::with_capacity(guess))
+        .collect();
+    let mut cells: Vec<(usize, usize)> = Vec::with_capacity(layout.width + 1);
+    let (mut pos, mut rows) = (0, 0);
+    while pos < text.len() {
+        let (next, empty) = scan_line(text, pos, &mut cells)?;
+        pos = next;
+        if empty {
+            continue;
+        }
+        check_row(&cells, layout)?;
+        for (out, &j) in cols.iter_mut().zip(layout.columns) {
+            let &(a, b) = cells.get(j)?;
+            out.push(number(text.get(a..b)?, layout.nan_ok)?);
+        }
+        rows += 1;
+    }
+    Some(Part { rows, cols })
+}
+
+/// The line at `start`: its cells' byte ranges into `cells`; returns (start of the next line,
+/// whether this one is empty). `None`: a byte that is not printable ASCII or tab, a `"`, a
+/// line longer than [`MAX_LINE`], a blank line that is not empty.
+fn scan_line(text: &[u8], start: usize, cells: &mut Vec<(usize, usize)>) -> Option<(usize, bool)> {
+    cells.clear();
+    let mut cell = start;
+    let mut content = false;
+    let mut end = text.len();
+    let mut next = text.len();
+    for (i, &b) in text.iter().enumerate().skip(start) {
+        match b {
+            b',' => {
+                cells.push((cell, i));
+                cell = i + 1;
+            }
+            b'\n' => {
+                (end, next) = (i, i + 1);
+                break;
+            }
+            b'\r' => {
+                let two = text.get(i + 1) == Some(&b'\n');
+                (end, next) = (i, i + 1 + usize::from(two));
+                break;
+            }
+            b' ' | b'\t' => {}
+            b'"' => return None,
+            0x21..=0x7e => content = true,
+            _ => return None,
+        }
+    }
+    cells.push((cell, end));
+    if end - start > MAX_LINE || (!content && end > start) {
+        return None;
+    }
+    Some((next, end == start))
+}
+
+fn check_row(cells: &[(usize, usize)], layout: &Layout<'_>) -> Option<()> {
+    let ok = if layout.exact_width {
+        cells.len() == layout.width
+    } else {
+        layout.columns.iter().all(|&j| j < cells.len())
+    };
+    ok.then_some(())
+}
+
+/// One cell (spaces and tabs around it ignored) as a number, if plain decimal syntax and
+/// finite, or a NaN where `nan_ok` (see the crate docs).
+pub fn number(cell: &[u8], nan_ok: bool) -> Option<f64> {
+    let s = trim(cell);
+    if !plain_decimal(s) {
+        return if nan_ok { nan(s) } else { None };
+    }
+    // plain_decimal accepted ASCII only, so this cannot fail
+    let v: f64 = std::str::from_utf8(s).ok()?.parse().ok()?;
+    v.is_finite().then_some(v)
+}
+
+/// `s` without the spaces and tabs around it.
+fn trim(s: &[u8]) -> &[u8] {
+    let blank = |b: &u8| *b == b' ' || *b == b'\t';
+    let a = s.iter().position(|b| !blank(b)).unwrap_or(s.len());
+    let n = s.iter().rposition(|b| !blank(b)).map_or(a, |k| k + 1);
+    s.get(a..n).unwrap_or_default()
+}
+
+/// `[+-]? (d+ [. d*] | . d+) ([eE] [+-]? d+)?`: what both `f64::from_str` and Python's
+/// `float` read as the same decimal number.
+fn plain_decimal(s: &[u8]) -> bool {
+    let digits = |from: usize| s.iter().skip(from).take_while(|b| b.is_ascii_digit()).count();
+    let mut i = usize::from(matches!(s.first(), Some(b'+' | b'-')));
+    let whole = digits(i);
+    i += whole;
+    let mut frac = 0;
+    if s.get(i) == Some(&b'.') {
+        frac = digits(i + 1);
+        i += 1 + frac;
+    }
+    if whole + frac == 0 {
+        return false;
+    }
+    if matches!(s.get(i), Some(b'e' | b'E')) {
+        i += 1;
+        i += usize::from(matches!(s.get(i), Some(b'+' | b'-')));
+        let exp = digits(i);
+        if exp == 0 {
+            return false;
+        }
+        i += exp;
+    }
+    i == s.len()
+}
+
+/// `nan` in any case, signed, as Python's `float` reads it: the quiet NaN, sign bit set by `-`.
+fn nan(s: &[u8]) -> Option<f64> {
+    let (neg, body) = match s.split_first() {
+        Some((b'-', rest)) => (true, rest),
+        Some((b'+', rest)) => (false, rest),
+        _ => (false, s),
+    };
+    body.eq_ignore_ascii_case(b"nan")
+        .then_some(if neg { -f64::NAN } else { f64::NAN })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn all(width: usize) -> Vec<usize> {
+        (0..width).collect()
+    }
+
+    fn run(text: &str, columns: &[usize], width: usize, exact: bool, nan_ok: bool) -> Option<Table> {
+        let layout = Layout { width, columns, exact_width: exact, nan_ok };
+        parse(text.as_bytes(), &layout, 1)
+    }
+
+    #[test]
+    fn columns_come_out_column_major() {
+        let t = run("1,2,3\n4,5,6\n", &[2, 0], 3, true, false);
+        assert_eq!(
+            t,
+            Some(Table {
+                rows: 2,
+                values: vec![3.0, 6.0, 1.0, 4.0]
+            })
+        );
+    }
+
+    #[test]
+    fn line_breaks_and_empty_lines() {
+        for text in [
+            "1,2\n3,4\n",
+            "1,2\r\n3,4\r\n",
+            "1,2\r3,4\r",
+            "1,2\n\n\r\n3,4",
+            "\r\n1,2\r\r3,4\n",
+        ] {
+            let t = run(text, &all(2), 2, true, false);
+            assert_eq!(t.map(|t| t.values), Some(vec![1.0, 3.0, 2.0, 4.0]), "{text:?}");
+        }
+        assert_eq!(run("", &all(2), 2, true, false).map(|t| t.rows), Some(0));
+    }
+
+    #[test]
+    fn numbers_as_python_float_reads_them() {
+        let cases: [(&str, f64); 14] = [
+            ("+1", 1.0),
+            (".5", 0.5),
+            ("5.", 5.0),
+            ("-0", -0.0),
+            ("  2.5\t", 2.5),
+            ("1e5", 1e5),
+            ("1E+05", 1e5),
+            ("2.5e-3", 2.5e-3),
+            ("4.9406564584124654e-324", 5e-324),
+            ("2.2250738585072011e-308", 2.225_073_858_507_201e-308),
+            ("0.1", 0.1),
+            ("1e-400", 0.0),
+            ("0e999999999999", 0.0),
+            ("1.7976931348623157e308", f64::MAX),
+        ];
+        for (cell, want) in cases {
+            let got = number(cell.as_bytes(), false);
+            assert_eq!(got.map(f64::to_bits), Some(want.to_bits()), "{cell}");
+        }
+        // a 17-digit round trip of many doubles
+        let mut x = 1.234_567_890_123_456_7e-300_f64;
+        while x < 1e300 {
+            let s = format!("{x:.16e}");
+            assert_eq!(number(s.as_bytes(), false).map(f64::to_bits), Some(x.to_bits()), "{s}");
+            x *= 1.618_033_988_7e7;
+        }
+    }
+
+    #[test]
+    fn cells_it_refuses() {
+        for cell in [
+            "", " ", ".", "e5", "1e", "1e+", "+", "-", "1_0", "0x10", "1.5.2", "1 2", "inf", "-inf",
+            "infinity", "nan", "1e400", "-1e400", "1,5", "1d5", "٣",
+        ] {
+            assert_eq!(number(cell.as_bytes(), false), None, "{cell:?}");
+        }
+    }
+
+    #[test]
+    fn nan_where_it_is_a_missing_value() {
+        for (cell, neg) in [("nan", false), ("NaN", false), ("+nan", false), ("-NAN", true), (" nan ", false)] {
+            let v = number(cell.as_bytes(), true);
+            assert!(v.is_some_and(|v| v.is_nan() && v.is_sign_negative() == neg), "{cell}");
+            assert_eq!(v.map(f64::to_bits), Some(if neg { -f64::NAN } else { f64::NAN }.to_bits()));
+        }
+        for cell in ["inf", "-inf", "Infinity", "nan1", "nann", "n"] {
+            assert_eq!(number(cell.as_bytes(), true), None, "{cell}");
+        }
+    }
+
+    #[test]
+    fn chunks_it_hands_to_the_row_by_row_reader() {
+        let three = all(3);
+        for text in [
+            "1,2,3\n\"4\",5,6\n", // quoting
+            "1,2,3\n4,5,6\0\n",   // NUL
+            "1,2,3\n4,5,6\x0c\n", // another control byte
+            "1,2,3\n4,5,é\n",
+            "1,2,3\n   \n4,5,6\n", // a line of spaces
+            "1,2,3\n,,\n",         // blank cells only
+            "1,2,3\n4,5\n",        // too short
+            "1,2,3\n4,5,6,7\n",    // too long for an exact width
+            "1,2,3\n4,,6\n",       // an empty cell
+            "1,2,3\n4,x,6\n",
+        ] {
+            assert_eq!(run(text, &three, 3, true, false), None, "{text:?}");
+        }
+        // a row longer than the header is fine without exact width, a short one is not
+        assert_eq!(run("1,2,3,x\n", &[0, 2], 3, false, false).map(|t| t.values), Some(vec![1.0, 3.0]));
+        assert_eq!(run("1,2\n", &[0, 2], 3, false, false), None);
+        // cells not wanted are not parsed
+        assert_eq!(run("1,x,3\n", &[0, 2], 3, true, false).map(|t| t.rows), Some(1));
+        let long = format!("1,{}\n", "2".repeat(MAX_LINE));
+        assert_eq!(run(&long, &all(2), 2, true, false), None);
+    }
+
+    #[test]
+    fn parts_join_into_the_single_thread_result() {
+        let mut text = String::new();
+        for k in 0..200_000 {
+            let nl = ["\n", "\r\n", "\r", "\n\n"][k % 4];
+            text.push_str(&format!("{},{:e},-{}.5{nl}", k, k as f64 * 0.1, k % 97));
+        }
+        let cols = [2, 0, 1];
+        let layout = Layout { width: 3, columns: &cols, exact_width: true, nan_ok: false };
+        let one = parse(text.as_bytes(), &layout, 1);
+        assert_eq!(one.as_ref().map(|t| t.rows), Some(200_000));
+        for parts in [2, 3, 7] {
+            assert_eq!(parse(text.as_bytes(), &layout, parts), one, "{parts} parts");
+        }
+        // a bad cell in the last part refuses the whole chunk
+        text.push_str("1,2,x\n");
+        assert_eq!(parse(text.as_bytes(), &layout, 4), None);
+    }
+
+    #[test]
+    fn split_keeps_crlf_whole() {
+        let text = b"1\r\n2\r\n3\r\n4\r\n";
+        for parts in 1..6 {
+            let pieces = split(text, parts);
+            assert_eq!(pieces.concat(), text.to_vec());
+            assert!(pieces.iter().all(|p| !p.starts_with(b"\n")), "{parts}");
+        }
+    }
+
+    #[test]
+    fn no_columns_still_counts_and_checks_rows() {
+        assert_eq!(run("1,2\n\n3,4\n", &[], 2, true, false).map(|t| t.rows), Some(2));
+        assert_eq!(run("1,2\n3\n", &[], 2, true, false), None);
+    }
+}
