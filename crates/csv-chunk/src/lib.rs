@@ -13,8 +13,9 @@
 //! - a row has exactly [`Layout::width`] cells if [`Layout::exact_width`], else at least one
 //!   more than the largest wanted column;
 //! - every wanted cell, stripped of spaces and tabs, is a plain decimal number
-//!   (`[+-]? (d+ [. d*] | . d+) ([eE] [+-]? d+)?`) whose value is finite, or with
-//!   [`Layout::nan_ok`] a NaN spelled as Python's `float` spells it (`nan`, any case, signed).
+//!   (`[+-]? (d+ [. d*] | . d+) ([eE] [+-]? d+)?`, see [`number`]) whose value is finite, or
+//!   with [`Layout::nan_ok`] a NaN spelled as Python's `float` spells it (`nan`, any case,
+//!   signed).
 //!
 //! On simple input the result equals the row-by-row reader's bit for bit: both readers skip the
 //! same lines, split the same cells, and both `f64::from_str` and Python's `float` round
@@ -70,6 +71,8 @@ pub fn cores() -> usize {
 
 /// Parse `chunk` (see the crate docs) on up to `parts` threads; `None`: not simple input.
 pub fn parse(chunk: &[u8], layout: &Layout<'_>, parts: usize) -> Option<Table> {
+    // text once (non-ASCII bytes are refused line by line below); cells are then sliced
+    let chunk = std::str::from_utf8(chunk).ok()?;
     let parts = parts.clamp(1, (chunk.len() / MIN_PART).max(1));
     let pieces = split(chunk, parts);
     let done: Vec<Part> = if pieces.len() == 1 {
@@ -104,152 +107,127 @@ struct Part {
 }
 
 /// `chunk` cut into at most `parts` pieces of whole lines, about equally long.
-fn split(chunk: &[u8], parts: usize) -> Vec<&[u8]> {
+fn split(chunk: &str, parts: usize) -> Vec<&str> {
     let mut out = Vec::with_capacity(parts);
     let mut start = 0;
     for p in 1..parts {
         let target = (chunk.len() * p / parts).max(start);
-        let Some(rest) = chunk.get(target..) else { break };
+        let Some(rest) = chunk.as_bytes().get(target..) else {
+            break;
+        };
         let Some(k) = rest.iter().position(|&b| b == b'\n' || b == b'\r') else {
             break;
         };
         let mut end = target + k + 1;
-        if chunk.get(end - 1) == Some(&b'\r') && chunk.get(end) == Some(&b'\n') {
+        if rest.get(k..k + 2) == Some(b"\r\n") {
             end += 1; // never between the halves of \r\n
         }
-        out.push(&chunk[start..end]);
+        // line breaks are ASCII: the cuts fall between characters
+        let Some(piece) = chunk.get(start..end) else {
+            break;
+        };
+        out.push(piece);
         start = end;
     }
-    out.push(&chunk[start..]);
+    out.push(chunk.get(start..).unwrap_or_default());
     out
 }
 
 /// One piece of whole lines parsed into one buffer per wanted column; `None`: not simple.
-fn parse_part(text: &[u8], layout: &Layout<'_>) -> Option<Part> {
+fn parse_part(text: &str, layout: &Layout<'_>) -> Option<Part> {
+    if !printable(text.as_bytes()) {
+        return None;
+    }
     let guess = text.len() / (8 * layout.width.max(1)) + 1;
     let mut cols: Vec<Vec<f64>> = (0..layout.columns.len())
         .map(|_| Vec::with_capacity(guess))
         .collect();
-    let mut cells: Vec<(usize, usize)> = Vec::with_capacity(layout.width + 1);
-    let (mut pos, mut rows) = (0, 0);
-    while pos < text.len() {
-        let (next, empty) = scan_line(text, pos, &mut cells)?;
-        pos = next;
-        if empty {
+    // the wanted cells of one row, by their position in the row
+    let span = layout.columns.iter().max().map_or(0, |&j| j + 1);
+    let mut wanted = vec![false; span];
+    for &j in layout.columns {
+        *wanted.get_mut(j)? = true;
+    }
+    let mut row = vec![0.0; span];
+    let mut rows = 0;
+    // empty lines are skipped, so \r\n may count as two breaks around an empty line
+    let lines: &mut dyn Iterator<Item = &str> = if text.contains('\r') {
+        &mut text.split(['\n', '\r'])
+    } else {
+        &mut text.split('\n')
+    };
+    for line in lines {
+        if line.is_empty() {
             continue;
         }
-        check_row(&cells, layout)?;
+        if line.len() > MAX_LINE
+            || (span == 0 && line.bytes().all(|b| matches!(b, b' ' | b'\t' | b',')))
+        {
+            return None; // too long for the csv module, or blank (skipped by the row-by-row reader)
+        }
+        let mut cells = 0;
+        for (cell, &want) in cells_of(line).zip(wanted.iter().chain(std::iter::repeat(&false))) {
+            if want {
+                *row.get_mut(cells)? = number(cell, layout.nan_ok)?;
+            }
+            cells += 1;
+        }
+        if (layout.exact_width && cells != layout.width) || cells < span {
+            return None;
+        }
         for (out, &j) in cols.iter_mut().zip(layout.columns) {
-            let &(a, b) = cells.get(j)?;
-            out.push(number(text.get(a..b)?, layout.nan_ok)?);
+            out.push(*row.get(j)?);
         }
         rows += 1;
     }
     Some(Part { rows, cols })
 }
 
-/// The line at `start`: its cells' byte ranges into `cells`; returns (start of the next line,
-/// whether this one is empty). `None`: a byte that is not printable ASCII or tab, a `"`, a
-/// line longer than [`MAX_LINE`], a blank line that is not empty.
-fn scan_line(text: &[u8], start: usize, cells: &mut Vec<(usize, usize)>) -> Option<(usize, bool)> {
-    cells.clear();
-    let mut cell = start;
-    let mut content = false;
-    let mut end = text.len();
-    let mut next = text.len();
-    for (i, &b) in text.iter().enumerate().skip(start) {
-        match b {
-            b',' => {
-                cells.push((cell, i));
-                cell = i + 1;
+/// The cells of `line`: `str::split(',')` without its `memchr` set-up per cell, which costs
+/// more than the search on cells of a few bytes.
+fn cells_of(line: &str) -> impl Iterator<Item = &str> {
+    let mut rest = Some(line);
+    std::iter::from_fn(move || {
+        let s = rest?;
+        match s.bytes().position(|b| b == b',') {
+            Some(k) => {
+                rest = s.get(k + 1..);
+                s.get(..k)
             }
-            b'\n' => {
-                (end, next) = (i, i + 1);
-                break;
-            }
-            b'\r' => {
-                let two = text.get(i + 1) == Some(&b'\n');
-                (end, next) = (i, i + 1 + usize::from(two));
-                break;
-            }
-            b' ' | b'\t' => {}
-            b'"' => return None,
-            0x21..=0x7e => content = true,
-            _ => return None,
+            None => rest.take(),
         }
-    }
-    cells.push((cell, end));
-    if end - start > MAX_LINE || (!content && end > start) {
-        return None;
-    }
-    Some((next, end == start))
+    })
 }
 
-fn check_row(cells: &[(usize, usize)], layout: &Layout<'_>) -> Option<()> {
-    let ok = if layout.exact_width {
-        cells.len() == layout.width
-    } else {
-        layout.columns.iter().all(|&j| j < cells.len())
-    };
-    ok.then_some(())
+/// Every byte printable ASCII, a tab or a line break, none a `"` (one pass without branches).
+fn printable(text: &[u8]) -> bool {
+    text.iter().fold(true, |ok, &b| {
+        ok & (((0x20..0x7f).contains(&b) && b != b'"') || b == b'\t' || b == b'\n' || b == b'\r')
+    })
 }
 
 /// One cell (spaces and tabs around it ignored) as a number, if plain decimal syntax and
 /// finite, or a NaN where `nan_ok` (see the crate docs).
-pub fn number(cell: &[u8], nan_ok: bool) -> Option<f64> {
-    let s = trim(cell);
-    if !plain_decimal(s) {
-        return if nan_ok { nan(s) } else { None };
-    }
-    // plain_decimal accepted ASCII only, so this cannot fail
-    let v: f64 = std::str::from_utf8(s).ok()?.parse().ok()?;
-    v.is_finite().then_some(v)
+///
+/// `f64::from_str` reads `[+-]? (d+ [. d*] | . d+) ([eE] [+-]? d+)?` and the spellings `inf`,
+/// `infinity` and `nan` (any case, signed), nothing else: its decimal numbers are a subset of
+/// Python's `float` syntax (which adds `_` between digits and Unicode digits), so a finite
+/// result is always a cell `float` reads, with the same value (both round correctly). The
+/// spellings give ±inf (refused) or NaN, spelled as `float` spells it, its sign kept.
+pub fn number(cell: &str, nan_ok: bool) -> Option<f64> {
+    let v: f64 = trim(cell).parse().ok()?;
+    (v.is_finite() || (nan_ok && v.is_nan())).then_some(v)
 }
 
 /// `s` without the spaces and tabs around it.
-fn trim(s: &[u8]) -> &[u8] {
-    let blank = |b: &u8| *b == b' ' || *b == b'\t';
-    let a = s.iter().position(|b| !blank(b)).unwrap_or(s.len());
-    let n = s.iter().rposition(|b| !blank(b)).map_or(a, |k| k + 1);
-    s.get(a..n).unwrap_or_default()
-}
-
-/// `[+-]? (d+ [. d*] | . d+) ([eE] [+-]? d+)?`: what both `f64::from_str` and Python's
-/// `float` read as the same decimal number.
-fn plain_decimal(s: &[u8]) -> bool {
-    let digits = |from: usize| s.iter().skip(from).take_while(|b| b.is_ascii_digit()).count();
-    let mut i = usize::from(matches!(s.first(), Some(b'+' | b'-')));
-    let whole = digits(i);
-    i += whole;
-    let mut frac = 0;
-    if s.get(i) == Some(&b'.') {
-        frac = digits(i + 1);
-        i += 1 + frac;
+fn trim(s: &str) -> &str {
+    let b = s.as_bytes();
+    let blank = |c: Option<&u8>| matches!(c, Some(b' ' | b'\t'));
+    if blank(b.first()) || blank(b.last()) {
+        s.trim_matches([' ', '\t'])
+    } else {
+        s
     }
-    if whole + frac == 0 {
-        return false;
-    }
-    if matches!(s.get(i), Some(b'e' | b'E')) {
-        i += 1;
-        i += usize::from(matches!(s.get(i), Some(b'+' | b'-')));
-        let exp = digits(i);
-        if exp == 0 {
-            return false;
-        }
-        i += exp;
-    }
-    i == s.len()
-}
-
-/// `nan` in any case, signed, as Python's `float` reads it: the quiet NaN, sign bit set by `-`.
-fn nan(s: &[u8]) -> Option<f64> {
-    let (neg, body) = match s.split_first() {
-        Some((b'-', rest)) => (true, rest),
-        Some((b'+', rest)) => (false, rest),
-        _ => (false, s),
-    };
-    body.eq_ignore_ascii_case(b"nan")
-        .then_some(if neg { -f64::NAN } else { f64::NAN })
 }
 
 #[cfg(test)]
@@ -260,8 +238,19 @@ mod tests {
         (0..width).collect()
     }
 
-    fn run(text: &str, columns: &[usize], width: usize, exact: bool, nan_ok: bool) -> Option<Table> {
-        let layout = Layout { width, columns, exact_width: exact, nan_ok };
+    fn run(
+        text: &str,
+        columns: &[usize],
+        width: usize,
+        exact: bool,
+        nan_ok: bool,
+    ) -> Option<Table> {
+        let layout = Layout {
+            width,
+            columns,
+            exact_width: exact,
+            nan_ok,
+        };
         parse(text.as_bytes(), &layout, 1)
     }
 
@@ -287,7 +276,11 @@ mod tests {
             "\r\n1,2\r\r3,4\n",
         ] {
             let t = run(text, &all(2), 2, true, false);
-            assert_eq!(t.map(|t| t.values), Some(vec![1.0, 3.0, 2.0, 4.0]), "{text:?}");
+            assert_eq!(
+                t.map(|t| t.values),
+                Some(vec![1.0, 3.0, 2.0, 4.0]),
+                "{text:?}"
+            );
         }
         assert_eq!(run("", &all(2), 2, true, false).map(|t| t.rows), Some(0));
     }
@@ -311,14 +304,18 @@ mod tests {
             ("1.7976931348623157e308", f64::MAX),
         ];
         for (cell, want) in cases {
-            let got = number(cell.as_bytes(), false);
+            let got = number(cell, false);
             assert_eq!(got.map(f64::to_bits), Some(want.to_bits()), "{cell}");
         }
         // a 17-digit round trip of many doubles
         let mut x = 1.234_567_890_123_456_7e-300_f64;
         while x < 1e300 {
             let s = format!("{x:.16e}");
-            assert_eq!(number(s.as_bytes(), false).map(f64::to_bits), Some(x.to_bits()), "{s}");
+            assert_eq!(
+                number(&s, false).map(f64::to_bits),
+                Some(x.to_bits()),
+                "{s}"
+            );
             x *= 1.618_033_988_7e7;
         }
     }
@@ -326,22 +323,34 @@ mod tests {
     #[test]
     fn cells_it_refuses() {
         for cell in [
-            "", " ", ".", "e5", "1e", "1e+", "+", "-", "1_0", "0x10", "1.5.2", "1 2", "inf", "-inf",
-            "infinity", "nan", "1e400", "-1e400", "1,5", "1d5", "٣",
+            "", " ", ".", "e5", "1e", "1e+", "+", "-", "1_0", "0x10", "1.5.2", "1 2", "inf",
+            "-inf", "infinity", "nan", "1e400", "-1e400", "1,5", "1d5", "٣",
         ] {
-            assert_eq!(number(cell.as_bytes(), false), None, "{cell:?}");
+            assert_eq!(number(cell, false), None, "{cell:?}");
         }
     }
 
     #[test]
     fn nan_where_it_is_a_missing_value() {
-        for (cell, neg) in [("nan", false), ("NaN", false), ("+nan", false), ("-NAN", true), (" nan ", false)] {
-            let v = number(cell.as_bytes(), true);
-            assert!(v.is_some_and(|v| v.is_nan() && v.is_sign_negative() == neg), "{cell}");
-            assert_eq!(v.map(f64::to_bits), Some(if neg { -f64::NAN } else { f64::NAN }.to_bits()));
+        for (cell, neg) in [
+            ("nan", false),
+            ("NaN", false),
+            ("+nan", false),
+            ("-NAN", true),
+            (" nan ", false),
+        ] {
+            let v = number(cell, true);
+            assert!(
+                v.is_some_and(|v| v.is_nan() && v.is_sign_negative() == neg),
+                "{cell}"
+            );
+            assert_eq!(
+                v.map(f64::to_bits),
+                Some(if neg { -f64::NAN } else { f64::NAN }.to_bits())
+            );
         }
         for cell in ["inf", "-inf", "Infinity", "nan1", "nann", "n"] {
-            assert_eq!(number(cell.as_bytes(), true), None, "{cell}");
+            assert_eq!(number(cell, true), None, "{cell}");
         }
     }
 
@@ -363,10 +372,16 @@ mod tests {
             assert_eq!(run(text, &three, 3, true, false), None, "{text:?}");
         }
         // a row longer than the header is fine without exact width, a short one is not
-        assert_eq!(run("1,2,3,x\n", &[0, 2], 3, false, false).map(|t| t.values), Some(vec![1.0, 3.0]));
+        assert_eq!(
+            run("1,2,3,x\n", &[0, 2], 3, false, false).map(|t| t.values),
+            Some(vec![1.0, 3.0])
+        );
         assert_eq!(run("1,2\n", &[0, 2], 3, false, false), None);
         // cells not wanted are not parsed
-        assert_eq!(run("1,x,3\n", &[0, 2], 3, true, false).map(|t| t.rows), Some(1));
+        assert_eq!(
+            run("1,x,3\n", &[0, 2], 3, true, false).map(|t| t.rows),
+            Some(1)
+        );
         let long = format!("1,{}\n", "2".repeat(MAX_LINE));
         assert_eq!(run(&long, &all(2), 2, true, false), None);
     }
@@ -379,7 +394,12 @@ mod tests {
             text.push_str(&format!("{},{:e},-{}.5{nl}", k, k as f64 * 0.1, k % 97));
         }
         let cols = [2, 0, 1];
-        let layout = Layout { width: 3, columns: &cols, exact_width: true, nan_ok: false };
+        let layout = Layout {
+            width: 3,
+            columns: &cols,
+            exact_width: true,
+            nan_ok: false,
+        };
         let one = parse(text.as_bytes(), &layout, 1);
         assert_eq!(one.as_ref().map(|t| t.rows), Some(200_000));
         for parts in [2, 3, 7] {
@@ -392,17 +412,20 @@ mod tests {
 
     #[test]
     fn split_keeps_crlf_whole() {
-        let text = b"1\r\n2\r\n3\r\n4\r\n";
+        let text = "1\r\n2\r\n3\r\n4\r\n";
         for parts in 1..6 {
             let pieces = split(text, parts);
-            assert_eq!(pieces.concat(), text.to_vec());
-            assert!(pieces.iter().all(|p| !p.starts_with(b"\n")), "{parts}");
+            assert_eq!(pieces.concat(), text);
+            assert!(pieces.iter().all(|p| !p.starts_with('\n')), "{parts}");
         }
     }
 
     #[test]
     fn no_columns_still_counts_and_checks_rows() {
-        assert_eq!(run("1,2\n\n3,4\n", &[], 2, true, false).map(|t| t.rows), Some(2));
+        assert_eq!(
+            run("1,2\n\n3,4\n", &[], 2, true, false).map(|t| t.rows),
+            Some(2)
+        );
         assert_eq!(run("1,2\n3\n", &[], 2, true, false), None);
     }
 }

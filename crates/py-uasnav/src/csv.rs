@@ -28,7 +28,10 @@ fn csv_parse_chunk<'py>(
     #[pyo3(from_py_with = threads_arg)] threads: usize,
 ) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
     if let Some(j) = columns.iter().find(|&&j| j >= width) {
-        return Err(input_error(py, format!("columns: {j} is not below width {width}")));
+        return Err(input_error(
+            py,
+            format!("columns: {j} is not below width {width}"),
+        ));
     }
     let layout = Layout {
         width,
