@@ -71,7 +71,7 @@ pub fn cores() -> usize {
 
 /// Parse `chunk` (see the crate docs) on up to `parts` threads; `None`: not simple input.
 pub fn parse(chunk: &[u8], layout: &Layout<'_>, parts: usize) -> Option<Table> {
-    // text once (non-ASCII bytes are refused line by line below); cells are then sliced
+    // UTF-8 checked once (non-ASCII bytes are then refused by `printable`), cells sliced as str
     let chunk = std::str::from_utf8(chunk).ok()?;
     let parts = parts.clamp(1, (chunk.len() / MIN_PART).max(1));
     let pieces = split(chunk, parts);
