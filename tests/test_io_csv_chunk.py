@@ -136,7 +136,7 @@ def _big_table(rows: int, seed: int) -> tuple[bytes, list[str]]:
 
 
 def test_parts_on_several_threads_join_into_the_row_by_row_result() -> None:
-    raw, lines = _big_table(40_000, 3)  # ≈ 3 MB: parts of ≥ 256 KiB each
+    raw, _ = _big_table(40_000, 3)  # ≈ 3 MB: parts of ≥ 256 KiB each
     header = ["a", "b", "c", "d"]
     with pytest.MonkeyPatch.context() as slow:
         slow.setattr(_text, "_numeric_rows_fast", lambda *a: None)

@@ -56,7 +56,7 @@ cells = st.one_of(
     st.integers(-(10**6), 10**6).map(str),
     st.sampled_from([" 1.5", "2 ", "+.5", "1_0", "1e-300", "-0.0", "1e400", "x", "", "nan", "٣"]),
     # the extension's parser: plain syntax it reads, and everything it hands over
-    st.sampled_from(["5.", ".5", "+1", "1E+05", "\t2.5\t", "4.9406564584124654e-324", "2.2250738585072011e-308"]),
+    st.sampled_from(["5.", ".5", "+1", "1E+05", "\t2.5\t", "4.9406564584124654e-324", "2.2250738585e-308"]),
     st.sampled_from(["-nan", "NaN", "inf", "-Infinity", "0x10", "1d5", "e5", ".", "1.5.2", "\x0c1", "1\x7f"]),
     st.from_regex(r"\A[ \t]?[+-]?[0-9]{0,25}\.?[0-9]{0,25}([eE][+-]?[0-9]{1,4})?[ \t]?\Z", fullmatch=True),
 )

@@ -3,8 +3,9 @@
 Every numeric CSV reader of :mod:`uasnav.io` (log format v1, x-io, the flight and GNSS CSVs,
 numeric tables) reads in chunks of whole lines (:mod:`uasnav.io._csvstream`), each parsed by
 the extension's numeric chunk parser on every core (:func:`parse_chunk`), and comes here, chunk
-by chunk (:func:`decode_part`, :func:`numeric_rows` with ``offset``), to name an error. So each hostile input gets one
-:class:`~uasnav.errors.DataFormatError` naming the file, line and (where it can be told) column:
+by chunk (:func:`decode_part`, :func:`numeric_rows` with ``offset``), to name an error. So each
+hostile input gets one :class:`~uasnav.errors.DataFormatError` naming the file, line and (where
+it can be told) column:
 
 - more bytes than the memory limit allows (checked on the bytes read, so ``/dev/zero`` or a
   FIFO cannot exhaust memory; :mod:`uasnav.limits`, ``UASNAV_MAX_MEMORY``);
