@@ -120,6 +120,11 @@ def test_layout_and_line_breaks() -> None:
     assert _core.csv_parse_chunk(text, 3, [2, 0], True) is None  # … but counted
     assert _core.csv_parse_chunk(b"1,2\n", 2, [], True).shape == (1, 0)
     assert _core.csv_parse_chunk(b"", 3, [0], True).shape == (0, 1)
+    # a prefix of the bytes, read in place
+    part = _core.csv_parse_chunk(b"1,2\n3,4\n5,x", 2, [0, 1], True, end=8)
+    assert part is not None and part.tolist() == [[1.0, 2.0], [3.0, 4.0]]
+    with pytest.raises(InputError, match="end: 12 is beyond the chunk's 11 bytes"):
+        _core.csv_parse_chunk(b"1,2\n3,4\n5,x", 2, [0, 1], True, end=12)
     with pytest.raises(InputError, match="columns: 3 is not below width 3"):
         _core.csv_parse_chunk(b"1,2,3\n", 3, [3], True)
     with pytest.raises(InputError, match="columns"):

@@ -13,11 +13,18 @@ uint_arg!(width_arg, "width", usize, usize_arg);
 uint_arg!(threads_arg, "threads", usize, usize_arg);
 uint_list_arg!(columns_arg, "columns");
 
-/// The rows of `chunk` (bytes of whole lines below the header row) as an (m, len(columns))
-/// Fortran-order float64 array of the cells at `columns`, or None when some line needs the
-/// row-by-row reader (see the `csv_chunk` crate). `threads` 0: one per core.
+fn end_arg(obj: &Bound<'_, PyAny>) -> PyResult<Option<usize>> {
+    if obj.is_none() {
+        return Ok(None);
+    }
+    crate::convert::usize_arg("end", obj).map(Some)
+}
+
+/// The rows of `chunk[:end]` (bytes of whole lines below the header row) as an
+/// (m, len(columns)) Fortran-order float64 array of the cells at `columns`, or None when some
+/// line needs the row-by-row reader (see the `csv_chunk` crate). `threads` 0: one per core.
 #[pyfunction]
-#[pyo3(signature = (chunk, width, columns, exact_width, nan_ok=false, threads=0))]
+#[pyo3(signature = (chunk, width, columns, exact_width, nan_ok=false, threads=0, end=None))]
 fn csv_parse_chunk<'py>(
     py: Python<'py>,
     chunk: &Bound<'py, PyBytes>,
@@ -26,6 +33,7 @@ fn csv_parse_chunk<'py>(
     exact_width: bool,
     nan_ok: bool,
     #[pyo3(from_py_with = threads_arg)] threads: usize,
+    #[pyo3(from_py_with = end_arg)] end: Option<usize>,
 ) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
     if let Some(j) = columns.iter().find(|&&j| j >= width) {
         return Err(input_error(
@@ -41,7 +49,16 @@ fn csv_parse_chunk<'py>(
     };
     let parts = if threads == 0 { cores() } else { threads };
     // bytes objects are immutable: the text is read in place while other threads run
-    let text = chunk.as_bytes();
+    let all = chunk.as_bytes();
+    let text = match end {
+        None => all,
+        Some(end) => all.get(..end).ok_or_else(|| {
+            input_error(
+                py,
+                format!("end: {end} is beyond the chunk's {} bytes", all.len()),
+            )
+        })?,
+    };
     let Some(table) = py.detach(|| parse(text, &layout, parts)) else {
         return Ok(None);
     };

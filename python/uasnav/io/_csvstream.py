@@ -57,11 +57,12 @@ def chunk_bytes() -> int:
     return int(min(MAX_CHUNK_BYTES, max(256 * 1024, max_memory() // 64)))
 
 
-def _line_count(raw: bytes) -> int:
-    """Line breaks in ``raw`` (``\\n``, ``\\r\\n`` or ``\\r``, like :func:`split_lines`)."""
-    n = raw.count(b"\n")
-    if raw.find(b"\r") >= 0:
-        n += raw.count(b"\r") - raw.count(b"\r\n")
+def _line_count(raw: bytes, end: int | None = None) -> int:
+    """Line breaks in ``raw[:end]`` (``\\n``, ``\\r\\n`` or ``\\r``, like :func:`split_lines`)."""
+    end = len(raw) if end is None else end
+    n = raw.count(b"\n", 0, end)
+    if raw.find(b"\r", 0, end) >= 0:
+        n += raw.count(b"\r", 0, end) - raw.count(b"\r\n", 0, end)
     return n
 
 
@@ -77,17 +78,18 @@ def _cut(buf: bytes) -> int:
 @dataclass
 class Block:
     """Rows of one chunk: ``data`` (m, k) float64 (columns contiguous), in the order of the
-    columns asked for; ``first_line`` is the file line (1-based) the chunk starts at."""
+    columns asked for; ``first_line`` is the file line (1-based) the chunk starts at, ``raw``
+    its bytes (a view of the bytes read)."""
 
     data: NDArray[np.float64]
     first_line: int
-    raw: bytes
+    raw: memoryview
     header: Sequence[str]
     source: str
 
     def row_lines(self) -> list[int]:
         """The file line of every row (blank lines skipped), told by the row-by-row reader."""
-        text = decode_part(self.raw, self.source, self.first_line, self.header)
+        text = decode_part(bytes(self.raw), self.source, self.first_line, self.header)
         return [
             ln
             for ln, _ in csv_rows(split_lines(text), 0, self.source, self.header, offset=self.first_line - 1)
@@ -112,8 +114,11 @@ class NumericCsv:
         self.comments: list[str] = []
         self.header: list[str] = []
         self.header_line = 0
-        self._carry = b""  # bytes read and not yet yielded
+        self._carry = b""  # bytes read and not yet yielded (just before the reading position)
         self._line = 1  # file line of self._carry's first byte
+        # a regular file is read again after each cut instead of carrying the cut line over, so
+        # a chunk is the bytes object read, never a copy
+        self._seekable = size is not None
         self._eof = False
         self.data_start = 0  # byte offset of the data (after the header row)
 
@@ -193,14 +198,18 @@ class NumericCsv:
         self.header = [h.strip() for h in cells]
         self.comments = lines[: self.header_line - 1]
         self.data_start = end
-        self._carry = raw[end:]
+        if self._seekable:
+            self._fh.seek(end)
+            self._eof = False
+        else:
+            self._carry = raw[end:]
         self._line = self.header_line + 1
         return True
 
-    def _chunks(self) -> Iterator[tuple[int, bytes]]:
-        """(first line, chunk of whole lines). The reading position is kept on ``self`` before
-        each chunk is yielded, so a second iterator (:meth:`fail`) goes on after the chunk the
-        first one yielded last."""
+    def _chunks(self) -> Iterator[tuple[int, bytes, int]]:
+        """(first line, bytes read, n): the first n bytes are a chunk of whole lines. The
+        reading position is kept on ``self`` before each chunk is yielded, so a second iterator
+        (:meth:`fail`) goes on after the chunk the first one yielded last."""
         while True:
             buf = self._carry
             if not self._eof and len(buf) < self._chunk:
@@ -216,11 +225,14 @@ class NumericCsv:
                 buf += more
                 n = len(buf) if self._eof else _cut(buf)
             n = n or len(buf)  # a line of more than 4 chunks: the row-by-row reader judges it
-            part = buf if n == len(buf) else buf[:n]
-            self._carry = buf[n:]
+            if n < len(buf) and self._seekable:
+                self._fh.seek(n - len(buf), os.SEEK_CUR)  # the cut line is read with the next chunk
+                self._carry = b""
+            else:
+                self._carry = buf[n:]
             first = self._line
-            self._line += _line_count(part)
-            yield first, part
+            self._line += _line_count(buf, n)
+            yield first, buf, n
 
     def _lookahead(self) -> bytes:
         """The whole lines of up to :data:`_LOOKAHEAD` bytes after the last chunk yielded
@@ -248,27 +260,23 @@ class NumericCsv:
             The first bad row's error (file, line, column), or an encoding error further on.
         """
         idx = [self.header.index(c) for c in columns]
-        for line, raw in self._chunks():
+        for line, buf, n in self._chunks():
             try:
-                data = self._fast(raw, idx, exact_width, nan_ok)
+                data = parse_chunk(buf, len(self.header), idx, exact_width=exact_width, nan_ok=nan_ok, end=n)
                 if data is None:
-                    data = self._row_by_row(raw, line, columns, exact_width, nan_ok)
+                    data = self._row_by_row(buf[:n], line, columns, exact_width, nan_ok)
             except DataFormatError as e:
                 self.fail(e)
-            yield Block(data, line, raw, self.header, self.source)
+            yield Block(data, line, memoryview(buf)[:n], self.header, self.source)
 
     def fail(self, error: DataFormatError) -> NoReturn:
         """Raise ``error``, or an encoding error (not UTF-8, NUL) in the rest of the file, which
         the whole-text reader finds first."""
-        for first, raw in self._chunks():
+        for first, buf, n in self._chunks():
+            raw = buf[:n]
             if not raw.isascii() or b"\x00" in raw:
                 decode_part(raw, self.source, first, self.header)
         raise error
-
-    def _fast(
-        self, raw: bytes, idx: Sequence[int], exact_width: bool, nan_ok: bool
-    ) -> NDArray[np.float64] | None:
-        return parse_chunk(raw, len(self.header), idx, exact_width=exact_width, nan_ok=nan_ok)
 
     def _row_by_row(
         self, raw: bytes, line: int, columns: Sequence[str], exact_width: bool, nan_ok: bool

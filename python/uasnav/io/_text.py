@@ -256,10 +256,16 @@ def numeric_rows(
 
 
 def parse_chunk(
-    raw: bytes, width: int, idx: Sequence[int], *, exact_width: bool, nan_ok: bool = False
+    raw: bytes,
+    width: int,
+    idx: Sequence[int],
+    *,
+    exact_width: bool,
+    nan_ok: bool = False,
+    end: int | None = None,
 ) -> NDArray[np.float64] | None:
-    """The numeric engine of every CSV reader: ``raw`` (bytes of whole data lines, empty lines
-    skipped) parsed by the extension (the ``csv-chunk`` crate: one part per core, the GIL
+    """The numeric engine of every CSV reader: ``raw[:end]`` (bytes of whole data lines, empty
+    lines skipped; read in place) parsed by the extension (the ``csv-chunk`` crate: one part per core, the GIL
     released) into an (m, len(idx)) Fortran-order float array of the columns at ``idx``, or
     ``None`` when some line needs the row-by-row reader's judgement: a ``"`` (quoting), a NUL,
     control or non-ASCII byte, a line longer than 64 KiB, a line of spaces, a row of the wrong
@@ -269,7 +275,7 @@ def parse_chunk(
     reader then names the first offending cell, or accepts what ``float`` accepts beyond plain
     syntax (``1_0``, non-ASCII digits). Both parse correctly rounded, so both paths return the
     same values bit for bit for every input."""
-    return _core.csv_parse_chunk(raw, width, list(idx), exact_width, nan_ok)
+    return _core.csv_parse_chunk(raw, width, list(idx), exact_width, nan_ok, 0, end)
 
 
 def _numeric_rows_fast(
