@@ -186,3 +186,11 @@ def test_the_gil_is_released_while_parsing() -> None:
         stop = True
         t.join()
     assert max(progressed[0::2]) > 0 and progressed[1::2] == [0, 0, 0], progressed
+
+
+@given(st.text(alphabet="\r\n1,", max_size=40), st.integers(0, 40))
+def test_line_breaks_are_counted_as_split_lines_counts_them(text, end) -> None:
+    raw = text.encode()
+    end = min(end, len(raw))
+    assert _core.csv_line_breaks(raw) == len(re.findall(r"\r\n|\r|\n", text))
+    assert _core.csv_line_breaks(raw, end) == len(re.findall(r"\r\n|\r|\n", text[:end]))

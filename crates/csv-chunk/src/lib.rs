@@ -106,6 +106,18 @@ struct Part {
     cols: Vec<Vec<f64>>,
 }
 
+/// Line breaks in `text` (`\n`, `\r\n` or `\r`, a `\r\n` counted once): the lines a chunk
+/// moves a reader on by. One pass the compiler vectorises, a second only if there is a `\r`.
+pub fn line_breaks(text: &[u8]) -> usize {
+    let lf = text.iter().filter(|&&b| b == b'\n').count();
+    if !text.contains(&b'\r') {
+        return lf;
+    }
+    let cr = text.iter().filter(|&&b| b == b'\r').count();
+    let crlf = text.windows(2).filter(|w| *w == b"\r\n").count();
+    lf + cr - crlf
+}
+
 /// `chunk` cut into at most `parts` pieces of whole lines, about equally long.
 fn split(chunk: &str, parts: usize) -> Vec<&str> {
     let mut out = Vec::with_capacity(parts);
@@ -408,6 +420,21 @@ mod tests {
         // a bad cell in the last part refuses the whole chunk
         text.push_str("1,2,x\n");
         assert_eq!(parse(text.as_bytes(), &layout, 4), None);
+    }
+
+    #[test]
+    fn line_breaks_as_split_lines_counts_them() {
+        for (text, n) in [
+            ("", 0),
+            ("1,2", 0),
+            ("1\n2\n", 2),
+            ("1\r\n2\r\n", 2),
+            ("1\r2\r", 2),
+            ("\r\n\n\r\r\n\r", 5),
+            ("1\r", 1),
+        ] {
+            assert_eq!(line_breaks(text.as_bytes()), n, "{text:?}");
+        }
     }
 
     #[test]

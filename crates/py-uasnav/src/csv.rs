@@ -1,6 +1,6 @@
 //! Binding of `csv_chunk`: whole lines of a numeric CSV file (bytes) into an (m, k) float64
 //! array, parsed on every core with the GIL released, or `None` for the row-by-row reader.
-use csv_chunk::{cores, parse, Layout};
+use csv_chunk::{cores, line_breaks, parse, Layout};
 use numpy::ndarray::{Array2, ShapeBuilder};
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
@@ -25,6 +25,7 @@ fn end_arg(obj: &Bound<'_, PyAny>) -> PyResult<Option<usize>> {
 /// line needs the row-by-row reader (see the `csv_chunk` crate). `threads` 0: one per core.
 #[pyfunction]
 #[pyo3(signature = (chunk, width, columns, exact_width, nan_ok=false, threads=0, end=None))]
+#[allow(clippy::too_many_arguments)] // the Python signature
 fn csv_parse_chunk<'py>(
     py: Python<'py>,
     chunk: &Bound<'py, PyBytes>,
@@ -68,7 +69,33 @@ fn csv_parse_chunk<'py>(
     Ok(Some(array.into_pyarray(py)))
 }
 
+/// Line breaks (`\n`, `\r\n`, `\r`) in `chunk[:end]`, counted with the GIL released.
+#[pyfunction]
+#[pyo3(signature = (chunk, end=None))]
+fn csv_line_breaks(
+    py: Python<'_>,
+    chunk: &Bound<'_, PyBytes>,
+    #[pyo3(from_py_with = end_arg)] end: Option<usize>,
+) -> PyResult<usize> {
+    let text = prefix(py, chunk.as_bytes(), end)?;
+    Ok(py.detach(|| line_breaks(text)))
+}
+
+/// `all[..end]` (all of it for None), or an `InputError` naming `end`.
+fn prefix<'a>(py: Python<'_>, all: &'a [u8], end: Option<usize>) -> PyResult<&'a [u8]> {
+    match end {
+        None => Ok(all),
+        Some(end) => all.get(..end).ok_or_else(|| {
+            input_error(
+                py,
+                format!("end: {end} is beyond the chunk's {} bytes", all.len()),
+            )
+        }),
+    }
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(csv_parse_chunk, m)?)?;
+    m.add_function(wrap_pyfunction!(csv_line_breaks, m)?)?;
     Ok(())
 }

@@ -36,6 +36,7 @@ from typing import BinaryIO, NoReturn
 import numpy as np
 from numpy.typing import NDArray
 
+from uasnav import _core
 from uasnav.errors import DataFormatError
 from uasnav.io._text import csv_rows, decode, decode_part, numeric_rows, parse_chunk, read_text, split_lines
 from uasnav.limits import check_memory, max_memory
@@ -59,11 +60,7 @@ def chunk_bytes() -> int:
 
 def _line_count(raw: bytes, end: int | None = None) -> int:
     """Line breaks in ``raw[:end]`` (``\\n``, ``\\r\\n`` or ``\\r``, like :func:`split_lines`)."""
-    end = len(raw) if end is None else end
-    n = raw.count(b"\n", 0, end)
-    if raw.find(b"\r", 0, end) >= 0:
-        n += raw.count(b"\r", 0, end) - raw.count(b"\r\n", 0, end)
-    return n
+    return _core.csv_line_breaks(raw, end)
 
 
 def _cut(buf: bytes) -> int:
