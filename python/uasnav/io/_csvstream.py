@@ -43,9 +43,9 @@ from uasnav.limits import check_memory, max_memory
 
 #: Largest chunk (bytes of text) parsed at once.
 MAX_CHUNK_BYTES = 16 * 1024**2
-#: Peak bytes of memory per byte of a chunk while it is parsed (the bytes, the text, its lines
-#: and the columns: ≈ 4; or the row-by-row reader's Python objects when it takes over: ≈ 6, see
-#: ``_text``).
+#: Peak bytes of memory per byte of a chunk while it is parsed (the bytes and the columns, once
+#: per part and once joined: ≈ 2; or the row-by-row reader's Python objects when it takes over:
+#: ≈ 6, see ``_text``).
 CHUNK_MEMORY_FACTOR = 8
 #: Text after a chunk given to the row-by-row reader with it when a ``"`` may open a quoted
 #: cell running on: the :mod:`csv` module stops such a cell at its field limit (128 KiB).
