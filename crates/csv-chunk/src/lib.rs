@@ -107,15 +107,27 @@ struct Part {
 }
 
 /// Line breaks in `text` (`\n`, `\r\n` or `\r`, a `\r\n` counted once): the lines a chunk
-/// moves a reader on by. One pass the compiler vectorises, a second only if there is a `\r`.
+/// moves a reader on by. A second pass only if there is a `\r`.
 pub fn line_breaks(text: &[u8]) -> usize {
-    let lf = text.iter().filter(|&&b| b == b'\n').count();
+    let lf = count_bytes(text, b'\n');
     if !text.contains(&b'\r') {
         return lf;
     }
-    let cr = text.iter().filter(|&&b| b == b'\r').count();
     let crlf = text.windows(2).filter(|w| *w == b"\r\n").count();
-    lf + cr - crlf
+    lf + count_bytes(text, b'\r') - crlf
+}
+
+/// Bytes equal to `byte`, counted in one-byte lanes over blocks of 255 (so the compiler
+/// vectorises the count 16 or 32 bytes at a time; a `usize` count per byte is not).
+fn count_bytes(text: &[u8], byte: u8) -> usize {
+    text.chunks(255)
+        .map(|block| {
+            let n = block
+                .iter()
+                .fold(0u8, |n, &b| n.wrapping_add(u8::from(b == byte)));
+            usize::from(n)
+        })
+        .sum()
 }
 
 /// `chunk` cut into at most `parts` pieces of whole lines, about equally long.
