@@ -459,6 +459,43 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// Any cut into parts (at line breaks, \r\n kept whole) parses into the rows of the
+        /// whole, in order, and counts the same line breaks.
+        #[test]
+        fn any_cut_joins_into_the_whole(
+            rows in proptest::collection::vec(
+                (proptest::collection::vec(-1e6f64..1e6, 3), 0usize..5), 0..60),
+            parts in 1usize..6,
+        ) {
+            let breaks = ["\n", "\r\n", "\r", "\n\n", "\r\n\r\n"];
+            let text: String = rows
+                .iter()
+                .map(|(r, nl)| format!("{},{:e},{:.3}{}", r[0], r[1], r[2], breaks[*nl]))
+                .collect();
+            let cols = [1, 2, 0];
+            let layout = Layout { width: 3, columns: &cols, exact_width: true, nan_ok: false };
+            let whole = parse_part(&text, &layout).map(|p| (p.rows, p.cols));
+            proptest::prop_assert_eq!(whole.as_ref().map(|w| w.0), Some(rows.len()));
+            let pieces = split(&text, parts);
+            proptest::prop_assert_eq!(pieces.concat(), text.clone());
+            let mut joined = vec![Vec::new(); 3];
+            let mut n = 0;
+            for piece in &pieces {
+                let p = parse_part(piece, &layout);
+                proptest::prop_assert!(p.is_some());
+                let p = p.unwrap_or(Part { rows: 0, cols: vec![] });
+                n += p.rows;
+                for (j, c) in p.cols.into_iter().enumerate() {
+                    joined[j].extend(c);
+                }
+            }
+            proptest::prop_assert_eq!(Some((n, joined)), whole);
+            let lines: usize = pieces.iter().map(|p| line_breaks(p.as_bytes())).sum();
+            proptest::prop_assert_eq!(lines, line_breaks(text.as_bytes()));
+        }
+    }
+
     #[test]
     fn no_columns_still_counts_and_checks_rows() {
         assert_eq!(
