@@ -43,7 +43,7 @@ def test_fast_equals_row_by_row(rows, blanks) -> None:
             body.append("   ")
     text = "a,b,c\n" + "\n".join(body) + "\n"
     fast, slow = _both(text, ["c", "a"])
-    # numpy refuses "1_0", which float() accepts: then the row-by-row reader decides alone
+    # the parser refuses "1_0", which float() accepts: then the row-by-row reader decides alone
     assert fast is not None or any("_" in c for r in rows for c in r)
     if fast is None:
         return

@@ -361,3 +361,27 @@ class InsStream:
     def counts(self) -> dict[str, Any]:
         """Running counts: imu_samples, imu_refused, imu_gaps, fixes_used, fixes_excluded,
         fixes_dropped, gnss_resets, course_reset."""
+
+# --- csv: the csv-chunk crate ----------------------------------------------------------------
+
+def csv_parse_chunk(
+    chunk: bytes,
+    width: int,
+    columns: Sequence[int],
+    exact_width: bool,
+    nan_ok: bool = False,
+    threads: int = 0,
+    end: int | None = None,
+) -> NDArray[np.float64] | None:
+    """The rows of ``chunk[:end]`` (bytes of whole CSV lines below a header row of ``width``
+    cells, read in place) as an (m, len(columns)) Fortran-order float64 array of the cells at
+    ``columns``, parsed on ``threads`` threads (0: one per core) with the GIL released; None
+    when some line needs the row-by-row reader (quoting, a non-ASCII or control byte, a line
+    over 64 KiB, a blank line, a row of the wrong width, a cell that is not a plain decimal
+    number, ±inf, NaN unless ``nan_ok``)."""
+
+def csv_line_breaks(chunk: bytes, end: int | None = None) -> int:
+    """Line breaks (``\\n``, ``\\r\\n`` or ``\\r``) in ``chunk[:end]``, counted with the GIL
+    released."""
+
+__all__ += ["csv_line_breaks", "csv_parse_chunk"]

@@ -6,6 +6,7 @@
 mod allan;
 mod attitude;
 mod convert;
+mod csv;
 mod earth;
 mod errors;
 mod ins;
@@ -28,5 +29,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     redundancy::register(m)?;
     utm::register(m)?;
     ins::register(m)?;
+    csv::register(m)?;
     Ok(())
 }

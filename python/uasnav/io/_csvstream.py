@@ -1,20 +1,23 @@
-"""The CSV engine of every numeric CSV reader: chunks of whole lines through numpy's C reader,
-with the row-by-row reader's errors.
+"""The CSV engine of every numeric CSV reader: chunks of whole lines through the extension's
+numeric parser, on every core, with the row-by-row reader's errors.
 
 :class:`NumericCsv` reads a CSV file (``#`` comment lines, a header row, numeric data rows) in
 chunks of whole lines (:func:`chunk_bytes`, at most 16 MiB), each parsed by
-:func:`~uasnav.io._text.loadtxt_rows` (:func:`numpy.loadtxt`) into float64 columns, so memory
-stays bounded by the chunk size whatever the file's length, and a consumer can stream (block
-means while reading, :class:`~uasnav.io.formats.csv_v1.CsvV1Stream`) or concatenate
-(:func:`read_table`: numeric tables, the GNSS, x-io and flight CSVs).
+:func:`~uasnav.io._text.parse_chunk` (the ``csv-chunk`` crate: the chunk cut at line breaks into
+one part per core, parsed with the GIL released) into float64 columns, so memory stays bounded
+by the chunk size whatever the file's length, and a consumer can stream (block means while
+reading, :class:`~uasnav.io.formats.csv_v1.CsvV1Stream`) or concatenate (:func:`read_table`:
+numeric tables, the GNSS, x-io and flight CSVs).
 
-numpy accepts a subset of what the row-by-row reader of :mod:`uasnav.io._text` accepts, never
-more: no quoting (a ``"`` anywhere sends the chunk row by row), no lines of spaces, cells of at
-most 64 KiB, UTF-8 checked, NUL bytes, ±inf (and NaN where it is refused) handed over. Any chunk
-numpy refuses is parsed by the row-by-row reader, which either names the first bad cell (file,
-line, column: the same :class:`~uasnav.errors.DataFormatError` as reading the whole text) or
-accepts what ``float`` accepts and numpy does not (``1_0``, non-ASCII digits). Both paths return
-the same values bit for bit (``tests/test_io_csv_stream.py``).
+The parser accepts a subset of what the row-by-row reader of :mod:`uasnav.io._text` accepts,
+never more: printable ASCII only (a ``"`` anywhere, a NUL, control or non-ASCII byte sends the
+chunk row by row), lines of at most 64 KiB (below the :mod:`csv` module's field limit of 128
+KiB), no lines of spaces, cells in plain decimal syntax, ±inf (and NaN where it is refused)
+handed over. Any chunk it refuses is parsed by the row-by-row reader, which either names the
+first bad cell (file, line, column: the same :class:`~uasnav.errors.DataFormatError` as reading
+the whole text) or accepts what ``float`` accepts beyond plain syntax (``1_0``, non-ASCII
+digits). Both parse correctly rounded and return the same values bit for bit
+(``tests/test_io_csv_stream.py``).
 
 The errors come in the order the whole-text reader finds them: an encoding error anywhere in
 the file (not UTF-8, a NUL byte) wins over any other error, so after the first other error the
@@ -33,20 +36,17 @@ from typing import BinaryIO, NoReturn
 import numpy as np
 from numpy.typing import NDArray
 
+from uasnav import _core
 from uasnav.errors import DataFormatError
-from uasnav.io._text import csv_rows, decode, decode_part, loadtxt_rows, numeric_rows, read_text, split_lines
+from uasnav.io._text import csv_rows, decode, decode_part, numeric_rows, parse_chunk, read_text, split_lines
 from uasnav.limits import check_memory, max_memory
 
 #: Largest chunk (bytes of text) parsed at once.
 MAX_CHUNK_BYTES = 16 * 1024**2
-#: Peak bytes of memory per byte of a chunk while it is parsed (the bytes, the text, its lines
-#: and the columns: ≈ 4; or the row-by-row reader's Python objects when it takes over: ≈ 6, see
-#: ``_text``).
+#: Peak bytes of memory per byte of a chunk while it is parsed (the bytes and the columns, once
+#: per part and once joined: ≈ 2; or the row-by-row reader's Python objects when it takes over:
+#: ≈ 6, see ``_text``).
 CHUNK_MEMORY_FACTOR = 8
-#: A chunk whose lines are all shorter than this is parsed by numpy; a longer line may hold a
-#: cell beyond the :mod:`csv` module's field limit (128 KiB), which only the row-by-row reader
-#: reports as such.
-_MAX_FAST_LINE = 64 * 1024
 #: Text after a chunk given to the row-by-row reader with it when a ``"`` may open a quoted
 #: cell running on: the :mod:`csv` module stops such a cell at its field limit (128 KiB).
 _LOOKAHEAD = 1024**2
@@ -58,12 +58,9 @@ def chunk_bytes() -> int:
     return int(min(MAX_CHUNK_BYTES, max(256 * 1024, max_memory() // 64)))
 
 
-def _line_count(raw: bytes) -> int:
-    """Line breaks in ``raw`` (``\\n``, ``\\r\\n`` or ``\\r``, like :func:`split_lines`)."""
-    n = raw.count(b"\n")
-    if raw.find(b"\r") >= 0:
-        n += raw.count(b"\r") - raw.count(b"\r\n")
-    return n
+def _line_count(raw: bytes, end: int | None = None) -> int:
+    """Line breaks in ``raw[:end]`` (``\\n``, ``\\r\\n`` or ``\\r``, like :func:`split_lines`)."""
+    return _core.csv_line_breaks(raw, end)
 
 
 def _cut(buf: bytes) -> int:
@@ -75,30 +72,21 @@ def _cut(buf: bytes) -> int:
     return r + 1
 
 
-def _short_lines(raw: bytes) -> bool:
-    """True if every aligned window of :data:`_MAX_FAST_LINE` bytes of ``raw`` holds a line
-    break: then no line is as long as 2 × 64 KiB, the :mod:`csv` module's field limit."""
-    w = _MAX_FAST_LINE
-    for a in range(0, len(raw), w):
-        if raw.find(b"\n", a, a + w) < 0 and raw.find(b"\r", a, a + w) < 0 and a + w < len(raw):
-            return False
-    return True
-
-
 @dataclass
 class Block:
     """Rows of one chunk: ``data`` (m, k) float64 (columns contiguous), in the order of the
-    columns asked for; ``first_line`` is the file line (1-based) the chunk starts at."""
+    columns asked for; ``first_line`` is the file line (1-based) the chunk starts at, ``raw``
+    its bytes (a view of the bytes read)."""
 
     data: NDArray[np.float64]
     first_line: int
-    raw: bytes
+    raw: memoryview
     header: Sequence[str]
     source: str
 
     def row_lines(self) -> list[int]:
         """The file line of every row (blank lines skipped), told by the row-by-row reader."""
-        text = decode_part(self.raw, self.source, self.first_line, self.header)
+        text = decode_part(bytes(self.raw), self.source, self.first_line, self.header)
         return [
             ln
             for ln, _ in csv_rows(split_lines(text), 0, self.source, self.header, offset=self.first_line - 1)
@@ -123,8 +111,11 @@ class NumericCsv:
         self.comments: list[str] = []
         self.header: list[str] = []
         self.header_line = 0
-        self._carry = b""  # bytes read and not yet yielded
+        self._carry = b""  # bytes read and not yet yielded (just before the reading position)
         self._line = 1  # file line of self._carry's first byte
+        # a regular file is read again after each cut instead of carrying the cut line over, so
+        # a chunk is the bytes object read, never a copy
+        self._seekable = size is not None
         self._eof = False
         self.data_start = 0  # byte offset of the data (after the header row)
 
@@ -204,14 +195,18 @@ class NumericCsv:
         self.header = [h.strip() for h in cells]
         self.comments = lines[: self.header_line - 1]
         self.data_start = end
-        self._carry = raw[end:]
+        if self._seekable:
+            self._fh.seek(end)
+            self._eof = False
+        else:
+            self._carry = raw[end:]
         self._line = self.header_line + 1
         return True
 
-    def _chunks(self) -> Iterator[tuple[int, bytes]]:
-        """(first line, chunk of whole lines). The reading position is kept on ``self`` before
-        each chunk is yielded, so a second iterator (:meth:`fail`) goes on after the chunk the
-        first one yielded last."""
+    def _chunks(self) -> Iterator[tuple[int, bytes, int]]:
+        """(first line, bytes read, n): the first n bytes are a chunk of whole lines. The
+        reading position is kept on ``self`` before each chunk is yielded, so a second iterator
+        (:meth:`fail`) goes on after the chunk the first one yielded last."""
         while True:
             buf = self._carry
             if not self._eof and len(buf) < self._chunk:
@@ -227,11 +222,14 @@ class NumericCsv:
                 buf += more
                 n = len(buf) if self._eof else _cut(buf)
             n = n or len(buf)  # a line of more than 4 chunks: the row-by-row reader judges it
-            part = buf if n == len(buf) else buf[:n]
-            self._carry = buf[n:]
+            if n < len(buf) and self._seekable:
+                self._fh.seek(n - len(buf), os.SEEK_CUR)  # the cut line is read with the next chunk
+                self._carry = b""
+            else:
+                self._carry = buf[n:]
             first = self._line
-            self._line += _line_count(part)
-            yield first, part
+            self._line += _line_count(buf, n)
+            yield first, buf, n
 
     def _lookahead(self) -> bytes:
         """The whole lines of up to :data:`_LOOKAHEAD` bytes after the last chunk yielded
@@ -259,40 +257,23 @@ class NumericCsv:
             The first bad row's error (file, line, column), or an encoding error further on.
         """
         idx = [self.header.index(c) for c in columns]
-        for line, raw in self._chunks():
+        for line, buf, n in self._chunks():
             try:
-                data = self._fast(raw, idx, exact_width, nan_ok)
+                data = parse_chunk(buf, len(self.header), idx, exact_width=exact_width, nan_ok=nan_ok, end=n)
                 if data is None:
-                    data = self._row_by_row(raw, line, columns, exact_width, nan_ok)
+                    data = self._row_by_row(buf[:n], line, columns, exact_width, nan_ok)
             except DataFormatError as e:
                 self.fail(e)
-            yield Block(data, line, raw, self.header, self.source)
+            yield Block(data, line, memoryview(buf)[:n], self.header, self.source)
 
     def fail(self, error: DataFormatError) -> NoReturn:
         """Raise ``error``, or an encoding error (not UTF-8, NUL) in the rest of the file, which
         the whole-text reader finds first."""
-        for first, raw in self._chunks():
+        for first, buf, n in self._chunks():
+            raw = buf[:n]
             if not raw.isascii() or b"\x00" in raw:
                 decode_part(raw, self.source, first, self.header)
         raise error
-
-    def _fast(
-        self, raw: bytes, idx: Sequence[int], exact_width: bool, nan_ok: bool
-    ) -> NDArray[np.float64] | None:
-        if b'"' in raw or b"\x00" in raw or not _short_lines(raw):
-            return None
-        if raw.isascii():
-            text = raw.decode("ascii")
-        else:
-            try:
-                text = raw.decode("utf-8")
-            except UnicodeDecodeError:
-                return None  # the row-by-row reader names the line and column
-        lines = text.split("\n") if "\r" not in text else split_lines(text)
-        if lines and not lines[-1]:
-            lines.pop()
-        data = loadtxt_rows(lines, len(self.header), idx, exact_width=exact_width, nan_ok=nan_ok)
-        return None if data is None else np.asfortranarray(data)
 
     def _row_by_row(
         self, raw: bytes, line: int, columns: Sequence[str], exact_width: bool, nan_ok: bool

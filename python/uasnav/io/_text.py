@@ -2,9 +2,10 @@
 
 Every numeric CSV reader of :mod:`uasnav.io` (log format v1, x-io, the flight and GNSS CSVs,
 numeric tables) reads in chunks of whole lines (:mod:`uasnav.io._csvstream`), each parsed by
-numpy's C reader (:func:`loadtxt_rows`), and comes here, chunk by chunk (:func:`decode_part`,
-:func:`numeric_rows` with ``offset``), to name an error. So each hostile input gets one
-:class:`~uasnav.errors.DataFormatError` naming the file, line and (where it can be told) column:
+the extension's numeric chunk parser on every core (:func:`parse_chunk`), and comes here, chunk
+by chunk (:func:`decode_part`, :func:`numeric_rows` with ``offset``), to name an error. So each
+hostile input gets one :class:`~uasnav.errors.DataFormatError` naming the file, line and (where
+it can be told) column:
 
 - more bytes than the memory limit allows (checked on the bytes read, so ``/dev/zero`` or a
   FIFO cannot exhaust memory; :mod:`uasnav.limits`, ``UASNAV_MAX_MEMORY``);
@@ -26,6 +27,7 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from uasnav import _core
 from uasnav.errors import DataFormatError, ResourceLimitError
 from uasnav.limits import ENV_MEMORY, format_size, max_memory, read_limited
 
@@ -253,56 +255,42 @@ def numeric_rows(
     return np.array(rows, dtype=np.float64).reshape(len(rows), len(columns)), row_lines
 
 
-def loadtxt_rows(
-    lines: Sequence[str], width: int, idx: Sequence[int], *, exact_width: bool, nan_ok: bool = False
+def parse_chunk(
+    raw: bytes,
+    width: int,
+    idx: Sequence[int],
+    *,
+    exact_width: bool,
+    nan_ok: bool = False,
+    end: int | None = None,
 ) -> NDArray[np.float64] | None:
-    """The numeric engine of every CSV reader: data ``lines`` (blank lines skipped) parsed by
-    numpy's C reader into an (m, len(idx)) float array of the columns at ``idx``, or ``None``
-    when some row needs the row-by-row reader's judgement: a ``"`` (quoting), a row of the
-    wrong width (any width other than ``width`` if ``exact_width``, else one too short for a
-    wanted column), a line of spaces, a cell that is not a number, ±inf (NaN too unless
-    ``nan_ok``). The row-by-row reader then names the first offending cell, or accepts what
-    ``float`` accepts and numpy does not (``1_0``, non-ASCII digits): numpy accepts a subset of
-    what ``float`` accepts, never more, so both paths return the same values for every input."""
-    if not lines:
-        return np.empty((0, len(idx)), dtype=np.float64)
-    try:
-        if exact_width:
-            # all columns: numpy refuses a row whose cell count differs from the first row's
-            data = np.loadtxt(lines, dtype=np.float64, delimiter=",", comments=None, quotechar=None, ndmin=2)
-            if data.shape[1] != width:
-                return None
-            if list(idx) != list(range(width)):
-                data = data[:, list(idx)]
-        else:
-            data = np.loadtxt(
-                lines,
-                dtype=np.float64,
-                delimiter=",",
-                comments=None,
-                quotechar=None,
-                usecols=list(idx),
-                ndmin=2,
-            )
-    except ValueError:
-        return None
-    if data.shape[0] == 0 and any(ln for ln in lines):
-        return None
-    ok = ~np.isinf(data) if nan_ok else np.isfinite(data)
-    if not ok.all():
-        return None
-    return data
+    """The numeric engine of every CSV reader: ``raw[:end]`` (bytes of whole data lines, empty
+    lines skipped; read in place) parsed by the extension (the ``csv-chunk`` crate: one part per core, the GIL
+    released) into an (m, len(idx)) Fortran-order float array of the columns at ``idx``, or
+    ``None`` when some line needs the row-by-row reader's judgement: a ``"`` (quoting), a NUL,
+    control or non-ASCII byte, a line longer than 64 KiB, a line of spaces, a row of the wrong
+    width (any width other than ``width`` if ``exact_width``, else one too short for a wanted
+    column), a wanted cell that is not plain decimal syntax (``[+-]``, digits, ``.``, an
+    exponent; spaces and tabs around it) or is ±inf (NaN too unless ``nan_ok``). The row-by-row
+    reader then names the first offending cell, or accepts what ``float`` accepts beyond plain
+    syntax (``1_0``, non-ASCII digits). Both parse correctly rounded, so both paths return the
+    same values bit for bit for every input."""
+    return _core.csv_parse_chunk(raw, width, list(idx), exact_width, nan_ok, 0, end)
 
 
 def _numeric_rows_fast(
     lines: list[str], start: int, width: int, idx: Sequence[int], exact_width: bool, nan_ok: bool = False
 ) -> tuple[NDArray[np.float64], list[int]] | None:
-    """:func:`numeric_rows` in one vectorised pass (:func:`loadtxt_rows`), or ``None``."""
+    """:func:`numeric_rows` in one pass of :func:`parse_chunk`, or ``None``."""
     body = lines[start:]
     keep = [k for k, ln in enumerate(body) if ln.strip()]
-    if len(keep) < 2 or any('"' in body[k] for k in keep):
+    if len(keep) < 2:
         return None
-    data = loadtxt_rows([body[k] for k in keep], width, idx, exact_width=exact_width, nan_ok=nan_ok)
+    try:
+        raw = "\n".join([body[k] for k in keep]).encode("ascii")
+    except UnicodeEncodeError:
+        return None  # the row-by-row reader judges non-ASCII text
+    data = parse_chunk(raw, width, idx, exact_width=exact_width, nan_ok=nan_ok)
     if data is None or data.shape[0] != len(keep):
         return None
     return data, [start + k + 1 for k in keep]
@@ -337,9 +325,9 @@ __all__ = [
     "decode",
     "decode_part",
     "finite_cell",
-    "loadtxt_rows",
     "max_text_bytes",
     "numeric_rows",
+    "parse_chunk",
     "read_text",
     "show_cell",
     "split_lines",
