@@ -50,16 +50,7 @@ fn csv_parse_chunk<'py>(
     };
     let parts = if threads == 0 { cores() } else { threads };
     // bytes objects are immutable: the text is read in place while other threads run
-    let all = chunk.as_bytes();
-    let text = match end {
-        None => all,
-        Some(end) => all.get(..end).ok_or_else(|| {
-            input_error(
-                py,
-                format!("end: {end} is beyond the chunk's {} bytes", all.len()),
-            )
-        })?,
-    };
+    let text = prefix(py, chunk.as_bytes(), end)?;
     let Some(table) = py.detach(|| parse(text, &layout, parts)) else {
         return Ok(None);
     };
