@@ -1,9 +1,8 @@
 # uasnav: `make demo` runs the main job, `make test` runs every check. Both start from nothing:
 # they create .venv, install the Python dependencies and build the Rust extension with maturin.
 # `make demo` installs what the report needs (the base install + the utm and fleet extras);
-# `make test` adds the test and docs tools and Chromium for the browser tests, and runs its
-# independent steps side by side (TEST_JOBS at a time: the Rust checks, the embedded build, the
-# wheel and the docs beside the Python tests, which mostly keep one core busy).
+# `make test` adds the test and docs tools and Chromium for the browser tests, and runs
+# independent steps side by side (see `test`).
 SHELL := /bin/bash
 PYTHON ?= python3
 VENV ?= .venv
@@ -17,19 +16,22 @@ DIST := build/dist
 ZIG_ENV := PATH="$(CURDIR)/$(BIN):$$PATH"
 MATURIN_BUILD := $(ZIG_ENV) $(BIN)/maturin build --release --strip --zig --compatibility manylinux2014 -q
 
-.PHONY: demo test test-steps setup browser rust-checks py-checks package-checks bench bench-python clean wheel dist docs publish-check
+.PHONY: demo test test-lane setup browser rust-checks py-checks package-checks bench bench-python clean wheel dist docs publish-check
 
 demo: $(VENV)/.built-demo
 	$(BIN)/uasnav report --out build/report
 
 TEST_JOBS ?= 2
-# Each step's output is printed whole when the step ends (--output-sync), so logs stay readable.
+# Two phases, TEST_JOBS steps at a time: the development install beside the Rust checks, then the
+# Python tests beside the other steps (one after the other: the wheel, its package tests, the
+# embedded build, the docs, the crate's publish check). Each step's output is printed whole when
+# the step ends (--output-sync), so logs stay readable.
 test:
-	+$(MAKE) -j$(TEST_JOBS) --output-sync=target test-steps
+	+$(MAKE) -j$(TEST_JOBS) --output-sync=target setup rust-checks
+	+$(MAKE) -j$(TEST_JOBS) --output-sync=target py-checks test-lane
 
-# Ordered so that the Python tests start as soon as the development install is ready, and the
-# downloads (Debian packages, PyPI) overlap the first compilations.
-test-steps: py-checks rust-checks wheel package-checks embedded docs publish-check
+test-lane:
+	+$(MAKE) --no-print-directory wheel package-checks embedded docs publish-check
 
 setup: $(VENV)/.built browser
 
@@ -41,16 +43,17 @@ APT_INSTALL := flock /tmp/uasnav-apt.lock sh -c 'apt-get update -q && DEBIAN_FRO
 browser:
 	@command -v chromium >/dev/null || $(APT_INSTALL) chromium
 
-$(BIN)/python:
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --upgrade pip maturin
+# The virtual environment is created in the same step as the development install.
+NEW_VENV := test -x $(BIN)/python || { $(PYTHON) -m venv $(VENV) && $(BIN)/pip install --upgrade pip maturin; }
 
-$(VENV)/.built: $(BIN)/python $(RUST_SRC) $(PY_SRC)
+$(VENV)/.built: $(RUST_SRC) $(PY_SRC)
+	$(NEW_VENV)
 	$(BIN)/maturin develop --release --extras $(EXTRAS) -q
 	$(BIN)/python -c 'import uasnav._core'
 	touch $@
 
-$(VENV)/.built-demo: $(BIN)/python $(RUST_SRC) $(PY_SRC)
+$(VENV)/.built-demo: $(RUST_SRC) $(PY_SRC)
+	$(NEW_VENV)
 	$(BIN)/maturin develop --release --extras $(DEMO_EXTRAS) -q
 	$(BIN)/python -c 'import uasnav._core'
 	touch $@
