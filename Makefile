@@ -31,7 +31,7 @@ test:
 	+$(MAKE) -j$(TEST_JOBS) --output-sync=target py-checks test-lane
 
 test-lane:
-	+$(MAKE) --no-print-directory wheel package-checks embedded docs publish-check
+	+$(MAKE) -j1 --no-print-directory wheel package-checks embedded docs publish-check
 
 setup: $(VENV)/.built browser
 

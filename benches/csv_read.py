@@ -4,8 +4,9 @@ Run: ``.venv/bin/python benches/csv_read.py LOG.csv [--repeat 3]`` (e.g. the def
 ``uasnav simulate --preset ax1 --profile soak --out soak.csv``). The runs alternate ours and the
 peer so that a change of machine load hits both; medians of wall and CPU time (all threads) are
 printed. Ours: ``read_log`` (chunks through the extension's parser on every core, every cell
-checked, t strictly increasing, an ImuLog built) and ``load_training_data`` (the calibration's 1 s block means while
-reading). Peer: ``pyarrow.csv.read_csv`` of all columns, types inferred, no checks.
+checked, t strictly increasing, an ImuLog built) and ``load_training_data`` (the calibration's
+1 s block means while reading). Peer: ``pyarrow.csv.read_csv`` of all columns, types inferred,
+no checks.
 """
 
 from __future__ import annotations
