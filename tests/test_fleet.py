@@ -26,14 +26,23 @@ from uasnav.fleet.simulate import load_truth
 
 
 @pytest.fixture(scope="module")
-def client():
+def worker_tmp(tmp_path_factory):
+    """The workers' temporary folder: their own (TMPDIR when they start), so that a check for
+    leftovers there is not disturbed by other processes using the machine's."""
+    return tmp_path_factory.mktemp("worker-tmp")
+
+
+@pytest.fixture(scope="module")
+def client(worker_tmp):
     from distributed import Client
 
-    cluster = fleet.local_cluster(2)
-    c = Client(cluster)
-    yield c
-    c.close()
-    cluster.close()
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("TMPDIR", str(worker_tmp))
+        cluster = fleet.local_cluster(2)
+        c = Client(cluster)
+        yield c
+        c.close()
+        cluster.close()
 
 
 @pytest.fixture(scope="module")
@@ -607,12 +616,16 @@ def _check_broken(errors, base):
     assert all(kinds[f"{base}/{b}"] == "FetchError" for b in _BROKEN)
 
 
-def test_url_list_equals_the_logs_read_from_disk(client, log_server, fleet_dir, reference, tmp_path):
+def test_url_list_equals_the_logs_read_from_disk(
+    client, worker_tmp, log_server, fleet_dir, reference, tmp_path
+):
     """A .urls list of http:// logs on the 2-worker cluster: the same rows and hashes as the
     logs read from disk, the corrupt log and every broken URL in the errors table (with the URL
     and the reason), temporary downloads removed; --resume fetches only what is missing."""
     import tempfile
 
+    # the downloads go to the workers' own temporary folder, checked for leftovers at the end
+    assert set(client.run(tempfile.gettempdir).values()) == {str(worker_tmp)}
     base, requested = log_server
     _, ref_rows, ref_errors = reference["imu_health"]
     logs = sorted({*ref_rows.column("path").to_pylist(), *ref_errors.column("path").to_pylist()})
@@ -620,7 +633,7 @@ def test_url_list_equals_the_logs_read_from_disk(client, log_server, fleet_dir, 
     url_of = {p: f"{base}/{Path(p).relative_to(fleet_dir).as_posix()}" for p in logs}
     fetch = {"fetch_timeout_s": 2.0, "fetch_max_bytes": 4 << 20}
     assert max(os.path.getsize(p) for p in logs) < 4 << 20
-    tmp0 = set(Path(tempfile.gettempdir()).glob("uasnav-fleet-*"))
+    tmp0 = set(worker_tmp.glob("uasnav-fleet-*"))
 
     # first run: 3 of the logs and the broken URLs
     out = tmp_path / "h.parquet"
@@ -670,7 +683,7 @@ def test_url_list_equals_the_logs_read_from_disk(client, log_server, fleet_dir, 
     nothing = fleet.run(fleet.IMU_HEALTH, [full], out, client=client, resume=True, **fetch)
     assert (nothing.n_skipped, nothing.n_ok, nothing.n_errors) == (7, 0, 4)
     assert sorted(requested) == sorted(f"/{b}" for b in _BROKEN)
-    assert set(Path(tempfile.gettempdir()).glob("uasnav-fleet-*")) == tmp0
+    assert set(worker_tmp.glob("uasnav-fleet-*")) == tmp0
 
 
 def pa_compute_equal(table, column, value):
